@@ -1,0 +1,1 @@
+//! Host-side library: map loading, storage on the heap, output.

@@ -1,0 +1,123 @@
+//! The planner's error enum: small, `Copy`, with `Display` and (behind the `defmt` feature)
+//! `defmt::Format`. Every value has a stable numeric [`Error::code`] so the wire protocol can
+//! carry it.
+
+use core::fmt;
+
+/// Which end of a path a [`Error::OutOfBounds`] or [`Error::Blocked`] refers to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Endpoint {
+    /// The start cell.
+    Start,
+    /// The goal cell.
+    Goal,
+}
+
+/// Which parameter a [`Error::BadParam`] rejects.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Param {
+    /// `ants` must be at least 1.
+    Ants,
+    /// `iterations` must be at least 1.
+    Iterations,
+    /// `alpha` must be finite and in `[0, 16]`.
+    Alpha,
+    /// `beta` must be finite and in `[0, 16]`.
+    Beta,
+    /// `rho` must be in `(0, 1]`.
+    Rho,
+    /// `q` must be finite and `> 0`.
+    Q,
+    /// `a` (goal-attraction base) must be in `(0, 1]`.
+    A,
+    /// `xi` (potential-field gain) must be finite and `>= 0`.
+    Xi,
+    /// `tau0`, `tau_min`, `tau_max` must satisfy `0 < tau_min <= tau0 <= tau_max`, all finite.
+    Tau,
+}
+
+/// Everything that can go wrong when planning.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Error {
+    /// The grid has a zero side, or its bit buffer is shorter than `width * height` bits.
+    BadMap,
+    /// The map has more cells than the storage was sized for.
+    MapTooLarge {
+        /// Cells in the map.
+        cells: u32,
+        /// Cells the storage can hold.
+        capacity: u32,
+    },
+    /// The start or goal lies outside the map.
+    OutOfBounds(Endpoint),
+    /// The start or goal is an obstacle cell.
+    Blocked(Endpoint),
+    /// A parameter is outside its valid range.
+    BadParam(Param),
+    /// The goal cannot be reached from the start (decided by a flood fill before any ant runs),
+    /// or, with [`crate::DeadEnd::Die`], no ant reached it.
+    NoPath,
+    /// The run was cancelled before it finished.
+    Cancelled,
+}
+
+impl Error {
+    /// A stable one-byte code for the wire protocol.
+    pub const fn code(&self) -> u8 {
+        match self {
+            Error::BadMap => 1,
+            Error::MapTooLarge { .. } => 2,
+            Error::OutOfBounds(Endpoint::Start) => 3,
+            Error::OutOfBounds(Endpoint::Goal) => 4,
+            Error::Blocked(Endpoint::Start) => 5,
+            Error::Blocked(Endpoint::Goal) => 6,
+            Error::BadParam(_) => 7,
+            Error::NoPath => 8,
+            Error::Cancelled => 9,
+        }
+    }
+}
+
+impl fmt::Display for Endpoint {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Endpoint::Start => "start",
+            Endpoint::Goal => "goal",
+        })
+    }
+}
+
+impl fmt::Display for Param {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Param::Ants => "ants must be at least 1",
+            Param::Iterations => "iterations must be at least 1",
+            Param::Alpha => "alpha must be finite and in [0, 16]",
+            Param::Beta => "beta must be finite and in [0, 16]",
+            Param::Rho => "rho must be in (0, 1]",
+            Param::Q => "q must be finite and > 0",
+            Param::A => "a must be in (0, 1]",
+            Param::Xi => "xi must be finite and >= 0",
+            Param::Tau => "need 0 < tau_min <= tau0 <= tau_max, all finite",
+        })
+    }
+}
+
+impl fmt::Display for Error {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Error::BadMap => f.write_str("map has a zero side or too few cell bits"),
+            Error::MapTooLarge { cells, capacity } => {
+                write!(f, "map has {cells} cells, capacity is {capacity}")
+            }
+            Error::OutOfBounds(e) => write!(f, "{e} is outside the map"),
+            Error::Blocked(e) => write!(f, "{e} is on an obstacle"),
+            Error::BadParam(p) => write!(f, "bad parameter: {p}"),
+            Error::NoPath => f.write_str("no path: the goal is not reachable from the start"),
+            Error::Cancelled => f.write_str("cancelled"),
+        }
+    }
+}

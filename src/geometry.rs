@@ -1,0 +1,194 @@
+//! Path geometry: lengths, and the segment rule every path is checked against.
+//!
+//! **The segment rule.** Cell `(x, y)` is the closed square `[x, x+1] x [y, y+1]`; a waypoint
+//! stands for its cell's centre `(x + 0.5, y + 0.5)`. A straight segment between two waypoints is
+//! valid iff it touches no blocked cell's closed square. Touching counts: a segment that passes
+//! exactly through the corner shared by two diagonally adjacent obstacles is invalid, and so is a
+//! segment that grazes an obstacle's edge. For a single step this is exactly the
+//! no-corner-cutting rule of [`crate::grid`], so every raw path is also valid segment by segment.
+//!
+//! [`segment_clear`] decides the rule exactly in integer arithmetic (doubled coordinates, so
+//! centres are odd integers), with no floating point and no tolerance.
+
+use crate::grid::{Grid, Point};
+
+/// `sqrt(2)` as f32; the length of a diagonal step.
+pub const SQRT_2: f32 = core::f32::consts::SQRT_2;
+
+/// Euclidean distance between two cell centres.
+#[inline]
+pub fn distance(a: Point, b: Point) -> f32 {
+    let dx = f32::from(a.x) - f32::from(b.x);
+    let dy = f32::from(a.y) - f32::from(b.y);
+    libm::sqrtf(dx * dx + dy * dy)
+}
+
+/// Length of a path of `straight` orthogonal and `diagonal` diagonal steps.
+#[inline]
+pub fn steps_length(straight: u32, diagonal: u32) -> f32 {
+    straight as f32 + diagonal as f32 * SQRT_2
+}
+
+/// Floor division for a positive divisor.
+#[inline]
+fn floor_div(n: i64, d: i64) -> i64 {
+    n.div_euclid(d)
+}
+
+/// Ceiling division for a positive divisor.
+#[inline]
+fn ceil_div(n: i64, d: i64) -> i64 {
+    -((-n).div_euclid(d))
+}
+
+/// True iff the straight segment between the centres of `a` and `b` touches no blocked (or
+/// off-map) cell's closed square. See the module docs for the rule.
+///
+/// Cost: one test per touched cell, about `|dx| + |dy|` cells.
+pub fn segment_clear(grid: &Grid<'_>, a: Point, b: Point) -> bool {
+    // Order by x so the walk goes left to right.
+    let (p, q) = if a.x <= b.x { (a, b) } else { (b, a) };
+    // Doubled coordinates: the centre of cell x is 2x + 1, the square of cell c spans [2c, 2c + 2].
+    let (x0, y0) = (2 * i64::from(p.x) + 1, 2 * i64::from(p.y) + 1);
+    let (x1, y1) = (2 * i64::from(q.x) + 1, 2 * i64::from(q.y) + 1);
+    let dx = x1 - x0; // >= 0
+    let dy = y1 - y0;
+    if dx == 0 {
+        // Vertical: the line x = 2x0+1 lies strictly inside one column.
+        let (lo, hi) = if p.y <= q.y { (p.y, q.y) } else { (q.y, p.y) };
+        let x = i32::from(p.x);
+        return (lo..=hi).all(|y| !grid.blocked_xy(x, i32::from(y)));
+    }
+    for cx in i64::from(p.x)..=i64::from(q.x) {
+        let xa = x0.max(2 * cx);
+        let xb = x1.min(2 * cx + 2);
+        // y * dx at both ends of this column's piece of the segment (exact rationals).
+        let ya = y0 * dx + (xa - x0) * dy;
+        let yb = y0 * dx + (xb - x0) * dy;
+        let (ylo, yhi) = if ya <= yb { (ya, yb) } else { (yb, ya) };
+        // Cell cy is touched iff 2cy <= yhi/dx and 2cy + 2 >= ylo/dx.
+        let cy_lo = ceil_div(ylo - 2 * dx, 2 * dx);
+        let cy_hi = floor_div(yhi, 2 * dx);
+        for cy in cy_lo..=cy_hi {
+            // Coordinates stay within the map's u16 range, so the narrowing is lossless.
+            if grid.blocked_xy(cx as i32, cy as i32) {
+                return false;
+            }
+        }
+    }
+    true
+}
+
+/// Total Euclidean length of a polyline through cell centres.
+pub fn polyline_length(points: &[Point]) -> f32 {
+    points
+        .windows(2)
+        .map(|w| match w {
+            [a, b] => distance(*a, *b),
+            _ => 0.0,
+        })
+        .sum()
+}
+
+/// Number of turns (direction changes) along a polyline: points where the incoming and outgoing
+/// segments are not collinear-and-forward.
+pub fn turns(points: &[Point]) -> u32 {
+    let mut n = 0;
+    for w in points.windows(3) {
+        if let [a, b, c] = w {
+            let (ux, uy) = (
+                i64::from(b.x) - i64::from(a.x),
+                i64::from(b.y) - i64::from(a.y),
+            );
+            let (vx, vy) = (
+                i64::from(c.x) - i64::from(b.x),
+                i64::from(c.y) - i64::from(b.y),
+            );
+            let cross = ux * vy - uy * vx;
+            let dot = ux * vx + uy * vy;
+            if cross != 0 || dot <= 0 {
+                n += 1;
+            }
+        }
+    }
+    n
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn grid(rows: &[&str]) -> (Vec<u8>, u16, u16) {
+        let w = rows[0].len();
+        let mut b = vec![0u8; (w * rows.len()).div_ceil(8)];
+        for (y, r) in rows.iter().enumerate() {
+            for (x, c) in r.chars().enumerate() {
+                if c == '#' {
+                    let i = y * w + x;
+                    b[i / 8] |= 1 << (i % 8);
+                }
+            }
+        }
+        (b, w as u16, rows.len() as u16)
+    }
+
+    #[test]
+    fn diagonal_step_needs_both_sides() {
+        let (b, w, h) = grid(&["..", "#."]);
+        let g = Grid::new(w, h, &b).unwrap();
+        assert!(!segment_clear(&g, Point::new(0, 0), Point::new(1, 1)));
+        assert!(segment_clear(&g, Point::new(0, 0), Point::new(1, 0)));
+    }
+
+    #[test]
+    fn corner_touch_is_blocked() {
+        // Segment (0,0)->(2,2) passes through the corner points (1,1)-(2,2) of the middle cell's
+        // neighbours; with the centre cell blocked it is clearly blocked.
+        let (b, w, h) = grid(&["...", ".#.", "..."]);
+        let g = Grid::new(w, h, &b).unwrap();
+        assert!(!segment_clear(&g, Point::new(0, 0), Point::new(2, 2)));
+        // A knight-like segment (0,0)->(2,1) passes the point (1.5, 1.0): touches cell (1,1)'s top edge.
+        assert!(!segment_clear(&g, Point::new(0, 0), Point::new(2, 1)));
+        assert!(segment_clear(&g, Point::new(0, 0), Point::new(2, 0)));
+    }
+
+    #[test]
+    fn grazing_a_corner_point_is_blocked() {
+        // Segment from (0,0) to (2,4): centres (0.5,0.5) -> (2.5,4.5); it passes x=1.5 at y=2.5,
+        // and the point (1, 1.5)... check a case that touches exactly a corner:
+        // (0,0)->(2,2) passes through (1,1) and (2,2) corners; block cell (1,0): square [1,2]x[0,1]
+        // touches the point (1,1), so the segment is invalid.
+        let (b, w, h) = grid(&[".#.", "...", "..."]);
+        let g = Grid::new(w, h, &b).unwrap();
+        assert!(!segment_clear(&g, Point::new(0, 0), Point::new(2, 2)));
+        let (b, w, h) = grid(&["...", "...", "#.."]);
+        let g = Grid::new(w, h, &b).unwrap();
+        // Cell (0,2) is [0,1]x[2,3]; the segment (0.5,0.5)->(2.5,2.5) meets it only if it reaches
+        // x<=1 while y>=2: it does not.
+        assert!(segment_clear(&g, Point::new(0, 0), Point::new(2, 2)));
+    }
+
+    #[test]
+    fn vertical_and_reverse() {
+        let (b, w, h) = grid(&[".", "#", "."]);
+        let g = Grid::new(w, h, &b).unwrap();
+        assert!(!segment_clear(&g, Point::new(0, 2), Point::new(0, 0)));
+        let (b, w, h) = grid(&["#..", "...", "..#"]);
+        let g = Grid::new(w, h, &b).unwrap();
+        assert!(segment_clear(&g, Point::new(2, 0), Point::new(0, 2)));
+        assert!(segment_clear(&g, Point::new(0, 2), Point::new(2, 0)));
+    }
+
+    #[test]
+    fn turns_counts_corners() {
+        let p = [
+            Point::new(0, 0),
+            Point::new(1, 0),
+            Point::new(2, 0),
+            Point::new(2, 1),
+            Point::new(3, 2),
+        ];
+        assert_eq!(turns(&p), 2);
+        assert_eq!(turns(&p[..3]), 0);
+    }
+}

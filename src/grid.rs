@@ -1,0 +1,281 @@
+//! The occupancy grid: cells, the eight moves and the no-corner-cutting rule.
+//!
+//! A map is `width x height` cells stored row-major, one bit per cell, least significant bit
+//! first (`bit i` of the buffer is cell `(i % width, i / width)`), `1` = blocked, `0` = free.
+//! This is also the layout the wire protocol sends. `x` grows to the right, `y` grows downwards
+//! (as in Moving AI maps: `(0, 0)` is the first character of the first row).
+//!
+//! Moves: the 8 neighbours. A diagonal move is allowed only when both orthogonally adjacent cells
+//! are free, so a path never squeezes between two obstacles that touch at a corner.
+//!
+//! The grid borrows its bits, so it costs nothing to build over a `static` buffer on the device or
+//! a `Vec` on the host.
+
+use crate::error::Error;
+
+/// A cell coordinate. `x` = column, `y` = row from the top.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Point {
+    /// Column, 0 = leftmost.
+    pub x: u16,
+    /// Row, 0 = top.
+    pub y: u16,
+}
+
+impl Point {
+    /// A point at column `x`, row `y`.
+    pub const fn new(x: u16, y: u16) -> Self {
+        Point { x, y }
+    }
+}
+
+/// One of the eight moves, `0..8` clockwise from east (with `y` pointing down): E, SE, S, SW, W,
+/// NW, N, NE. Odd directions are diagonal.
+pub type Dir = u8;
+
+/// Column offset of each direction.
+pub const DX: [i32; 8] = [1, 1, 0, -1, -1, -1, 0, 1];
+/// Row offset of each direction.
+pub const DY: [i32; 8] = [0, 1, 1, 1, 0, -1, -1, -1];
+
+/// True for the four diagonal directions.
+#[inline]
+pub const fn is_diagonal(d: Dir) -> bool {
+    d & 1 == 1
+}
+
+/// The direction that undoes `d`.
+#[inline]
+pub const fn opposite(d: Dir) -> Dir {
+    (d + 4) & 7
+}
+
+/// A borrowed occupancy grid. See the module docs for the bit layout.
+#[derive(Clone, Copy, Debug)]
+pub struct Grid<'a> {
+    width: u16,
+    height: u16,
+    bits: &'a [u8],
+}
+
+/// Bytes needed to hold `cells` bits.
+pub const fn bytes_for(cells: usize) -> usize {
+    cells.div_ceil(8)
+}
+
+impl<'a> Grid<'a> {
+    /// A grid over `bits` (see the module docs). Fails with [`Error::BadMap`] if a side is zero or
+    /// `bits` holds fewer than `width * height` bits.
+    pub fn new(width: u16, height: u16, bits: &'a [u8]) -> Result<Self, Error> {
+        let cells = usize::from(width) * usize::from(height);
+        if cells == 0 || bits.len() < bytes_for(cells) {
+            return Err(Error::BadMap);
+        }
+        Ok(Grid {
+            width,
+            height,
+            bits,
+        })
+    }
+
+    /// Columns.
+    #[inline]
+    pub fn width(&self) -> u16 {
+        self.width
+    }
+
+    /// Rows.
+    #[inline]
+    pub fn height(&self) -> u16 {
+        self.height
+    }
+
+    /// `width * height`.
+    #[inline]
+    pub fn cells(&self) -> usize {
+        usize::from(self.width) * usize::from(self.height)
+    }
+
+    /// The bit buffer this grid reads.
+    pub fn bits(&self) -> &'a [u8] {
+        self.bits
+    }
+
+    /// True if `p` lies inside the map.
+    #[inline]
+    pub fn contains(&self, p: Point) -> bool {
+        p.x < self.width && p.y < self.height
+    }
+
+    /// Row-major index of `p` (which must be inside the map for the result to mean anything).
+    #[inline]
+    pub fn index(&self, p: Point) -> usize {
+        usize::from(p.y) * usize::from(self.width) + usize::from(p.x)
+    }
+
+    /// The point with row-major index `i`.
+    #[inline]
+    pub fn point(&self, i: usize) -> Point {
+        let w = usize::from(self.width);
+        // Both quotients fit in u16 for every index below `cells()`; larger ones are clamped.
+        Point::new(
+            u16::try_from(i % w).unwrap_or(u16::MAX),
+            u16::try_from(i / w).unwrap_or(u16::MAX),
+        )
+    }
+
+    /// True if cell index `i` is blocked; indices outside the map count as blocked.
+    #[inline]
+    fn blocked_index(&self, i: usize) -> bool {
+        match self.bits.get(i / 8) {
+            Some(b) => (b >> (i % 8)) & 1 == 1,
+            None => true,
+        }
+    }
+
+    /// True if `p` is inside the map and free.
+    #[inline]
+    pub fn is_free(&self, p: Point) -> bool {
+        self.contains(p) && !self.blocked_index(self.index(p))
+    }
+
+    /// True if `(x, y)` is outside the map or blocked. Takes signed coordinates so callers can ask
+    /// about cells one step beyond the border.
+    #[inline]
+    pub fn blocked_xy(&self, x: i32, y: i32) -> bool {
+        if x < 0 || y < 0 || x >= i32::from(self.width) || y >= i32::from(self.height) {
+            return true;
+        }
+        // Non-negative and inside the map, so the casts are lossless.
+        let i = (y as usize) * usize::from(self.width) + x as usize;
+        self.blocked_index(i)
+    }
+
+    /// Where move `d` from `p` leads, or `None` if the target is outside the map or blocked, or
+    /// the move is a diagonal that would cut a corner.
+    #[inline]
+    pub fn step(&self, p: Point, d: Dir) -> Option<Point> {
+        let di = usize::from(d & 7);
+        let dx = DX.get(di).copied().unwrap_or(0);
+        let dy = DY.get(di).copied().unwrap_or(0);
+        let x = i32::from(p.x) + dx;
+        let y = i32::from(p.y) + dy;
+        if self.blocked_xy(x, y) {
+            return None;
+        }
+        if is_diagonal(d)
+            && (self.blocked_xy(x, i32::from(p.y)) || self.blocked_xy(i32::from(p.x), y))
+        {
+            return None;
+        }
+        // Not blocked implies inside the map, so both fit in u16.
+        Some(Point::new(x as u16, y as u16))
+    }
+
+    /// Flood fill from `start` over allowed moves; true if `goal` is reached.
+    ///
+    /// `mark` and `queue` are scratch space of at least [`Grid::cells`] entries (the planner lends
+    /// its own buffers). Returns `false` if they are too short.
+    pub fn reachable(
+        &self,
+        start: Point,
+        goal: Point,
+        mark: &mut [u16],
+        queue: &mut [u32],
+    ) -> bool {
+        let cells = self.cells();
+        if mark.len() < cells || queue.len() < cells || !self.is_free(start) || !self.is_free(goal)
+        {
+            return false;
+        }
+        let Some(mark) = mark.get_mut(..cells) else {
+            return false;
+        };
+        mark.fill(0);
+        let (mut head, mut tail) = (0usize, 0usize);
+        let push = |q: &mut [u32], m: &mut [u16], tail: &mut usize, p: Point| {
+            let i = self.index(p);
+            if let (Some(slot), Some(mk)) = (q.get_mut(*tail), m.get_mut(i)) {
+                if *mk == 0 {
+                    *mk = 1;
+                    *slot = i as u32;
+                    *tail += 1;
+                }
+            }
+        };
+        push(queue, mark, &mut tail, start);
+        while head < tail {
+            let Some(&i) = queue.get(head) else { break };
+            head += 1;
+            let p = self.point(i as usize);
+            if p == goal {
+                return true;
+            }
+            for d in 0..8 {
+                if let Some(n) = self.step(p, d) {
+                    push(queue, mark, &mut tail, n);
+                }
+            }
+        }
+        false
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn grid_from(rows: &[&str], buf: &mut [u8]) -> (u16, u16) {
+        let w = rows[0].len();
+        for (y, r) in rows.iter().enumerate() {
+            for (x, c) in r.chars().enumerate() {
+                if c == '#' {
+                    let i = y * w + x;
+                    buf[i / 8] |= 1 << (i % 8);
+                }
+            }
+        }
+        (w as u16, rows.len() as u16)
+    }
+
+    #[test]
+    fn rejects_empty_and_short_maps() {
+        assert_eq!(Grid::new(0, 3, &[0; 4]).unwrap_err(), Error::BadMap);
+        assert_eq!(Grid::new(5, 5, &[0; 3]).unwrap_err(), Error::BadMap);
+        assert!(Grid::new(5, 5, &[0; 4]).is_ok());
+    }
+
+    #[test]
+    fn diagonal_needs_both_sides_free() {
+        let mut b = [0u8; 2];
+        let (w, h) = grid_from(&["..", "#."], &mut b);
+        let g = Grid::new(w, h, &b).unwrap();
+        // (0,0) -> (1,1) is SE; (0,1) is blocked, so the move cuts a corner.
+        assert_eq!(g.step(Point::new(0, 0), 1), None);
+        assert_eq!(g.step(Point::new(0, 0), 0), Some(Point::new(1, 0)));
+        assert_eq!(g.step(Point::new(1, 0), 2), Some(Point::new(1, 1)));
+        // Off the map.
+        assert_eq!(g.step(Point::new(0, 0), 4), None);
+    }
+
+    #[test]
+    fn flood_fill_sees_diagonal_walls() {
+        // A diagonal wall of touching obstacles separates the corners.
+        let mut b = [0u8; 2];
+        let (w, h) = grid_from(&["..#", ".#.", "#.."], &mut b);
+        let g = Grid::new(w, h, &b).unwrap();
+        let mut m = [0u16; 9];
+        let mut q = [0u32; 9];
+        assert!(!g.reachable(Point::new(0, 0), Point::new(2, 2), &mut m, &mut q));
+        assert!(g.reachable(Point::new(0, 0), Point::new(0, 1), &mut m, &mut q));
+    }
+
+    #[test]
+    fn index_and_point_round_trip() {
+        let g = Grid::new(7, 3, &[0; 3]).unwrap();
+        for i in 0..21 {
+            assert_eq!(g.index(g.point(i)), i);
+        }
+    }
+}

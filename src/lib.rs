@@ -1,0 +1,89 @@
+//! # ohaca — the Optimized Hybrid Ant Colony planner
+//!
+//! A `no_std`, allocation-free implementation of the path planner of *An Optimized Hybrid Ant
+//! Colony Algorithm for Robot Path Planning* (OHACA) and of the three variants the paper compares
+//! it with (ACA, PACA, HACA). The same code runs on a Cortex-M4F (the firmware in `src/main.rs`)
+//! and under std on a PC (the `ohaca` host tool and the tests), and gives bit-identical results on
+//! both: every float function comes from [`libm`], and the random numbers from a local
+//! [`rng::Xoshiro128pp`].
+//!
+//! Modules, one concept each:
+//!
+//! | module | owns |
+//! | --- | --- |
+//! | [`grid`] | the occupancy map, cells, the 8 moves and the no-corner-cutting rule, reachability |
+//! | [`geometry`] | path lengths and the segment rule used by smoothing and path checks |
+//! | [`heuristic`] | the distance heuristic and the goal attraction of the potential field |
+//! | [`pheromone`] | the pheromone table: storage, evaporation, deposit, clamping |
+//! | [`colony`] | one ant: the transition rule, tabu list, backtracking (or dying) |
+//! | [`update`] | the per-iteration pheromone update: classic deposit and the wolves rule |
+//! | [`smoothing`] | line-of-sight smoothing of the raw ant path |
+//! | [`planner`] | parameters, caller-provided storage, the iteration loop and the result |
+//! | [`rng`] | the small seedable generator every platform shares |
+//! | [`error`] | the error enum |
+//!
+//! ## Panic freedom
+//! Nothing reachable from a map, a start/goal pair or a parameter set panics: indexing goes
+//! through `get`, arithmetic that can overflow is checked or saturating, and the clippy lints
+//! `unwrap_used`, `expect_used`, `panic` and `indexing_slicing` are denied for the whole crate.
+//!
+//! ## Example
+//! ```
+//! use ohaca::{grid::Grid, planner::{plan, Params, Storage}, grid::Point};
+//!
+//! // 4x3 map, one wall cell in the middle ('#').
+//! let map = "....\n.#..\n....";
+//! let mut bits = [0u8; 2];
+//! for (y, row) in map.lines().enumerate() {
+//!     for (x, c) in row.chars().enumerate() {
+//!         if c == '#' { let i = y * 4 + x; bits[i / 8] |= 1 << (i % 8); }
+//!     }
+//! }
+//! let grid = Grid::new(4, 3, &bits).unwrap();
+//! // Storage for maps up to 16 cells; a firmware puts this in a `static`.
+//! let mut storage: Storage<16> = Storage::new();
+//! let plan = plan(&grid, Point::new(0, 0), Point::new(3, 2), &Params::default(),
+//!                 &mut storage.workspace()).unwrap();
+//! assert_eq!(plan.raw().next(), Some(Point::new(0, 0)));
+//! assert_eq!(plan.waypoints().last(), Some(&Point::new(3, 2)));
+//! ```
+#![cfg_attr(not(test), no_std)]
+#![deny(unsafe_code)]
+#![deny(missing_docs)]
+#![deny(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::panic,
+    clippy::indexing_slicing,
+    clippy::unreachable,
+    clippy::todo,
+    clippy::unimplemented
+)]
+#![cfg_attr(
+    test,
+    allow(
+        clippy::unwrap_used,
+        clippy::indexing_slicing,
+        clippy::expect_used,
+        clippy::panic
+    )
+)]
+
+pub(crate) mod fmt;
+
+pub mod colony;
+pub mod error;
+pub mod geometry;
+pub mod grid;
+pub mod heuristic;
+pub mod pheromone;
+pub mod planner;
+pub mod rng;
+pub mod smoothing;
+pub mod update;
+
+pub use colony::DeadEnd;
+pub use error::Error;
+pub use grid::{Grid, Point};
+pub use planner::{plan, Algorithm, Params, Plan, Run, Storage, Workspace};
+pub use smoothing::SmoothingKind;

@@ -1,0 +1,93 @@
+//! The per-iteration pheromone update (paper eq. 11-13).
+//!
+//! ```text
+//! tau(t+1) = clamp( (1 - rho) tau(t) + sum_k dtau_k + dtau_best - dtau_worst , tau_min, tau_max )
+//! dtau_k     = Q / L_k            on every edge of ant k's path            (classic ant system)
+//! dtau_best  = b * Q / L_best     on the iteration's best path  (wolves rule: feed the strong wolf)
+//! dtau_worst = w * Q / L_worst    on the iteration's worst path (wolves rule: drop the weak wolf)
+//! ```
+//!
+//! Readings we chose (also in `docs/ALGORITHM.md`):
+//!
+//! - **`b` and `w`** are "the number of the local best path and the worst path": the number of
+//!   ants of this iteration whose path has the best (resp. worst) length. So the more ants agree
+//!   on the best path, the stronger it is rewarded. Lengths are compared exactly, as counts of
+//!   straight and diagonal steps.
+//! - **No wolves term when every ant has the same length**: then the best and the worst wolf are
+//!   the same and reward and punishment would just cancel (or, for two different paths of equal
+//!   length, arbitrarily punish one of them).
+//! - **Clamping** to `[tau_min, tau_max]` after the whole update, so the punishment cannot drive
+//!   an edge negative (which would make eq. 14's `[...]^alpha` undefined).
+//!
+//! ACA and PACA use only the first two terms; HACA and OHACA add the wolves terms. Ants that died
+//! deposit nothing.
+
+use crate::grid::{Dir, Grid, Point};
+use crate::pheromone::Table;
+
+/// Add `amount` to every edge of the path that starts at `start` and follows `tour`.
+pub fn deposit(table: &mut Table<'_>, grid: &Grid<'_>, start: Point, tour: &[Dir], amount: f32) {
+    let mut p = start;
+    for &d in tour {
+        table.add(p, d, amount);
+        match grid.step(p, d) {
+            Some(n) => p = n,
+            None => return,
+        }
+    }
+}
+
+/// The wolves-distribution terms: reward the iteration's best path with `b * q / l_best` and
+/// punish its worst with `w * q / l_worst`, both added into `delta` (merged into `tau` by
+/// [`Table::evaporate_and_merge`], which clamps). Does nothing when `l_worst <= l_best`.
+#[allow(clippy::too_many_arguments)]
+pub fn wolves(
+    delta: &mut Table<'_>,
+    grid: &Grid<'_>,
+    start: Point,
+    q: f32,
+    best: (&[Dir], f32, u32),
+    worst: (&[Dir], f32, u32),
+) {
+    let (best_tour, l_best, b) = best;
+    let (worst_tour, l_worst, w) = worst;
+    if l_worst <= l_best || l_best <= 0.0 {
+        return;
+    }
+    deposit(delta, grid, start, best_tour, b as f32 * q / l_best);
+    deposit(delta, grid, start, worst_tour, -(w as f32 * q / l_worst));
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn reward_best_punish_worst() {
+        let bits = [0u8; 2];
+        let g = Grid::new(4, 3, &bits).unwrap();
+        let mut buf = [[0.0f32; 4]; 12];
+        let mut delta = Table::new(4, &mut buf);
+        let start = Point::new(0, 0);
+        let best = [1u8, 0, 0]; // SE, E, E
+        let worst = [0u8, 0, 2, 0]; // E, E, S, E
+        wolves(
+            &mut delta,
+            &g,
+            start,
+            1.0,
+            (&best, 2.0, 3),
+            (&worst, 4.0, 1),
+        );
+        assert_eq!(delta.get(Point::new(0, 0), 1), 1.5);
+        assert_eq!(delta.get(Point::new(0, 0), 0), -0.25);
+        // An edge on both paths gets both: (1,1)->E? best walks (1,1)->(2,1)->(3,1); worst walks
+        // (2,0)->(2,1)->(3,1): the edge (2,1)-(3,1) is shared.
+        assert_eq!(delta.get(Point::new(2, 1), 0), 1.5 - 0.25);
+        // Equal lengths: no wolves term.
+        let mut buf2 = [[0.0f32; 4]; 12];
+        let mut d2 = Table::new(4, &mut buf2);
+        wolves(&mut d2, &g, start, 1.0, (&best, 2.0, 3), (&worst, 2.0, 1));
+        assert!(d2.entries().iter().flatten().all(|v| *v == 0.0));
+    }
+}
