@@ -22,7 +22,7 @@
 //! compile-time capacity, for a `static` on the device; the host builds a `Workspace` over `Vec`s
 //! with [`Workspace::from_slices`].
 
-use crate::colony::{Colony, DeadEnd, Walk};
+use crate::colony::{tighten, Colony, DeadEnd, Walk};
 use crate::error::{Endpoint, Error, Param};
 use crate::geometry::{polyline_length, steps_length, turns};
 use crate::grid::{Dir, Grid, Point, DX, DY};
@@ -120,6 +120,9 @@ pub struct Params {
     pub dead_end: DeadEnd,
     /// How OHACA smooths the result (the other variants never smooth).
     pub smoothing: SmoothingKind,
+    /// Straighten each ant's path before the pheromone update ([`crate::colony::tighten`]); not in
+    /// the paper, off for faithful comparisons.
+    pub tighten: bool,
 }
 
 impl Default for Params {
@@ -141,6 +144,7 @@ impl Default for Params {
             seed: 1,
             dead_end: DeadEnd::Backtrack,
             smoothing: SmoothingKind::Shortest,
+            tighten: true,
         }
     }
 }
@@ -472,6 +476,8 @@ impl<'g, 'a> Run<'g, 'a> {
             iter_best,
             iter_worst,
             best: best_tour,
+            points,
+            prev,
             curve,
             ..
         } = &mut self.ws;
@@ -509,6 +515,7 @@ impl<'g, 'a> Run<'g, 'a> {
                     continue;
                 };
                 self.moves = self.moves.saturating_add(u64::from(walk.moves));
+                let walk = if p.tighten { tighten(self.grid, self.start, walk, tour, points, prev) } else { walk };
                 let Some(path) = tour.get(..walk.steps) else {
                     continue;
                 };
