@@ -17,9 +17,9 @@
 //! The path is recorded as one direction byte per step, so a tour costs one byte per step whatever
 //! the map size.
 
-use crate::grid::{is_diagonal, opposite, Dir, Grid, Point};
-use crate::heuristic::{octile_steps, Heuristic};
-use crate::pheromone::Table;
+use crate::grid::{is_diagonal, opposite, Dir, Grid, Point, DX, DY};
+use crate::heuristic::Heuristic;
+use crate::pheromone::{slot_offsets, Table};
 use crate::rng::Xoshiro128pp;
 
 /// What an ant does when every neighbour is blocked or already visited.
@@ -62,6 +62,8 @@ pub struct Colony<'g, 't, 'h> {
     pub alpha: f32,
     /// Dead-end behaviour.
     pub dead_end: DeadEnd,
+    /// Allowed-move mask of every cell ([`Grid::move_mask`]), computed once per plan.
+    pub moves: &'t [u8],
 }
 
 /// `tau^alpha` with the common exponents done without `powf`.
@@ -91,65 +93,57 @@ impl Colony<'_, '_, '_> {
         tour: &mut [Dir],
     ) -> Option<Walk> {
         let grid = self.grid;
+        let offsets = grid.offsets();
+        let slots = slot_offsets(&offsets);
+        let tau = self.tau.flat();
+        let goal = grid.index(self.goal);
         let mut cur = self.start;
+        let mut ci = grid.index(cur);
         let mut steps = 0usize;
         let mut moves = 0u32;
-        *visited.get_mut(grid.index(cur))? = stamp;
-        while cur != self.goal {
-            let from = octile_steps(cur, self.goal);
+        *visited.get_mut(ci)? = stamp;
+        while ci != goal {
+            let eta = self.heuristic.weights(cur);
+            let mut mask = *self.moves.get(ci)?;
             let mut cand_dir = [0u8; 8];
             let mut cand_w = [0.0f32; 8];
             let mut n = 0usize;
             let mut total = 0.0f32;
-            for d in 0..8u8 {
-                let Some(next) = grid.step(cur, d) else {
-                    continue;
-                };
-                if visited.get(grid.index(next)).is_none_or(|&s| s == stamp) {
+            // Visit the allowed moves only (set bits of the mask, lowest first).
+            while mask != 0 {
+                let di = mask.trailing_zeros() as usize;
+                mask &= mask - 1;
+                let ni = ci.wrapping_add_signed(*offsets.get(di)?);
+                if *visited.get(ni)? == stamp {
                     continue;
                 }
-                let w = pow_alpha(self.tau.get(cur, d), self.alpha)
-                    * self.heuristic.weight(from, next, d);
-                if let (Some(cd), Some(cw)) = (cand_dir.get_mut(n), cand_w.get_mut(n)) {
-                    *cd = d;
-                    *cw = w;
-                    total += w;
-                    n += 1;
-                }
+                let t = *tau.get((4 * ci).wrapping_add_signed(*slots.get(di)?))?;
+                let w = pow_alpha(t, self.alpha) * eta.get(di)?;
+                *cand_dir.get_mut(n)? = di as u8;
+                *cand_w.get_mut(n)? = w;
+                total += w;
+                n += 1;
             }
             moves = moves.saturating_add(1);
-            if n == 0 {
+            let d = if n == 0 {
                 match self.dead_end {
                     DeadEnd::Die => return None,
                     DeadEnd::Backtrack => {
                         steps = steps.checked_sub(1)?;
                         let back = opposite(*tour.get(steps)?);
-                        cur = grid.step(cur, back)?;
+                        ci = ci.wrapping_add_signed(*offsets.get(usize::from(back))?);
+                        cur = neighbour(cur, back);
                         continue;
                     }
                 }
-            }
-            let pick = if n == 1 {
-                0
-            } else if total > 0.0 && total.is_finite() {
-                let r = rng.next_unit() * total;
-                let mut acc = 0.0f32;
-                let mut pick = n - 1;
-                for (i, w) in cand_w.iter().take(n).enumerate() {
-                    acc += w;
-                    if r < acc {
-                        pick = i;
-                        break;
-                    }
-                }
-                pick
+            } else if n == 1 {
+                cand_dir[0]
             } else {
-                // Every weight underflowed to 0 (or overflowed): choose uniformly.
-                ((u64::from(rng.next()) * n as u64) >> 32) as usize
+                *cand_dir.get(roulette(rng, cand_w.get(..n)?, total))?
             };
-            let d = *cand_dir.get(pick)?;
-            cur = grid.step(cur, d)?;
-            *visited.get_mut(grid.index(cur))? = stamp;
+            ci = ci.wrapping_add_signed(*offsets.get(usize::from(d))?);
+            cur = neighbour(cur, d);
+            *visited.get_mut(ci)? = stamp;
             *tour.get_mut(steps)? = d;
             steps += 1;
         }
@@ -164,6 +158,35 @@ impl Colony<'_, '_, '_> {
     }
 }
 
+/// The cell one move `d` from `p` (no checks: callers only move along allowed moves).
+#[inline]
+fn neighbour(p: Point, d: Dir) -> Point {
+    let di = usize::from(d & 7);
+    let x = i32::from(p.x) + DX.get(di).copied().unwrap_or(0);
+    let y = i32::from(p.y) + DY.get(di).copied().unwrap_or(0);
+    Point::new(x as u16, y as u16)
+}
+
+/// Roulette-wheel choice: index `i` with probability `w[i] / total` (one uniform draw). If every
+/// weight underflowed to 0 (or the sum overflowed), choose uniformly instead.
+#[inline]
+fn roulette(rng: &mut Xoshiro128pp, w: &[f32], total: f32) -> usize {
+    let n = w.len();
+    if !(total > 0.0 && total.is_finite()) {
+        return ((u64::from(rng.next_word()) * n as u64) >> 32) as usize;
+    }
+    let r = rng.next_unit() * total;
+    let mut acc = 0.0f32;
+    for (i, wi) in w.iter().enumerate() {
+        acc += wi;
+        if r < acc {
+            return i;
+        }
+    }
+    // Rounding can leave r just above the running sum: take the last candidate.
+    n.saturating_sub(1)
+}
+
 /// Straighten a finished walk in place: from each cell of the path, jump to the furthest later
 /// path cell that is one allowed move away, dropping the detour in between. Returns the new walk.
 ///
@@ -171,34 +194,50 @@ impl Colony<'_, '_, '_> {
 /// three sides of a square where one step would do). Cutting such bulges before the pheromone
 /// update makes every ant deposit on a tighter path, which is what lets the colony settle on
 /// near-optimal 8-connected paths within a few iterations (see `docs/ALGORITHM.md`). It costs at
-/// most 8 lookups per path cell. `pts` and `pos` are scratch of at least `cells` entries.
-pub fn tighten(grid: &Grid<'_>, start: Point, walk: Walk, tour: &mut [Dir], pts: &mut [Point], pos: &mut [u32]) -> Walk {
+/// most 8 lookups per path cell. `cells` and `pos` are scratch of at least as many entries as the
+/// map has cells; `moves` holds the allowed-move masks ([`Grid::move_mask`]).
+pub fn tighten(
+    grid: &Grid<'_>,
+    start: Point,
+    walk: Walk,
+    tour: &mut [Dir],
+    moves: &[u8],
+    cells: &mut [Point],
+    pos: &mut [u32],
+) -> Walk {
     let n = walk.steps + 1;
-    let (Some(pts), Some(path)) = (pts.get_mut(..n), tour.get(..walk.steps)) else { return walk };
-    // Lay the path out as cells and remember each cell's position on it.
+    let offsets = grid.offsets();
+    let (Some(cells), Some(path)) = (cells.get_mut(..n), tour.get(..walk.steps)) else {
+        return walk;
+    };
+    // Lay the path out as cell indices and remember each cell's position on it.
     let mut p = start;
-    for (i, slot) in pts.iter_mut().enumerate() {
+    for (i, slot) in cells.iter_mut().enumerate() {
         *slot = p;
         if let Some(q) = pos.get_mut(grid.index(p)) {
             *q = i as u32;
         }
         if let Some(&d) = path.get(i) {
-            p = grid.step(p, d).unwrap_or(p);
+            p = neighbour(p, d);
         }
     }
     let mut i = 0usize;
     let mut out = 0usize;
     let (mut straight, mut diagonal) = (0u32, 0u32);
     while i + 1 < n {
-        let Some(&cur) = pts.get(i) else { break };
+        let Some(&cp) = cells.get(i) else { break };
+        let ci = grid.index(cp);
+        let mut mask = moves.get(ci).copied().unwrap_or(0);
         // Furthest later path cell one allowed move away (the next cell always qualifies).
         let mut best = (i, 0u8);
-        for d in 0..8u8 {
-            let Some(nb) = grid.step(cur, d) else { continue };
-            let Some(&j) = pos.get(grid.index(nb)) else { continue };
+        while mask != 0 {
+            let d = mask.trailing_zeros() as u8;
+            mask &= mask - 1;
+            let nb = ci.wrapping_add_signed(offsets.get(usize::from(d)).copied().unwrap_or(0));
+            let Some(&j) = pos.get(nb) else { continue };
             let j = j as usize;
             // `pos` is stale for cells of earlier walks: trust it only if it points back here.
-            if j > best.0 && pts.get(j) == Some(&nb) {
+            if j > best.0 && cells.get(j).is_some_and(|&q| grid.index(q) == nb) {
                 best = (j, d);
             }
         }
@@ -218,7 +257,12 @@ pub fn tighten(grid: &Grid<'_>, start: Point, walk: Walk, tour: &mut [Dir], pts:
         }
         i = j;
     }
-    Walk { steps: out, straight, diagonal, moves: walk.moves }
+    Walk {
+        steps: out,
+        straight,
+        diagonal,
+        moves: walk.moves,
+    }
 }
 
 #[cfg(test)]
@@ -251,6 +295,7 @@ mod tests {
         let mut tau_buf = vec![[1.0f32; 4]; g.cells()];
         let tau = Table::new(w, &mut tau_buf);
         let heur = Heuristic::new(goal, true, 0.05, 1.0, 2.0);
+        let moves: Vec<u8> = (0..g.cells()).map(|i| g.move_mask(g.point(i))).collect();
         let c = Colony {
             grid: &g,
             start,
@@ -259,6 +304,7 @@ mod tests {
             heuristic: &heur,
             alpha: 1.0,
             dead_end,
+            moves: &moves,
         };
         let mut visited = vec![0u16; g.cells()];
         let mut tour = vec![0u8; g.cells()];

@@ -173,6 +173,30 @@ impl<'a> Grid<'a> {
         Some(Point::new(x as u16, y as u16))
     }
 
+    /// The allowed moves from `p` as a bit mask: bit `d` is set iff [`Grid::step`] in direction
+    /// `d` succeeds. 0 for blocked or off-map cells.
+    pub fn move_mask(&self, p: Point) -> u8 {
+        if !self.is_free(p) {
+            return 0;
+        }
+        (0..8u8)
+            .filter(|&d| self.step(p, d).is_some())
+            .fold(0, |m, d| m | (1 << d))
+    }
+
+    /// Row-major index offset of each direction on this grid (`dy * width + dx`).
+    pub fn offsets(&self) -> [isize; 8] {
+        // u16 -> isize is lossless on every target with a 32- or 64-bit isize.
+        let w = self.width as isize;
+        let mut o = [0isize; 8];
+        for (d, slot) in o.iter_mut().enumerate() {
+            let dx = DX.get(d).copied().unwrap_or(0) as isize;
+            let dy = DY.get(d).copied().unwrap_or(0) as isize;
+            *slot = dy * w + dx;
+        }
+        o
+    }
+
     /// Flood fill from `start` over allowed moves; true if `goal` is reached.
     ///
     /// `mark` and `queue` are scratch space of at least [`Grid::cells`] entries (the planner lends

@@ -14,15 +14,16 @@
 //! 3. **`d(P, G)` is the octile distance**, the length of the shortest obstacle-free
 //!    8-connected path and so the same metric as the objective (eqs. 1-2). Its change over one
 //!    move is `ds + sqrt(2) dk` with small integers `ds` in `-2..=2` and `dk` in `-1..=1`, so
-//!    every weight the ants can need is one of 15 numbers, computed once per plan: no `powf` or
-//!    `expf` in the inner loop, and bit-identical on every platform. The last form of the paper's
+//!    every weight the ants can need is one of 15 numbers, computed once per plan into a table
+//!    of 63 x 8 entries ([`Heuristic`]): no `powf` or `expf` in the inner loop, one load per
+//!    candidate, and bit-identical on every platform. The last form of the paper's
 //!    eq. (10), `xi d(P,G) n_PG / d_ij`, is a vector and is not used.
 //!
 //! Plain ACA uses `eta_ij = 1 / d_ij` alone (eq. 5): 1 for a straight step, `1/sqrt 2` for a
 //! diagonal one. That is the paper's "blind search".
 
 use crate::geometry::SQRT_2;
-use crate::grid::{is_diagonal, Dir, Point};
+use crate::grid::{Dir, Point, DX, DY};
 
 /// Octile decomposition of the obstacle-free distance from `p` to `g`: `(straight, diagonal)`
 /// step counts, so the distance is `straight + sqrt(2) * diagonal`.
@@ -41,12 +42,21 @@ pub fn octile(p: Point, g: Point) -> f32 {
     s as f32 + k as f32 * SQRT_2
 }
 
+/// Keys of the weight table: see [`Heuristic::key`].
+const KEYS: usize = 3 * 3 * 7;
+
 /// The precomputed `eta^beta` table of one plan.
+///
+/// The change of octile distance over move `d` depends on the cell's offset `(dx, dy)` from the
+/// goal only through `sign(dx)`, `sign(dy)` and `|dx| - |dy|` clamped to `-3..=3` (one move
+/// changes `|dx| - |dy|` by at most 2, so beyond 3 its sign cannot flip). That gives 63 keys, and
+/// the table holds the 8 weights of every key: an ant computes the key once per step and then
+/// reads one `f32` per candidate.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Heuristic {
     goal: Point,
-    /// `[straight | diagonal][(ds + 2) * 3 + (dk + 1)]`, normalised so the largest entry is 1.
-    table: [[f32; 15]; 2],
+    /// `[key][direction]`, normalised so the largest entry is 1.
+    table: [[f32; 8]; KEYS],
 }
 
 impl Heuristic {
@@ -55,27 +65,49 @@ impl Heuristic {
     /// Everything is raised to `beta`. Inputs are assumed validated (`0 < a <= 1`, finite
     /// `xi >= 0`, `0 <= beta <= 16`).
     pub fn new(goal: Point, attract: bool, a: f32, xi: f32, beta: f32) -> Self {
-        let mut table = [[0.0f32; 15]; 2];
         let diag_step = libm::powf(SQRT_2, -beta);
-        let mut max = 0.0f32;
-        for (kind, row) in table.iter_mut().enumerate() {
-            let step = if kind == 1 { diag_step } else { 1.0 };
-            for (i, w) in row.iter_mut().enumerate() {
-                let ds = (i / 3) as f32 - 2.0;
-                let dk = (i % 3) as f32 - 1.0;
-                let att = if attract {
-                    libm::powf(a, xi * beta * (ds + dk * SQRT_2))
+        // The 15 possible weights, by (ds, dk) of the octile decomposition.
+        let mut by_change = [[0.0f32; 3]; 5];
+        for (i, row) in by_change.iter_mut().enumerate() {
+            for (j, w) in row.iter_mut().enumerate() {
+                let change = (i as f32 - 2.0) + (j as f32 - 1.0) * SQRT_2;
+                *w = if attract {
+                    libm::powf(a, xi * beta * change)
                 } else {
                     1.0
                 };
-                *w = step * att;
-                if w.is_finite() && *w > max {
-                    max = *w;
+            }
+        }
+        let mut table = [[0.0f32; 8]; KEYS];
+        // Every key occurs for some offset in -5..=5 (|dx| - |dy| reaches +-3 there).
+        for dy in -5i32..=5 {
+            for dx in -5i32..=5 {
+                let Some(row) = table.get_mut(Self::key_of(dx, dy)) else {
+                    continue;
+                };
+                let (s0, k0) = octile_offset(dx, dy);
+                for (d, w) in row.iter_mut().enumerate() {
+                    let (ex, ey) = (
+                        DX.get(d).copied().unwrap_or(0),
+                        DY.get(d).copied().unwrap_or(0),
+                    );
+                    let (s1, k1) = octile_offset(dx + ex, dy + ey);
+                    let att = by_change
+                        .get((s1 - s0 + 2) as usize)
+                        .and_then(|r| r.get((k1 - k0 + 1) as usize))
+                        .copied()
+                        .unwrap_or(0.0);
+                    *w = att * if d % 2 == 1 { diag_step } else { 1.0 };
                 }
             }
         }
         // Normalise so weights never overflow when multiplied by pheromone; an infinite entry
         // (absurd parameters) becomes 1, the rest shrink accordingly (possibly to 0).
+        let max = table
+            .iter()
+            .flatten()
+            .filter(|w| w.is_finite())
+            .fold(0.0f32, |m, &w| m.max(w));
         if max > 0.0 {
             for w in table.iter_mut().flatten() {
                 *w = if w.is_finite() { *w / max } else { 1.0 };
@@ -89,26 +121,59 @@ impl Heuristic {
         self.goal
     }
 
-    /// `eta^beta` for moving in direction `d` from a cell whose octile steps to the goal are
-    /// `from` to the cell `to`.
+    fn key_of(dx: i32, dy: i32) -> usize {
+        let sx = dx.signum() + 1;
+        let sy = dy.signum() + 1;
+        let diff = (dx.abs() - dy.abs()).clamp(-3, 3) + 3;
+        ((sx * 3 + sy) * 7 + diff) as usize
+    }
+
+    /// The table key of cell `p` (its offset class relative to the goal).
     #[inline]
-    pub fn weight(&self, from: (i32, i32), to: Point, d: Dir) -> f32 {
-        let (s, k) = octile_steps(to, self.goal);
-        let ds = (s - from.0).clamp(-2, 2);
-        let dk = (k - from.1).clamp(-1, 1);
-        let idx = ((ds + 2) * 3 + (dk + 1)) as usize;
-        let kind = usize::from(is_diagonal(d));
-        self.table
-            .get(kind)
-            .and_then(|r| r.get(idx))
+    pub fn key(&self, p: Point) -> usize {
+        Self::key_of(
+            i32::from(p.x) - i32::from(self.goal.x),
+            i32::from(p.y) - i32::from(self.goal.y),
+        )
+    }
+
+    /// `eta^beta` of the 8 moves from cell `p`, by direction.
+    #[inline]
+    pub fn weights(&self, p: Point) -> &[f32; 8] {
+        const NONE: [f32; 8] = [0.0; 8];
+        self.table.get(self.key(p)).unwrap_or(&NONE)
+    }
+
+    /// `eta^beta` for moving in direction `d` from `p`.
+    #[inline]
+    pub fn weight(&self, p: Point, d: Dir) -> f32 {
+        self.weights(p)
+            .get(usize::from(d & 7))
             .copied()
             .unwrap_or(0.0)
     }
 }
 
+/// Octile decomposition of an offset.
+fn octile_offset(dx: i32, dy: i32) -> (i32, i32) {
+    let (ax, ay) = (dx.abs(), dy.abs());
+    (ax.max(ay) - ax.min(ay), ax.min(ay))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The weight computed from scratch, as the module docs define it (before normalisation).
+    fn direct(p: Point, g: Point, d: Dir, a: f32, xi: f32, beta: f32) -> f32 {
+        let (ex, ey) = (DX[d as usize], DY[d as usize]);
+        let q = (i32::from(p.x) + ex, i32::from(p.y) + ey);
+        let d0 = octile(p, g);
+        let dq = octile_offset(q.0 - i32::from(g.x), q.1 - i32::from(g.y));
+        let d1 = dq.0 as f32 + dq.1 as f32 * SQRT_2;
+        let step = if d % 2 == 1 { SQRT_2 } else { 1.0 };
+        libm::powf(a, xi * beta * (d1 - d0)) * libm::powf(1.0 / step, beta)
+    }
 
     #[test]
     fn octile_matches_definition() {
@@ -117,14 +182,35 @@ mod tests {
     }
 
     #[test]
+    fn table_matches_direct_computation_everywhere() {
+        let g = Point::new(20, 20);
+        let h = Heuristic::new(g, true, 0.3, 1.0, 2.0);
+        // Normalisation constant: ratio of any entry to its direct value.
+        let scale =
+            h.weight(Point::new(25, 21), 4) / direct(Point::new(25, 21), g, 4, 0.3, 1.0, 2.0);
+        for y in 1..40u16 {
+            for x in 1..40u16 {
+                let p = Point::new(x, y);
+                for d in 0..8u8 {
+                    let want = direct(p, g, d, 0.3, 1.0, 2.0) * scale;
+                    let got = h.weight(p, d);
+                    assert!(
+                        (got / want - 1.0).abs() < 1e-4,
+                        "{p:?} d{d}: {got} vs {want}"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
     fn attraction_prefers_moves_towards_the_goal() {
         let g = Point::new(10, 0);
         let h = Heuristic::new(g, true, 0.05, 1.0, 2.0);
         let at = Point::new(5, 0);
-        let from = octile_steps(at, g);
-        let east = h.weight(from, Point::new(6, 0), 0);
-        let west = h.weight(from, Point::new(4, 0), 4);
-        let south = h.weight(from, Point::new(5, 1), 2);
+        let east = h.weight(at, 0);
+        let west = h.weight(at, 4);
+        let south = h.weight(at, 2);
         assert!(east > south && south > west, "{east} {south} {west}");
         // Ratio of one step closer vs one step away is a^(-2 xi beta) = 0.05^-4.
         let ratio = east / west;
@@ -138,10 +224,10 @@ mod tests {
     fn plain_aca_prefers_straight_steps_only() {
         let g = Point::new(10, 10);
         let h = Heuristic::new(g, false, 0.05, 1.0, 2.0);
-        let from = octile_steps(Point::new(5, 5), g);
-        assert_eq!(h.weight(from, Point::new(6, 5), 0), 1.0);
-        assert_eq!(h.weight(from, Point::new(4, 5), 4), 1.0);
-        assert!((h.weight(from, Point::new(6, 6), 1) - 0.5).abs() < 1e-6);
+        let p = Point::new(5, 5);
+        assert_eq!(h.weight(p, 0), 1.0);
+        assert_eq!(h.weight(p, 4), 1.0);
+        assert!((h.weight(p, 1) - 0.5).abs() < 1e-6);
     }
 
     #[test]

@@ -33,6 +33,21 @@ pub fn edge(width: u16, p: Point, d: Dir) -> Option<(usize, usize)> {
     ))
 }
 
+/// For each direction, the offset from `4 * cell` to the edge's slot in a flattened table: `d`
+/// for the four directions a cell owns, `4 * offset(d) + (d - 4)` for the other four (the edge
+/// is stored with the neighbour). `offsets` are [`crate::grid::Grid::offsets`].
+pub fn slot_offsets(offsets: &[isize; 8]) -> [isize; 8] {
+    let mut s = [0isize; 8];
+    for (d, (slot, off)) in s.iter_mut().zip(offsets).enumerate() {
+        *slot = if d < 4 {
+            d as isize
+        } else {
+            4 * off + (d as isize - 4)
+        };
+    }
+    s
+}
+
 /// A pheromone (or pheromone-increment) table over a map of width `width`.
 #[derive(Debug)]
 pub struct Table<'a> {
@@ -88,6 +103,20 @@ impl<'a> Table<'a> {
             edge(self.width, p, d).and_then(|(c, s)| self.tau.get_mut(c).and_then(|e| e.get_mut(s)))
         {
             *v = v.clamp(lo, hi);
+        }
+    }
+
+    /// The table as one flat slice: edge `(cell, slot)` is at `4 * cell + slot`.
+    #[inline]
+    pub fn flat(&self) -> &[f32] {
+        self.tau.as_flattened()
+    }
+
+    /// Add `amount` at a flat index (see [`Table::flat`]); out-of-range indices are ignored.
+    #[inline]
+    pub fn add_flat(&mut self, i: usize, amount: f32) {
+        if let Some(v) = self.tau.as_flattened_mut().get_mut(i) {
+            *v += amount;
         }
     }
 

@@ -210,6 +210,7 @@ pub struct Workspace<'a> {
     tau: &'a mut [[f32; 4]],
     delta: &'a mut [[f32; 4]],
     visited: &'a mut [u16],
+    moves: &'a mut [u8],
     tour: &'a mut [Dir],
     iter_best: &'a mut [Dir],
     iter_worst: &'a mut [Dir],
@@ -222,8 +223,9 @@ pub struct Workspace<'a> {
 
 impl<'a> Workspace<'a> {
     /// Bytes of storage a run needs per map cell: pheromone and its increment (2 x 16), tabu
-    /// stamps (2), four tours (4), raw path points (4), smoothing distance and links (8).
-    pub const BYTES_PER_CELL: usize = 2 * 16 + 2 + 4 + 4 + 4 + 4;
+    /// stamps (2), allowed-move masks (1), four tours (4), raw path points (4), smoothing
+    /// distance and links (8).
+    pub const BYTES_PER_CELL: usize = 2 * 16 + 2 + 1 + 4 + 4 + 4 + 4;
 
     /// A workspace over caller buffers (see the type docs for the sizes).
     #[allow(clippy::too_many_arguments)]
@@ -231,6 +233,7 @@ impl<'a> Workspace<'a> {
         tau: &'a mut [[f32; 4]],
         delta: &'a mut [[f32; 4]],
         visited: &'a mut [u16],
+        moves: &'a mut [u8],
         tours: [&'a mut [Dir]; 4],
         points: &'a mut [Point],
         dist: &'a mut [f32],
@@ -242,6 +245,7 @@ impl<'a> Workspace<'a> {
             tau,
             delta,
             visited,
+            moves,
             tour,
             iter_best,
             iter_worst,
@@ -259,6 +263,7 @@ impl<'a> Workspace<'a> {
             self.tau.len(),
             self.delta.len(),
             self.visited.len(),
+            self.moves.len(),
             self.tour.len(),
             self.iter_best.len(),
             self.iter_worst.len(),
@@ -286,6 +291,7 @@ pub struct Storage<const CELLS: usize, const CURVE: usize = 128> {
     tau: [[f32; 4]; CELLS],
     delta: [[f32; 4]; CELLS],
     visited: [u16; CELLS],
+    moves: [u8; CELLS],
     tours: [[Dir; CELLS]; 4],
     points: [Point; CELLS],
     dist: [f32; CELLS],
@@ -300,6 +306,7 @@ impl<const CELLS: usize, const CURVE: usize> Storage<CELLS, CURVE> {
             tau: [[0.0; 4]; CELLS],
             delta: [[0.0; 4]; CELLS],
             visited: [0; CELLS],
+            moves: [0; CELLS],
             tours: [[0; CELLS]; 4],
             points: [Point::new(0, 0); CELLS],
             dist: [0.0; CELLS],
@@ -319,6 +326,7 @@ impl<const CELLS: usize, const CURVE: usize> Storage<CELLS, CURVE> {
             &mut self.tau,
             &mut self.delta,
             &mut self.visited,
+            &mut self.moves,
             [t0, t1, t2, t3],
             &mut self.points,
             &mut self.dist,
@@ -416,6 +424,9 @@ impl<'g, 'a> Run<'g, 'a> {
         if let Some(d) = ws.delta.get_mut(..cells) {
             d.fill([0.0; 4]);
         }
+        for (i, m) in ws.moves.iter_mut().take(cells).enumerate() {
+            *m = grid.move_mask(grid.point(i));
+        }
         let heuristic = Heuristic::new(
             goal,
             params.algorithm.attracts(),
@@ -476,6 +487,7 @@ impl<'g, 'a> Run<'g, 'a> {
             iter_best,
             iter_worst,
             best: best_tour,
+            moves,
             points,
             prev,
             curve,
@@ -504,6 +516,7 @@ impl<'g, 'a> Run<'g, 'a> {
                 heuristic: &self.heuristic,
                 alpha: p.alpha,
                 dead_end: p.dead_end,
+                moves,
             };
             for _ in 0..p.ants {
                 self.stamp = self.stamp.wrapping_add(1);
@@ -515,7 +528,11 @@ impl<'g, 'a> Run<'g, 'a> {
                     continue;
                 };
                 self.moves = self.moves.saturating_add(u64::from(walk.moves));
-                let walk = if p.tighten { tighten(self.grid, self.start, walk, tour, points, prev) } else { walk };
+                let walk = if p.tighten {
+                    tighten(self.grid, self.start, walk, tour, moves, points, prev)
+                } else {
+                    walk
+                };
                 let Some(path) = tour.get(..walk.steps) else {
                     continue;
                 };

@@ -40,7 +40,7 @@ impl Xoshiro128pp {
 
     /// The next 32 random bits.
     #[inline]
-    pub fn next(&mut self) -> u32 {
+    pub fn next_word(&mut self) -> u32 {
         let [s0, s1, s2, s3] = self.s;
         let result = s0.wrapping_add(s3).rotate_left(7).wrapping_add(s0);
         let t = s1 << 9;
@@ -56,13 +56,13 @@ impl Xoshiro128pp {
     /// A uniform `f32` in `[0, 1)` with 24 random bits (exact on every platform).
     #[inline]
     pub fn next_unit(&mut self) -> f32 {
-        (self.next() >> 8) as f32 * (1.0 / 16_777_216.0)
+        (self.next_word() >> 8) as f32 * (1.0 / 16_777_216.0)
     }
 }
 
 impl RngCore for Xoshiro128pp {
     fn next_u32(&mut self) -> u32 {
-        self.next()
+        self.next_word()
     }
     fn next_u64(&mut self) -> u64 {
         impls::next_u64_via_u32(self)
@@ -106,7 +106,7 @@ mod tests {
     fn reference_vector() {
         // xoshiro128++ from state [1, 2, 3, 4] (reference implementation output).
         let mut r = Xoshiro128pp { s: [1, 2, 3, 4] };
-        let got: Vec<u32> = (0..4).map(|_| r.next()).collect();
+        let got: Vec<u32> = (0..4).map(|_| r.next_word()).collect();
         assert_eq!(got, [641, 1_573_767, 3_222_811_527, 3_517_856_514]);
     }
 
@@ -118,8 +118,8 @@ mod tests {
             assert!((0.0..1.0).contains(&u));
         }
         assert_ne!(
-            Xoshiro128pp::from_u64(1).next(),
-            Xoshiro128pp::from_u64(2).next()
+            Xoshiro128pp::from_u64(1).next_word(),
+            Xoshiro128pp::from_u64(2).next_word()
         );
     }
 }

@@ -173,8 +173,7 @@ fn shortest(
     // Follow prev from the goal back to the start, reversing the links into "next" links.
     let mut cur = n - 1;
     let mut next = u32::MAX;
-    loop {
-        let Some(slot) = prev.get_mut(cur) else { break };
+    while let Some(slot) = prev.get_mut(cur) {
         let p = *slot as usize;
         *slot = next;
         next = cur as u32;
@@ -187,8 +186,7 @@ fn shortest(
     // index i after writing slot k <= i is safe).
     let mut k = 0usize;
     let mut i = 0usize;
-    loop {
-        let Some(&p) = pts.get(i) else { break };
+    while let Some(&p) = pts.get(i) {
         if let Some(slot) = pts.get_mut(k) {
             *slot = p;
         }

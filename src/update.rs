@@ -23,17 +23,20 @@
 //! deposit nothing.
 
 use crate::grid::{Dir, Grid, Point};
-use crate::pheromone::Table;
+use crate::pheromone::{slot_offsets, Table};
 
 /// Add `amount` to every edge of the path that starts at `start` and follows `tour`.
 pub fn deposit(table: &mut Table<'_>, grid: &Grid<'_>, start: Point, tour: &[Dir], amount: f32) {
-    let mut p = start;
+    let offsets = grid.offsets();
+    let slots = slot_offsets(&offsets);
+    let mut c = grid.index(start);
     for &d in tour {
-        table.add(p, d, amount);
-        match grid.step(p, d) {
-            Some(n) => p = n,
-            None => return,
-        }
+        let d = usize::from(d & 7);
+        let (Some(&slot), Some(&off)) = (slots.get(d), offsets.get(d)) else {
+            return;
+        };
+        table.add_flat((4 * c).wrapping_add_signed(slot), amount);
+        c = c.wrapping_add_signed(off);
     }
 }
 
