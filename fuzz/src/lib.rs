@@ -1,0 +1,135 @@
+//! The checks behind every fuzz target, as plain functions so the same inputs can be replayed
+//! from tests (`cargo test` in this crate runs the saved regression inputs).
+
+use arbitrary::{Arbitrary, Unstructured};
+use ohaca::geometry::{polyline_length, segment_clear, steps_length};
+use ohaca::grid::{is_diagonal, Grid, Point};
+use ohaca::planner::{CurvePoint, Workspace};
+use ohaca::{plan, Algorithm, DeadEnd, Error, Params, SmoothingKind};
+
+/// A planner input: a small map, endpoints and parameters including extremes.
+#[derive(Debug)]
+pub struct PlannerInput {
+    pub width: u16,
+    pub height: u16,
+    pub bits: Vec<u8>,
+    pub start: Point,
+    pub goal: Point,
+    pub params: Params,
+}
+
+fn pick_f32(u: &mut Unstructured<'_>, choices: &[f32]) -> arbitrary::Result<f32> {
+    // Mostly interesting fixed values, sometimes raw bits (NaN, inf, subnormal, huge).
+    if u.ratio(1, 4)? {
+        Ok(f32::from_bits(u32::arbitrary(u)?))
+    } else {
+        Ok(*u.choose(choices)?)
+    }
+}
+
+impl<'a> Arbitrary<'a> for PlannerInput {
+    fn arbitrary(u: &mut Unstructured<'a>) -> arbitrary::Result<Self> {
+        let width = u.int_in_range(1..=20u16)?;
+        let height = u.int_in_range(1..=20u16)?;
+        let cells = usize::from(width) * usize::from(height);
+        let mut bits = vec![0u8; cells.div_ceil(8)];
+        u.fill_buffer(&mut bits)?;
+        // Thin the obstacles out so paths exist often.
+        let density = u.int_in_range(0..=3u8)?;
+        for b in bits.iter_mut() {
+            for _ in 0..density {
+                *b &= u8::arbitrary(u)?;
+            }
+        }
+        let start = Point::new(u.int_in_range(0..=width)?, u.int_in_range(0..=height)?);
+        let goal = Point::new(u.int_in_range(0..=width)?, u.int_in_range(0..=height)?);
+        let algorithm = *u.choose(&Algorithm::ALL)?;
+        let params = Params {
+            algorithm,
+            ants: *u.choose(&[0u16, 1, 2, 5, 50])?,
+            iterations: *u.choose(&[0u16, 1, 2, 10])?,
+            alpha: pick_f32(u, &[0.0, 1.0, 2.0, 0.5, 16.0, 17.0])?,
+            beta: pick_f32(u, &[0.0, 1.0, 2.0, 16.0, -1.0])?,
+            rho: pick_f32(u, &[0.1, 1.0, 0.0, 1e-7])?,
+            q: pick_f32(u, &[1.0, 1e30, 1e-30, 0.0])?,
+            a: pick_f32(u, &[0.05, 1.0, 1e-30, 0.999])?,
+            xi: pick_f32(u, &[1.0, 0.0, 1e6])?,
+            tau0: pick_f32(u, &[1.0, 0.01, 100.0])?,
+            tau_min: pick_f32(u, &[0.01, 1e-30, 1.0])?,
+            tau_max: pick_f32(u, &[100.0, 1e30, 1.0])?,
+            patience: *u.choose(&[0u16, 1, 20])?,
+            seed: u64::arbitrary(u)?,
+            dead_end: if bool::arbitrary(u)? { DeadEnd::Backtrack } else { DeadEnd::Die },
+            smoothing: *u.choose(&[SmoothingKind::Shortest, SmoothingKind::Greedy, SmoothingKind::None])?,
+            tighten: bool::arbitrary(u)?,
+        };
+        Ok(PlannerInput { width, height, bits, start, goal, params })
+    }
+}
+
+/// Plan and check every promise the planner makes. Panics (= a fuzz finding) on a broken one.
+pub fn check_planner(input: &PlannerInput) {
+    let Ok(grid) = Grid::new(input.width, input.height, &input.bits) else {
+        return;
+    };
+    let cells = grid.cells();
+    let mut tau = vec![[0f32; 4]; cells];
+    let mut delta = vec![[0f32; 4]; cells];
+    let mut visited = vec![0u16; cells];
+    let mut moves = vec![0u8; cells];
+    let mut tours: Vec<Vec<u8>> = (0..4).map(|_| vec![0u8; cells]).collect();
+    let mut points = vec![Point::default(); cells];
+    let mut dist = vec![0f32; cells];
+    let mut prev = vec![0u32; cells];
+    let mut curve = vec![CurvePoint::default(); 16];
+    let [t0, t1, t2, t3] = &mut tours[..] else { return };
+    let ws = Workspace::from_slices(
+        &mut tau, &mut delta, &mut visited, &mut moves, [t0, t1, t2, t3], &mut points, &mut dist,
+        &mut prev, &mut curve,
+    );
+    let p = &input.params;
+    match plan(&grid, input.start, input.goal, p, ws) {
+        Ok(plan) => {
+            let raw: Vec<Point> = plan.raw().collect();
+            assert_eq!(raw.first(), Some(&input.start));
+            assert_eq!(raw.last(), Some(&input.goal));
+            for (w, &d) in raw.windows(2).zip(plan.directions()) {
+                assert_eq!(grid.step(w[0], d), Some(w[1]), "raw path leaves the allowed moves");
+            }
+            let diag = plan.directions().iter().filter(|&&d| is_diagonal(d)).count() as u32;
+            let straight = plan.directions().len() as u32 - diag;
+            assert_eq!(plan.raw_length, steps_length(straight, diag));
+            let wp = plan.waypoints();
+            assert_eq!(wp.first(), Some(&input.start));
+            assert_eq!(wp.last(), Some(&input.goal));
+            for s in wp.windows(2) {
+                assert!(segment_clear(&grid, s[0], s[1]), "smoothed segment {s:?} touches an obstacle");
+            }
+            assert!(plan.length <= plan.raw_length + 1e-3 * (1.0 + plan.raw_length));
+            assert_eq!(plan.length, polyline_length(wp));
+            // Termination bound: every ant moves at most 2 * cells times.
+            let bound = u64::from(p.ants) * u64::from(p.iterations) * 2 * cells as u64;
+            assert!(plan.moves <= bound, "{} moves > bound {bound}", plan.moves);
+            assert!(plan.iterations <= p.iterations);
+        }
+        Err(Error::BadParam(_)) => assert!(p.validate().is_err()),
+        Err(Error::NoPath) => {
+            // Either unreachable, or every ant died.
+            let mut m = vec![0u16; cells];
+            let mut q = vec![0u32; cells];
+            let reachable = grid.reachable(input.start, input.goal, &mut m, &mut q);
+            assert!(!reachable || p.dead_end == DeadEnd::Die, "NoPath on a reachable goal");
+        }
+        Err(Error::OutOfBounds(_)) => assert!(!grid.contains(input.start) || !grid.contains(input.goal)),
+        Err(Error::Blocked(_)) => assert!(!grid.is_free(input.start) || !grid.is_free(input.goal)),
+        Err(e) => panic!("unexpected error {e}"),
+    }
+}
+
+/// Decode raw fuzzer bytes into a planner input and check it.
+pub fn fuzz_planner(data: &[u8]) {
+    let mut u = Unstructured::new(data);
+    if let Ok(input) = PlannerInput::arbitrary(&mut u) {
+        check_planner(&input);
+    }
+}
