@@ -44,6 +44,9 @@ pub struct Walk {
     pub diagonal: u32,
     /// Moves made, counting forward steps and backtracking steps.
     pub moves: u32,
+    /// The walk passed next to a cell it had visited before (other than the one it came from),
+    /// so [`tighten`] may find a shortcut; when false, tightening cannot change the path.
+    pub may_tighten: bool,
 }
 
 /// Everything an ant reads; borrowed for one iteration.
@@ -101,6 +104,7 @@ impl Colony<'_, '_, '_> {
         let mut ci = grid.index(cur);
         let mut steps = 0usize;
         let mut moves = 0u32;
+        let mut may_tighten = false;
         *visited.get_mut(ci)? = stamp;
         while ci != goal {
             let eta = self.heuristic.weights(cur);
@@ -109,12 +113,14 @@ impl Colony<'_, '_, '_> {
             let mut cand_w = [0.0f32; 8];
             let mut n = 0usize;
             let mut total = 0.0f32;
+            let mut seen = 0u32;
             // Visit the allowed moves only (set bits of the mask, lowest first).
             while mask != 0 {
                 let di = mask.trailing_zeros() as usize;
                 mask &= mask - 1;
                 let ni = ci.wrapping_add_signed(*offsets.get(di)?);
                 if *visited.get(ni)? == stamp {
+                    seen += 1;
                     continue;
                 }
                 let t = *tau.get((4 * ci).wrapping_add_signed(*slots.get(di)?))?;
@@ -125,6 +131,8 @@ impl Colony<'_, '_, '_> {
                 n += 1;
             }
             moves = moves.saturating_add(1);
+            // One visited neighbour is the cell we came from; a second one may be a shortcut.
+            may_tighten |= seen > 1;
             let d = if n == 0 {
                 match self.dead_end {
                     DeadEnd::Die => return None,
@@ -154,6 +162,7 @@ impl Colony<'_, '_, '_> {
             straight: steps as u32 - diagonal,
             diagonal,
             moves,
+            may_tighten,
         })
     }
 }
@@ -262,6 +271,7 @@ pub fn tighten(
         straight,
         diagonal,
         moves: walk.moves,
+        may_tighten: false,
     }
 }
 

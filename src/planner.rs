@@ -528,7 +528,7 @@ impl<'g, 'a> Run<'g, 'a> {
                     continue;
                 };
                 self.moves = self.moves.saturating_add(u64::from(walk.moves));
-                let walk = if p.tighten {
+                let walk = if p.tighten && walk.may_tighten {
                     tighten(self.grid, self.start, walk, tour, moves, points, prev)
                 } else {
                     walk
