@@ -911,6 +911,14 @@ mod tests {
     }
 
     #[test]
+    fn storage_size_is_bytes_per_cell_times_cells() {
+        let curve = core::mem::size_of::<CurvePoint>();
+        assert_eq!(curve, 12);
+        assert_eq!(core::mem::size_of::<Storage<1024>>(), 1024 * Workspace::BYTES_PER_CELL + 128 * curve);
+        assert_eq!(core::mem::size_of::<Storage<676>>(), 676 * Workspace::BYTES_PER_CELL + 128 * curve);
+    }
+
+    #[test]
     fn deterministic_per_seed() {
         let (b, w, h) = grid(&ROWS);
         let g = Grid::new(w, h, &b).unwrap();
