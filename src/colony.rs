@@ -33,6 +33,32 @@ pub enum DeadEnd {
     Die,
 }
 
+impl DeadEnd {
+    /// Both, default first.
+    pub const ALL: [DeadEnd; 2] = [DeadEnd::Backtrack, DeadEnd::Die];
+
+    /// Lower-case name (`"backtrack"`, `"die"`).
+    pub const fn name(self) -> &'static str {
+        match self {
+            DeadEnd::Backtrack => "backtrack",
+            DeadEnd::Die => "die",
+        }
+    }
+
+    /// Parse a name (case-insensitive).
+    pub fn from_name(s: &str) -> Option<Self> {
+        Self::ALL
+            .into_iter()
+            .find(|d| d.name().eq_ignore_ascii_case(s))
+    }
+}
+
+impl core::fmt::Display for DeadEnd {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
 /// A finished walk.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Walk {

@@ -57,9 +57,11 @@ pub enum Error {
     Blocked(Endpoint),
     /// A parameter is outside its valid range.
     BadParam(Param),
-    /// The goal cannot be reached from the start (decided by a flood fill before any ant runs),
-    /// or, with [`crate::DeadEnd::Die`], no ant reached it.
+    /// The goal cannot be reached from the start (decided by a flood fill before any ant runs).
     NoPath,
+    /// The goal is reachable, but no ant reached it: with [`crate::DeadEnd::Die`] every ant
+    /// died at a dead end (or the run was finished before its first iteration).
+    NoAntArrived,
     /// The run was cancelled before it finished.
     Cancelled,
 }
@@ -77,6 +79,7 @@ impl Error {
             Error::BadParam(_) => 7,
             Error::NoPath => 8,
             Error::Cancelled => 9,
+            Error::NoAntArrived => 10,
         }
     }
 }
@@ -118,6 +121,9 @@ impl fmt::Display for Error {
             Error::BadParam(p) => write!(f, "bad parameter: {p}"),
             Error::NoPath => f.write_str("no path: the goal is not reachable from the start"),
             Error::Cancelled => f.write_str("cancelled"),
+            Error::NoAntArrived => {
+                f.write_str("no ant reached the goal (every ant died at a dead end)")
+            }
         }
     }
 }

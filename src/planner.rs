@@ -47,6 +47,12 @@ pub enum Algorithm {
     Ohaca,
 }
 
+impl core::fmt::Display for Algorithm {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
 impl Algorithm {
     /// All four, in the paper's order.
     pub const ALL: [Algorithm; 4] = [
@@ -459,6 +465,21 @@ impl<'g, 'a> Run<'g, 'a> {
         })
     }
 
+    /// Ant moves made so far.
+    pub fn moves(&self) -> u64 {
+        self.moves
+    }
+
+    /// Iteration (0-based) in which the best path so far was found, if any ant has arrived.
+    pub fn best_iteration(&self) -> Option<u16> {
+        self.best.map(|_| self.best_iteration)
+    }
+
+    /// Length of the best raw path found so far.
+    pub fn best_length(&self) -> Option<f32> {
+        self.best.map(|b| b.length())
+    }
+
     /// Iterations run so far.
     pub fn iteration(&self) -> u16 {
         self.iteration
@@ -609,7 +630,7 @@ impl<'g, 'a> Run<'g, 'a> {
     }
 
     /// Stop now and turn the best path found so far into the result (smoothed for OHACA).
-    /// Fails with [`Error::NoPath`] if no ant has reached the goal (only possible with
+    /// Fails with [`Error::NoAntArrived`] if no ant has reached the goal (only possible with
     /// [`DeadEnd::Die`], or before the first iteration).
     pub fn finish(self) -> Result<Plan<'a>, Error> {
         let Run {
@@ -624,7 +645,7 @@ impl<'g, 'a> Run<'g, 'a> {
             moves,
             ..
         } = self;
-        let best = best.ok_or(Error::NoPath)?;
+        let best = best.ok_or(Error::NoAntArrived)?;
         let Workspace {
             best: best_tour,
             points,
@@ -648,7 +669,13 @@ impl<'g, 'a> Run<'g, 'a> {
         let k = smooth(grid, kind, pts, n, dist, prev);
         let pts: &'a [Point] = points;
         let waypoints = pts.get(..k).ok_or(Error::NoPath)?;
-        let length = polyline_length(waypoints);
+        // Without smoothing the waypoints are the raw path's corners: report the exact step-count
+        // length rather than re-summing it (which can differ in the last bit).
+        let length = if kind == SmoothingKind::None {
+            best.length()
+        } else {
+            polyline_length(waypoints)
+        };
         let curve: &'a [CurvePoint] = curve;
         let curve = curve
             .get(..usize::from(iteration).min(curve.len()))
@@ -914,8 +941,14 @@ mod tests {
     fn storage_size_is_bytes_per_cell_times_cells() {
         let curve = core::mem::size_of::<CurvePoint>();
         assert_eq!(curve, 12);
-        assert_eq!(core::mem::size_of::<Storage<1024>>(), 1024 * Workspace::BYTES_PER_CELL + 128 * curve);
-        assert_eq!(core::mem::size_of::<Storage<676>>(), 676 * Workspace::BYTES_PER_CELL + 128 * curve);
+        assert_eq!(
+            core::mem::size_of::<Storage<1024>>(),
+            1024 * Workspace::BYTES_PER_CELL + 128 * curve
+        );
+        assert_eq!(
+            core::mem::size_of::<Storage<676>>(),
+            676 * Workspace::BYTES_PER_CELL + 128 * curve
+        );
     }
 
     #[test]

@@ -36,6 +36,37 @@ pub enum SmoothingKind {
     Shortest,
 }
 
+impl SmoothingKind {
+    /// All three, default first.
+    pub const ALL: [SmoothingKind; 3] = [
+        SmoothingKind::Shortest,
+        SmoothingKind::Greedy,
+        SmoothingKind::None,
+    ];
+
+    /// Lower-case name (`"shortest"`, `"greedy"`, `"none"`).
+    pub const fn name(self) -> &'static str {
+        match self {
+            SmoothingKind::None => "none",
+            SmoothingKind::Greedy => "greedy",
+            SmoothingKind::Shortest => "shortest",
+        }
+    }
+
+    /// Parse a name (case-insensitive).
+    pub fn from_name(s: &str) -> Option<Self> {
+        Self::ALL
+            .into_iter()
+            .find(|k| k.name().eq_ignore_ascii_case(s))
+    }
+}
+
+impl core::fmt::Display for SmoothingKind {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
 /// True if `b` lies on the straight line from `a` to `c`, between them.
 fn collinear_between(a: Point, b: Point, c: Point) -> bool {
     let (ux, uy) = (

@@ -113,12 +113,15 @@ pub fn check_planner(input: &PlannerInput) {
             assert!(plan.iterations <= p.iterations);
         }
         Err(Error::BadParam(_)) => assert!(p.validate().is_err()),
-        Err(Error::NoPath) => {
-            // Either unreachable, or every ant died.
+        Err(e @ (Error::NoPath | Error::NoAntArrived)) => {
             let mut m = vec![0u16; cells];
             let mut q = vec![0u32; cells];
             let reachable = grid.reachable(input.start, input.goal, &mut m, &mut q);
-            assert!(!reachable || p.dead_end == DeadEnd::Die, "NoPath on a reachable goal");
+            if e == Error::NoPath {
+                assert!(!reachable, "NoPath on a reachable goal");
+            } else {
+                assert!(reachable && p.dead_end == DeadEnd::Die, "NoAntArrived without dying ants");
+            }
         }
         Err(Error::OutOfBounds(_)) => assert!(!grid.contains(input.start) || !grid.contains(input.goal)),
         Err(Error::Blocked(_)) => assert!(!grid.is_free(input.start) || !grid.is_free(input.goal)),

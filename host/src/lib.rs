@@ -1,1 +1,54 @@
-//! Host-side library: map loading, storage on the heap, output.
+//! # ohaca-host — the host side of ohaca
+//!
+//! The library behind the `ohaca` command-line tool, reusable by the tests and by every
+//! subcommand (`plan` today; `send`, `render`, `experiment`, `bench` later). It runs the `no_std`
+//! core ([`ohaca`]) under std: it loads maps from files, lends the planner heap buffers instead of
+//! a fixed-size `Storage`, and turns results into a stable JSON report or an ASCII picture.
+//!
+//! Modules, one concept each:
+//!
+//! | module | owns |
+//! | --- | --- |
+//! | [`map`] | loading Moving AI `.map` files and plain text grids into an owned [`map::Map`] |
+//! | [`storage`] | [`storage::HeapStorage`]: planner buffers on the heap, sized per map |
+//! | [`args`] | command-line values shared by subcommands: `X,Y` points and the planner flags |
+//! | [`planning`] | one planning run on a loaded map, timed, as a [`output::PlanReport`] |
+//! | [`output`] | the JSON report (a stable contract) and the ASCII renderer |
+//! | [`exit`] | the tool's exit codes |
+//!
+//! ## Panic freedom
+//! Like the core, nothing reachable from a file, a command line or a parameter set panics:
+//! the lints `unwrap_used`, `expect_used`, `panic` and `indexing_slicing` are denied here too.
+#![deny(unsafe_code)]
+#![deny(missing_docs)]
+#![deny(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::panic,
+    clippy::indexing_slicing,
+    clippy::unreachable,
+    clippy::todo,
+    clippy::unimplemented
+)]
+#![cfg_attr(
+    test,
+    allow(
+        clippy::unwrap_used,
+        clippy::indexing_slicing,
+        clippy::expect_used,
+        clippy::panic
+    )
+)]
+
+pub mod args;
+pub mod exit;
+pub mod map;
+pub mod output;
+pub mod planning;
+pub mod storage;
+
+pub use args::{parse_point, ParamArgs};
+pub use map::{Map, MapError};
+pub use output::{ParamsReport, PlanReport};
+pub use planning::{plan_map, plan_map_in, PlanError};
+pub use storage::HeapStorage;

@@ -1,1 +1,72 @@
-fn main() {}
+//! `ohaca`, the host tool. One subcommand per module under `src/cmd/` (those modules belong to
+//! this binary, not to the library): each has an `Args` struct (clap derive) and a `run` that
+//! returns the exit code (see [`ohaca_host::exit`]). Adding a subcommand (`send`, `render`,
+//! `experiment`, `bench`) means a new module and one new [`Command`] variant; nothing in `plan`
+//! changes.
+#![deny(unsafe_code)]
+#![deny(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::panic,
+    clippy::indexing_slicing,
+    clippy::unreachable,
+    clippy::todo,
+    clippy::unimplemented
+)]
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+mod cmd;
+
+/// Plan robot paths with the Optimized Hybrid Ant Colony algorithm (and ACA, PACA, HACA).
+///
+/// Exit codes: 0 path found, 1 no path, 2 bad input.
+#[derive(Parser, Debug)]
+#[command(name = "ohaca", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Plan a path on a map file and print it (ASCII picture, or JSON with --json)
+    Plan(cmd::plan::Args),
+}
+
+fn main() -> ExitCode {
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => return ExitCode::from(usage_error(&e)),
+    };
+    let code = match cli.command {
+        Command::Plan(args) => cmd::plan::run(&args),
+    };
+    ExitCode::from(code)
+}
+
+/// Report a command-line error. Help, version and "no subcommand" go through clap as usual; a
+/// real usage error (bad number, unknown flag, missing argument) becomes one `error: ...` line on
+/// stderr, like every other bad input, with exit code 2.
+fn usage_error(e: &clap::Error) -> u8 {
+    use clap::error::ErrorKind;
+    if !e.use_stderr() || e.kind() == ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand {
+        // Help or version: clap prints it and exits (0, or 2 for the bare `ohaca`).
+        e.exit();
+    }
+    let text = e.render().to_string();
+    let line = one_line(&text);
+    cmd::bad_input(line.strip_prefix("error: ").unwrap_or(&line))
+}
+
+/// clap's message without the usage and hint lines, joined into one line.
+fn one_line(text: &str) -> String {
+    text.lines()
+        .map(str::trim)
+        .take_while(|l| !l.starts_with("Usage:") && !l.starts_with("For more information"))
+        .filter(|l| !l.is_empty() && !l.starts_with("tip:"))
+        .collect::<Vec<_>>()
+        .join(" ")
+}

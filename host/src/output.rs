@@ -1,0 +1,448 @@
+//! What the tool prints: the JSON [`PlanReport`] and the ASCII picture.
+//!
+//! ## The JSON contract
+//! `ohaca plan --json` prints one [`PlanReport`] as a single-line JSON object, and every command
+//! that produces a path (e.g. a later `ohaca send`, which plans on the firmware) must print the
+//! very same keys, so scripts work with either. The keys, in this order:
+//!
+//! | key | type | meaning |
+//! | --- | --- | --- |
+//! | `found` | bool | a path was found |
+//! | `raw` | `[[x, y], ...]` | the raw 8-connected path, start to goal (`[]` if not found) |
+//! | `waypoints` | `[[x, y], ...]` | the output path (smoothed for OHACA; `[]` if not found) |
+//! | `raw_length` | number or null | length of `raw` in cell units |
+//! | `length` | number or null | length of the polyline through `waypoints` |
+//! | `turns` | integer or null | turns along `waypoints` |
+//! | `iterations` | integer or null | iterations run (null if unknown) |
+//! | `best_iteration` | integer or null | 0-based iteration in which the best path was first found |
+//! | `moves` | integer or null | ant moves made, forward and backtracking, over the run |
+//! | `elapsed_us` | integer | planning time in microseconds (map loading excluded) |
+//! | `params` | object | every parameter ([`ParamsReport`]) |
+//! | `error` | string | only when `found` is false: why |
+//!
+//! `x` is the column, `y` the row from the top. Numbers that describe a path are null exactly
+//! when no path was found. The struct's fields are public and it derives `Deserialize`, so a
+//! report can be built from plain fields (a firmware reply) or read back from JSON.
+//!
+//! ## The picture
+//! [`render`] draws the map with the raw path (`*`), the waypoints (`o`), start `S`, goal `G`,
+//! obstacles `#` and free cells `.` (cells separated by spaces, so a cell looks square in a
+//! terminal), followed by a short [`summary`].
+
+use std::fmt::Write as _;
+use std::time::Duration;
+
+use ohaca::{Algorithm, Params, Plan, Point};
+use serde::{Deserialize, Serialize};
+
+use crate::args::{dead_end_name, parse_dead_end, parse_smoothing, smoothing_name};
+use crate::map::Map;
+
+/// Every planner parameter, as printed in a report. Enum-valued parameters are lower-case names
+/// (`"ohaca"`, `"backtrack"`, `"shortest"`), the same words the command-line flags take.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ParamsReport {
+    /// `ohaca`, `haca`, `paca` or `aca`.
+    pub algorithm: String,
+    /// Ants per iteration.
+    pub ants: u16,
+    /// Maximum iterations.
+    pub iterations: u16,
+    /// Pheromone exponent.
+    pub alpha: f32,
+    /// Heuristic exponent.
+    pub beta: f32,
+    /// Evaporation rate.
+    pub rho: f32,
+    /// Pheromone deposit constant.
+    pub q: f32,
+    /// Goal-attraction base.
+    pub a: f32,
+    /// Potential-field gain.
+    pub xi: f32,
+    /// Initial pheromone.
+    pub tau0: f32,
+    /// Lower pheromone bound.
+    pub tau_min: f32,
+    /// Upper pheromone bound.
+    pub tau_max: f32,
+    /// Early-stop patience (0 = never).
+    pub patience: u16,
+    /// Random seed.
+    pub seed: u64,
+    /// `backtrack` or `die`.
+    pub dead_end: String,
+    /// `shortest`, `greedy` or `none`.
+    pub smoothing: String,
+    /// Ant paths straightened before the pheromone update.
+    pub tighten: bool,
+}
+
+impl From<&Params> for ParamsReport {
+    fn from(p: &Params) -> Self {
+        ParamsReport {
+            algorithm: p.algorithm.name().to_string(),
+            ants: p.ants,
+            iterations: p.iterations,
+            alpha: p.alpha,
+            beta: p.beta,
+            rho: p.rho,
+            q: p.q,
+            a: p.a,
+            xi: p.xi,
+            tau0: p.tau0,
+            tau_min: p.tau_min,
+            tau_max: p.tau_max,
+            patience: p.patience,
+            seed: p.seed,
+            dead_end: dead_end_name(p.dead_end).to_string(),
+            smoothing: smoothing_name(p.smoothing).to_string(),
+            tighten: p.tighten,
+        }
+    }
+}
+
+impl ParamsReport {
+    /// Back to core parameters; fails with a message if a name is unknown.
+    pub fn to_params(&self) -> Result<Params, String> {
+        Ok(Params {
+            algorithm: Algorithm::from_name(&self.algorithm)
+                .ok_or_else(|| format!("unknown algorithm `{}`", self.algorithm))?,
+            ants: self.ants,
+            iterations: self.iterations,
+            alpha: self.alpha,
+            beta: self.beta,
+            rho: self.rho,
+            q: self.q,
+            a: self.a,
+            xi: self.xi,
+            tau0: self.tau0,
+            tau_min: self.tau_min,
+            tau_max: self.tau_max,
+            patience: self.patience,
+            seed: self.seed,
+            dead_end: parse_dead_end(&self.dead_end)?,
+            smoothing: parse_smoothing(&self.smoothing)?,
+            tighten: self.tighten,
+        })
+    }
+}
+
+/// The result of one planning request. See the module docs for the JSON contract.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PlanReport {
+    /// A path was found.
+    pub found: bool,
+    /// Raw 8-connected path, `[x, y]` per cell, start to goal.
+    pub raw: Vec<[u16; 2]>,
+    /// Output waypoints, `[x, y]`, start to goal.
+    pub waypoints: Vec<[u16; 2]>,
+    /// Length of the raw path.
+    pub raw_length: Option<f32>,
+    /// Length through the waypoints.
+    pub length: Option<f32>,
+    /// Turns along the waypoints.
+    pub turns: Option<u32>,
+    /// Iterations run.
+    pub iterations: Option<u16>,
+    /// 0-based iteration in which the best path was first found.
+    pub best_iteration: Option<u16>,
+    /// Ant moves over the run.
+    pub moves: Option<u64>,
+    /// Planning time in microseconds.
+    pub elapsed_us: u64,
+    /// Parameters used.
+    pub params: ParamsReport,
+    /// Why no path was found (absent when `found`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub error: Option<String>,
+}
+
+/// `[x, y]` of a point.
+pub fn xy(p: Point) -> [u16; 2] {
+    [p.x, p.y]
+}
+
+/// Microseconds of `d`, saturating.
+pub fn micros(d: Duration) -> u64 {
+    u64::try_from(d.as_micros()).unwrap_or(u64::MAX)
+}
+
+impl PlanReport {
+    /// The report of a successful plan that took `elapsed`.
+    pub fn from_plan(plan: &Plan<'_>, elapsed: Duration) -> Self {
+        PlanReport {
+            found: true,
+            raw: plan.raw().map(xy).collect(),
+            waypoints: plan.waypoints().iter().copied().map(xy).collect(),
+            raw_length: Some(plan.raw_length),
+            length: Some(plan.length),
+            turns: Some(plan.turns),
+            iterations: Some(plan.iterations),
+            best_iteration: Some(plan.best_iteration),
+            moves: Some(plan.moves),
+            elapsed_us: micros(elapsed),
+            params: ParamsReport::from(&plan.params),
+            error: None,
+        }
+    }
+
+    /// The report of a request that found no path: `error` says why, `iterations` is how many
+    /// ran if known.
+    pub fn not_found(
+        params: &Params,
+        error: impl std::fmt::Display,
+        iterations: Option<u16>,
+        elapsed: Duration,
+    ) -> Self {
+        PlanReport {
+            found: false,
+            raw: Vec::new(),
+            waypoints: Vec::new(),
+            raw_length: None,
+            length: None,
+            turns: None,
+            iterations,
+            best_iteration: None,
+            moves: None,
+            elapsed_us: micros(elapsed),
+            params: ParamsReport::from(params),
+            error: Some(error.to_string()),
+        }
+    }
+
+    /// One line of JSON (no trailing newline).
+    pub fn to_json(&self) -> String {
+        // Serialising plain numbers, strings and vectors cannot fail; NaN/inf become null.
+        serde_json::to_string(self).unwrap_or_else(|e| {
+            format!(
+                "{{\"found\":false,\"error\":{}}}",
+                serde_json::Value::String(e.to_string())
+            )
+        })
+    }
+}
+
+/// The map as characters, with the path drawn on it: `#` obstacle, `.` free, `*` raw path,
+/// `o` waypoint, `S` start, `G` goal (later marks win). Points outside the map are ignored.
+/// One line per row, cells separated by a space, each line ending in `\n`.
+pub fn picture(
+    map: &Map,
+    start: Point,
+    goal: Point,
+    raw: &[[u16; 2]],
+    waypoints: &[[u16; 2]],
+) -> String {
+    let (w, h) = (usize::from(map.width), usize::from(map.height));
+    let mut cells: Vec<u8> = (0..w * h)
+        .map(|i| {
+            // i < w * h, so both fit in u16.
+            let p = Point::new((i % w) as u16, (i / w) as u16);
+            if map.is_blocked(p) {
+                b'#'
+            } else {
+                b'.'
+            }
+        })
+        .collect();
+    let mut mark = |[x, y]: [u16; 2], c: u8| {
+        if x < map.width && y < map.height {
+            if let Some(slot) = cells.get_mut(usize::from(y) * w + usize::from(x)) {
+                *slot = c;
+            }
+        }
+    };
+    for &p in raw {
+        mark(p, b'*');
+    }
+    for &p in waypoints {
+        mark(p, b'o');
+    }
+    mark(xy(start), b'S');
+    mark(xy(goal), b'G');
+    let mut s = String::with_capacity(h * (2 * w + 1));
+    for row in cells.chunks(w.max(1)) {
+        for (i, &c) in row.iter().enumerate() {
+            if i > 0 {
+                s.push(' ');
+            }
+            s.push(char::from(c));
+        }
+        s.push('\n');
+    }
+    s
+}
+
+/// `12.345 ms` style duration from microseconds.
+pub fn format_us(us: u64) -> String {
+    if us >= 1_000_000 {
+        format!("{:.3} s", us as f64 / 1e6)
+    } else {
+        format!("{:.3} ms", us as f64 / 1e3)
+    }
+}
+
+/// A short summary of a report: lengths, turns, iterations, time (two lines, each ending in
+/// `\n`).
+pub fn summary(r: &PlanReport) -> String {
+    let mut s = String::new();
+    let n = |v: Option<f32>| v.map_or_else(|| "-".to_string(), |v| format!("{v:.3}"));
+    if r.found {
+        let _ = writeln!(
+            s,
+            "raw length {}   waypoint path {} ({} waypoints)   {} turns",
+            n(r.raw_length),
+            n(r.length),
+            r.waypoints.len(),
+            r.turns.map_or_else(|| "-".to_string(), |t| t.to_string()),
+        );
+    } else {
+        let _ = writeln!(
+            s,
+            "no path: {}",
+            r.error.as_deref().unwrap_or("no path found")
+        );
+    }
+    let mut line = String::new();
+    if let Some(it) = r.iterations {
+        let _ = write!(line, "{it} iterations");
+        if let Some(b) = r.best_iteration {
+            let _ = write!(line, " (best found in iteration {})", u32::from(b) + 1);
+        }
+        line.push_str("   ");
+    }
+    if let Some(m) = r.moves {
+        let _ = write!(line, "{m} ant moves   ");
+    }
+    let p = &r.params;
+    let _ = write!(
+        line,
+        "{}   {} seed {}, {} ants",
+        format_us(r.elapsed_us),
+        p.algorithm,
+        p.seed,
+        p.ants
+    );
+    s.push_str(&line);
+    s.push('\n');
+    s
+}
+
+/// The legend line of [`picture`].
+pub const LEGEND: &str = "S start   G goal   o waypoint   * raw ant path   # obstacle   . free";
+
+/// Legend, picture and summary.
+pub fn render(map: &Map, start: Point, goal: Point, report: &PlanReport) -> String {
+    let mut s = String::new();
+    s.push_str(LEGEND);
+    s.push('\n');
+    s.push_str(&picture(map, start, goal, &report.raw, &report.waypoints));
+    s.push_str(&summary(report));
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::map::Format;
+
+    fn report() -> PlanReport {
+        PlanReport {
+            found: true,
+            raw: vec![[0, 0], [1, 1], [2, 1]],
+            waypoints: vec![[0, 0], [2, 1]],
+            raw_length: Some(2.4142137),
+            length: Some(2.236068),
+            turns: Some(0),
+            iterations: Some(3),
+            best_iteration: Some(0),
+            moves: Some(42),
+            elapsed_us: 1500,
+            params: ParamsReport::from(&Params::default()),
+            error: None,
+        }
+    }
+
+    #[test]
+    fn json_keys_in_order() {
+        let j = report().to_json();
+        let v: serde_json::Value = serde_json::from_str(&j).unwrap();
+        let keys: Vec<_> = v.as_object().unwrap().keys().cloned().collect();
+        // serde_json's map is sorted unless preserve_order; check presence and the text order.
+        let mut pos = Vec::new();
+        for k in [
+            "found",
+            "raw",
+            "waypoints",
+            "raw_length",
+            "length",
+            "turns",
+            "iterations",
+            "best_iteration",
+            "moves",
+            "elapsed_us",
+            "params",
+        ] {
+            assert!(keys.contains(&k.to_string()), "{k}");
+            pos.push(j.find(&format!("\"{k}\":")).unwrap());
+        }
+        assert!(pos.windows(2).all(|w| w[0] < w[1]), "{j}");
+        assert_eq!(keys.len(), 11, "no error key when found: {j}");
+        assert!(j.contains("\"raw\":[[0,0],[1,1],[2,1]]"), "{j}");
+        assert!(j.contains("\"raw_length\":2.4142137"), "{j}");
+        assert_eq!(serde_json::from_str::<PlanReport>(&j).unwrap(), report());
+    }
+
+    #[test]
+    fn params_round_trip() {
+        let p = Params::default();
+        assert_eq!(ParamsReport::from(&p).to_params(), Ok(p));
+        let j = serde_json::to_value(ParamsReport::from(&p)).unwrap();
+        assert_eq!(j["algorithm"], "ohaca");
+        assert_eq!(j["dead_end"], "backtrack");
+        assert_eq!(j["smoothing"], "shortest");
+        assert_eq!(j["rho"].as_f64().unwrap() as f32, 0.1);
+    }
+
+    #[test]
+    fn not_found_has_error_and_nulls() {
+        let r = PlanReport::not_found(
+            &Params::default(),
+            ohaca::Error::NoPath,
+            Some(0),
+            Duration::from_micros(7),
+        );
+        let v: serde_json::Value = serde_json::from_str(&r.to_json()).unwrap();
+        assert_eq!(v["found"], false);
+        assert_eq!(v["raw"], serde_json::json!([]));
+        assert!(v["length"].is_null());
+        assert_eq!(v["iterations"], 0);
+        assert_eq!(v["elapsed_us"], 7);
+        assert_eq!(
+            v["error"],
+            "no path: the goal is not reachable from the start"
+        );
+    }
+
+    #[test]
+    fn draws_marks_over_the_map() {
+        let map = Map::parse("...\n.#.\n", "t", Format::Text).unwrap();
+        let r = report();
+        let pic = picture(
+            &map,
+            Point::new(0, 0),
+            Point::new(2, 1),
+            &r.raw,
+            &r.waypoints,
+        );
+        assert_eq!(pic, "S . .\n. * G\n");
+        // Out-of-map points are ignored.
+        let pic = picture(&map, Point::new(9, 9), Point::new(2, 0), &[[5, 5]], &[]);
+        assert_eq!(pic, ". . G\n. # .\n");
+        let all = render(&map, Point::new(0, 0), Point::new(2, 1), &r);
+        assert!(all.starts_with(LEGEND));
+        assert!(all.contains("raw length 2.414   waypoint path 2.236 (2 waypoints)   0 turns"));
+        assert!(all.contains("3 iterations (best found in iteration 1)"));
+        assert!(all.contains("1.500 ms"));
+    }
+}
