@@ -117,8 +117,8 @@ impl Colony<'_, '_, '_> {
     pub fn walk(
         &self,
         rng: &mut Xoshiro128pp,
-        visited: &mut [u16],
-        stamp: u16,
+        visited: &mut [u8],
+        stamp: u8,
         tour: &mut [Dir],
     ) -> Option<Walk> {
         let grid = self.grid;
@@ -342,7 +342,7 @@ mod tests {
             dead_end,
             moves: &moves,
         };
-        let mut visited = vec![0u16; g.cells()];
+        let mut visited = vec![0u8; g.cells()];
         let mut tour = vec![0u8; g.cells()];
         let mut rng = Xoshiro128pp::from_u64(seed);
         c.walk(&mut rng, &mut visited, 1, &mut tour)

@@ -201,13 +201,7 @@ impl<'a> Grid<'a> {
     ///
     /// `mark` and `queue` are scratch space of at least [`Grid::cells`] entries (the planner lends
     /// its own buffers). Returns `false` if they are too short.
-    pub fn reachable(
-        &self,
-        start: Point,
-        goal: Point,
-        mark: &mut [u16],
-        queue: &mut [u32],
-    ) -> bool {
+    pub fn reachable(&self, start: Point, goal: Point, mark: &mut [u8], queue: &mut [u32]) -> bool {
         let cells = self.cells();
         if mark.len() < cells || queue.len() < cells || !self.is_free(start) || !self.is_free(goal)
         {
@@ -218,7 +212,7 @@ impl<'a> Grid<'a> {
         };
         mark.fill(0);
         let (mut head, mut tail) = (0usize, 0usize);
-        let push = |q: &mut [u32], m: &mut [u16], tail: &mut usize, p: Point| {
+        let push = |q: &mut [u32], m: &mut [u8], tail: &mut usize, p: Point| {
             let i = self.index(p);
             if let (Some(slot), Some(mk)) = (q.get_mut(*tail), m.get_mut(i)) {
                 if *mk == 0 {
@@ -289,7 +283,7 @@ mod tests {
         let mut b = [0u8; 2];
         let (w, h) = grid_from(&["..#", ".#.", "#.."], &mut b);
         let g = Grid::new(w, h, &b).unwrap();
-        let mut m = [0u16; 9];
+        let mut m = [0u8; 9];
         let mut q = [0u32; 9];
         assert!(!g.reachable(Point::new(0, 0), Point::new(2, 2), &mut m, &mut q));
         assert!(g.reachable(Point::new(0, 0), Point::new(0, 1), &mut m, &mut q));

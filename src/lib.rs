@@ -43,7 +43,7 @@
 //! // Storage for maps up to 16 cells; a firmware puts this in a `static`.
 //! let mut storage: Storage<16> = Storage::new();
 //! let plan = plan(&grid, Point::new(0, 0), Point::new(3, 2), &Params::default(),
-//!                 &mut storage.workspace()).unwrap();
+//!                 storage.workspace()).unwrap();
 //! assert_eq!(plan.raw().next(), Some(Point::new(0, 0)));
 //! assert_eq!(plan.waypoints().last(), Some(&Point::new(3, 2)));
 //! ```

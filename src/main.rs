@@ -5,7 +5,10 @@
 fn main() {}
 
 #[cfg(target_os = "none")]
-#[cortex_m_rt::entry]
-fn main() -> ! {
-    loop {}
+mod firmware;
+
+#[cfg(target_os = "none")]
+#[embassy_executor::main]
+async fn main(spawner: embassy_executor::Spawner) {
+    firmware::run(spawner);
 }

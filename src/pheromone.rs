@@ -90,19 +90,11 @@ impl<'a> Table<'a> {
         let keep = 1.0 - rho;
         for (t, d) in self.tau.iter_mut().zip(delta.tau.iter_mut()) {
             for (tv, dv) in t.iter_mut().zip(d.iter_mut()) {
-                *tv = (keep * *tv + *dv).clamp(lo, hi);
+                // max/min rather than `f32::clamp`: no panic path (clamp asserts lo <= hi), and no
+                // float-formatting code pulled into the firmware by that panic message.
+                *tv = (keep * *tv + *dv).max(lo).min(hi);
                 *dv = 0.0;
             }
-        }
-    }
-
-    /// Clamp edge `(p, d)` into `[lo, hi]`.
-    #[inline]
-    pub fn clamp_edge(&mut self, p: Point, d: Dir, lo: f32, hi: f32) {
-        if let Some(v) =
-            edge(self.width, p, d).and_then(|(c, s)| self.tau.get_mut(c).and_then(|e| e.get_mut(s)))
-        {
-            *v = v.clamp(lo, hi);
         }
     }
 

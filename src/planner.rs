@@ -215,34 +215,33 @@ pub struct CurvePoint {
 pub struct Workspace<'a> {
     tau: &'a mut [[f32; 4]],
     delta: &'a mut [[f32; 4]],
-    visited: &'a mut [u16],
+    visited: &'a mut [u8],
     moves: &'a mut [u8],
     tour: &'a mut [Dir],
     iter_best: &'a mut [Dir],
     iter_worst: &'a mut [Dir],
     best: &'a mut [Dir],
     points: &'a mut [Point],
-    dist: &'a mut [f32],
     prev: &'a mut [u32],
     curve: &'a mut [CurvePoint],
 }
 
 impl<'a> Workspace<'a> {
     /// Bytes of storage a run needs per map cell: pheromone and its increment (2 x 16), tabu
-    /// stamps (2), allowed-move masks (1), four tours (4), raw path points (4), smoothing
-    /// distance and links (8).
-    pub const BYTES_PER_CELL: usize = 2 * 16 + 2 + 1 + 4 + 4 + 4 + 4;
+    /// stamps (1), allowed-move masks (1), four tours (4), raw path points (4), and links (4: the
+    /// flood-fill queue, the tightening positions and the smoothing links). Smoothing keeps its
+    /// distances in the increment table, which is free once the iterations are over.
+    pub const BYTES_PER_CELL: usize = 2 * 16 + 1 + 1 + 4 + 4 + 4;
 
     /// A workspace over caller buffers (see the type docs for the sizes).
     #[allow(clippy::too_many_arguments)]
     pub fn from_slices(
         tau: &'a mut [[f32; 4]],
         delta: &'a mut [[f32; 4]],
-        visited: &'a mut [u16],
+        visited: &'a mut [u8],
         moves: &'a mut [u8],
         tours: [&'a mut [Dir]; 4],
         points: &'a mut [Point],
-        dist: &'a mut [f32],
         prev: &'a mut [u32],
         curve: &'a mut [CurvePoint],
     ) -> Self {
@@ -257,7 +256,6 @@ impl<'a> Workspace<'a> {
             iter_worst,
             best,
             points,
-            dist,
             prev,
             curve,
         }
@@ -275,7 +273,6 @@ impl<'a> Workspace<'a> {
             self.iter_worst.len(),
             self.best.len(),
             self.points.len(),
-            self.dist.len(),
             self.prev.len(),
         ]
         .into_iter()
@@ -296,11 +293,10 @@ impl<'a> Workspace<'a> {
 pub struct Storage<const CELLS: usize, const CURVE: usize = 128> {
     tau: [[f32; 4]; CELLS],
     delta: [[f32; 4]; CELLS],
-    visited: [u16; CELLS],
+    visited: [u8; CELLS],
     moves: [u8; CELLS],
     tours: [[Dir; CELLS]; 4],
     points: [Point; CELLS],
-    dist: [f32; CELLS],
     prev: [u32; CELLS],
     curve: [CurvePoint; CURVE],
 }
@@ -315,7 +311,6 @@ impl<const CELLS: usize, const CURVE: usize> Storage<CELLS, CURVE> {
             moves: [0; CELLS],
             tours: [[0; CELLS]; 4],
             points: [Point::new(0, 0); CELLS],
-            dist: [0.0; CELLS],
             prev: [0; CELLS],
             curve: [CurvePoint {
                 best: 0.0,
@@ -335,7 +330,6 @@ impl<const CELLS: usize, const CURVE: usize> Storage<CELLS, CURVE> {
             &mut self.moves,
             [t0, t1, t2, t3],
             &mut self.points,
-            &mut self.dist,
             &mut self.prev,
             &mut self.curve,
         )
@@ -382,7 +376,7 @@ pub struct Run<'g, 'a> {
     rng: Xoshiro128pp,
     ws: Workspace<'a>,
     cells: usize,
-    stamp: u16,
+    stamp: u8,
     iteration: u16,
     best: Option<Best>,
     best_iteration: u16,
@@ -649,11 +643,14 @@ impl<'g, 'a> Run<'g, 'a> {
         let Workspace {
             best: best_tour,
             points,
-            dist,
+            delta,
             prev,
             curve,
             ..
         } = ws;
+        // The increment table is all zeros between iterations and unused from here on: lend it
+        // to the smoothing as its distance scratch (4 floats per cell, at least n).
+        let dist = delta.as_flattened_mut();
         let tour: &'a [Dir] = best_tour.get(..best.steps).ok_or(Error::NoPath)?;
         // Expand the tour into cells.
         let n = best.steps + 1;

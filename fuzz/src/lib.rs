@@ -75,16 +75,15 @@ pub fn check_planner(input: &PlannerInput) {
     let cells = grid.cells();
     let mut tau = vec![[0f32; 4]; cells];
     let mut delta = vec![[0f32; 4]; cells];
-    let mut visited = vec![0u16; cells];
+    let mut visited = vec![0u8; cells];
     let mut moves = vec![0u8; cells];
     let mut tours: Vec<Vec<u8>> = (0..4).map(|_| vec![0u8; cells]).collect();
     let mut points = vec![Point::default(); cells];
-    let mut dist = vec![0f32; cells];
     let mut prev = vec![0u32; cells];
     let mut curve = vec![CurvePoint::default(); 16];
     let [t0, t1, t2, t3] = &mut tours[..] else { return };
     let ws = Workspace::from_slices(
-        &mut tau, &mut delta, &mut visited, &mut moves, [t0, t1, t2, t3], &mut points, &mut dist,
+        &mut tau, &mut delta, &mut visited, &mut moves, [t0, t1, t2, t3], &mut points,
         &mut prev, &mut curve,
     );
     let p = &input.params;
@@ -114,7 +113,7 @@ pub fn check_planner(input: &PlannerInput) {
         }
         Err(Error::BadParam(_)) => assert!(p.validate().is_err()),
         Err(e @ (Error::NoPath | Error::NoAntArrived)) => {
-            let mut m = vec![0u16; cells];
+            let mut m = vec![0u8; cells];
             let mut q = vec![0u32; cells];
             let reachable = grid.reachable(input.start, input.goal, &mut m, &mut q);
             if e == Error::NoPath {

@@ -21,11 +21,10 @@ use ohaca::{Point, Workspace};
 pub struct HeapStorage {
     tau: Vec<[f32; 4]>,
     delta: Vec<[f32; 4]>,
-    visited: Vec<u16>,
+    visited: Vec<u8>,
     moves: Vec<u8>,
     tours: [Vec<Dir>; 4],
     points: Vec<Point>,
-    dist: Vec<f32>,
     prev: Vec<u32>,
     curve: Vec<CurvePoint>,
 }
@@ -90,7 +89,6 @@ impl HeapStorage {
             grow(t, cells, 0).map_err(err)?;
         }
         grow(&mut self.points, cells, Point::default()).map_err(err)?;
-        grow(&mut self.dist, cells, 0.0).map_err(err)?;
         grow(&mut self.prev, cells, 0).map_err(err)?;
         grow(&mut self.curve, iterations, CurvePoint::default()).map_err(err)?;
         Ok(())
@@ -116,7 +114,6 @@ impl HeapStorage {
             &mut self.moves,
             [t0, t1, t2, t3],
             &mut self.points,
-            &mut self.dist,
             &mut self.prev,
             &mut self.curve,
         )

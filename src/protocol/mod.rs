@@ -263,7 +263,7 @@ impl fmt::Display for ErrorReply {
     }
 }
 
-/// Error codes on the wire (one byte). 1 to 9 are the planner's [`Error::code`]; 16 and up are
+/// Error codes on the wire (one byte). 1 to 10 are the planner's [`Error::code`]; 16 and up are
 /// the protocol's own. `detail` / `limit` of the [`ErrorReply`] are given where they mean
 /// something.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -289,6 +289,9 @@ pub enum ErrorCode {
     NoPath = 8,
     /// The plan was cancelled (by [`Request::Cancel`] or a new map).
     Cancelled = 9,
+    /// The goal is reachable but no ant reached it (every ant died at a dead end with
+    /// [`crate::DeadEnd::Die`]).
+    NoAntArrived = 10,
     /// The frame's CRC did not match (id: [`UNKNOWN_ID`]).
     BadCrc = 16,
     /// The frame was not valid COBS, or too short, or its message did not decode (id: the
@@ -309,7 +312,7 @@ pub enum ErrorCode {
 
 impl ErrorCode {
     /// Every code, in numeric order.
-    pub const ALL: [ErrorCode; 16] = [
+    pub const ALL: [ErrorCode; 17] = [
         ErrorCode::BadMap,
         ErrorCode::MapTooLarge,
         ErrorCode::StartOutOfBounds,
@@ -319,6 +322,7 @@ impl ErrorCode {
         ErrorCode::BadParam,
         ErrorCode::NoPath,
         ErrorCode::Cancelled,
+        ErrorCode::NoAntArrived,
         ErrorCode::BadCrc,
         ErrorCode::Undecodable,
         ErrorCode::TooLarge,
@@ -350,6 +354,7 @@ impl ErrorCode {
             ErrorCode::BadParam => "bad parameter",
             ErrorCode::NoPath => "no path",
             ErrorCode::Cancelled => "cancelled",
+            ErrorCode::NoAntArrived => "no ant reached the goal",
             ErrorCode::BadCrc => "bad CRC",
             ErrorCode::Undecodable => "undecodable frame",
             ErrorCode::TooLarge => "too large",
@@ -371,7 +376,8 @@ impl From<Error> for ErrorCode {
             Error::Blocked(Endpoint::Start) => ErrorCode::StartBlocked,
             Error::Blocked(Endpoint::Goal) => ErrorCode::GoalBlocked,
             Error::BadParam(_) => ErrorCode::BadParam,
-            Error::NoPath | Error::NoAntArrived => ErrorCode::NoPath,
+            Error::NoPath => ErrorCode::NoPath,
+            Error::NoAntArrived => ErrorCode::NoAntArrived,
             Error::Cancelled => ErrorCode::Cancelled,
         }
     }
@@ -425,7 +431,7 @@ pub struct StatsReply {
     pub tx_frames: u32,
     /// Plans answered with a path.
     pub plans: u32,
-    /// Plans answered with a planner error ([`ErrorCode`] 1 to 8).
+    /// Plans answered with a planner error (every [`ErrorCode`] below 16 but `Cancelled`).
     pub plan_errors: u32,
     /// Plans cancelled.
     pub cancelled: u32,

@@ -582,6 +582,7 @@ fn error_codes_match_the_planner() {
         Error::BadParam(Param::Tau),
         Error::NoPath,
         Error::Cancelled,
+        Error::NoAntArrived,
     ];
     for e in all {
         assert_eq!(ErrorCode::from(e).code(), e.code(), "{e:?}");
@@ -626,7 +627,7 @@ const EXAMPLE_WAYPOINTS: [Point; 4] = [
 ];
 const EXAMPLE_DIRECTIONS: [u8; 4] = [0, 0, 1, 2];
 /// Ticks (µs of virtual time) the QEMU firmware reported for the example plan.
-const EXAMPLE_TICKS: u64 = 1_234_567;
+const EXAMPLE_TICKS: u64 = 1689;
 
 fn example_path() -> PathReply<'static> {
     PathReply {
@@ -833,7 +834,7 @@ fn request_fields(id: u32, r: &Request<'_>) -> Vec<(String, Vec<u8>)> {
             ));
             v.push((format!("  seed = {seed:?}"), ser(&seed)));
         }
-        _ => unimplemented!(),
+        _ => panic!("not used by the example"),
     }
     v
 }
@@ -920,7 +921,7 @@ fn reply_fields(id: u32, r: &Reply<'_>) -> Vec<(String, Vec<u8>)> {
                 ser(p.directions),
             ));
         }
-        _ => unimplemented!(),
+        _ => panic!("not used by the example"),
     }
     v
 }
@@ -930,7 +931,6 @@ fn print_frame(marker: &str, wire_marker: &str, fields: Vec<(String, Vec<u8>)>, 
     let mut all = vec![];
     for (name, b) in &fields {
         all.extend(b);
-        let h = hex(b);
         // Long fields wrap at 16 bytes a line.
         let mut chunks: Vec<&[u8]> = b.chunks(16).collect();
         if chunks.is_empty() {
@@ -938,18 +938,12 @@ fn print_frame(marker: &str, wire_marker: &str, fields: Vec<(String, Vec<u8>)>, 
         }
         for (i, c) in chunks.iter().enumerate() {
             let h2 = hex(c);
-            let label = if i == 0 { name.as_str() } else { "" };
-            println!(
-                "{marker}{:<48}{}",
-                h2,
-                if label.is_empty() {
-                    String::new()
-                } else {
-                    format!("; {label}")
-                }
-            );
+            if i == 0 {
+                println!("{marker}{h2:<48}; {name}");
+            } else {
+                println!("{marker}{h2}");
+            }
         }
-        let _ = h;
     }
     let crc = &payload[all.len()..];
     assert_eq!(&payload[..all.len()], &all[..]);

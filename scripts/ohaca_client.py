@@ -1,0 +1,498 @@
+#!/usr/bin/env python3
+"""A small, dependency-free client for the ohaca firmware protocol (docs/PROTOCOL.md).
+
+Talks to the firmware over TCP (QEMU's `-serial tcp:...`, see scripts/qemu-serve.sh). Meant for
+checking the firmware by hand and from scripts; the real host tool is `ohaca send`.
+
+  scripts/ohaca_client.py --port 4444 hello
+  scripts/ohaca_client.py --port 4444 plan --map maps/complex-26.map --start 0,0 --goal 25,25
+  scripts/ohaca_client.py --port 4444 stats
+  scripts/ohaca_client.py --port 4444 selftest     # every request and error path, asserts
+"""
+
+import argparse
+import socket
+import struct
+import sys
+import time
+import zlib
+
+# ---- postcard primitives ---------------------------------------------------------------------
+
+
+def varint(n):
+    out = bytearray()
+    while True:
+        b = n & 0x7F
+        n >>= 7
+        if n:
+            out.append(b | 0x80)
+        else:
+            out.append(b)
+            return bytes(out)
+
+
+def f32(x):
+    return struct.pack("<f", x)
+
+
+def byte_str(b):
+    return varint(len(b)) + bytes(b)
+
+
+class Reader:
+    def __init__(self, data):
+        self.d = data
+        self.i = 0
+
+    def byte(self):
+        b = self.d[self.i]
+        self.i += 1
+        return b
+
+    def varint(self):
+        n, shift = 0, 0
+        while True:
+            b = self.byte()
+            n |= (b & 0x7F) << shift
+            shift += 7
+            if not b & 0x80:
+                return n
+
+    def f32(self):
+        (x,) = struct.unpack_from("<f", self.d, self.i)
+        self.i += 4
+        return x
+
+    def bytes(self):
+        n = self.varint()
+        b = self.d[self.i : self.i + n]
+        if len(b) != n:
+            raise ValueError("truncated")
+        self.i += n
+        return bytes(b)
+
+    def str(self):
+        return self.bytes().decode()
+
+    def done(self):
+        return self.i == len(self.d)
+
+
+# ---- framing ---------------------------------------------------------------------------------
+
+
+def cobs_encode(data):
+    out = bytearray([0])
+    code_at, code = 0, 1
+    for b in data:
+        if b == 0:
+            out[code_at] = code
+            code_at, code = len(out), 1
+            out.append(0)
+        else:
+            out.append(b)
+            code += 1
+            if code == 0xFF:
+                out[code_at] = code
+                code_at, code = len(out), 1
+                out.append(0)
+    out[code_at] = code
+    return bytes(out)
+
+
+def cobs_decode(data):
+    out = bytearray()
+    i = 0
+    while i < len(data):
+        code = data[i]
+        if code == 0:
+            raise ValueError("zero in COBS frame")
+        i += 1
+        run = data[i : i + code - 1]
+        if len(run) != code - 1:
+            raise ValueError("COBS run past the end")
+        out += run
+        i += code - 1
+        if code != 0xFF and i < len(data):
+            out.append(0)
+    return bytes(out)
+
+
+def frame(body):
+    return cobs_encode(body + struct.pack("<I", zlib.crc32(body))) + b"\x00"
+
+
+def unframe(wire):
+    p = cobs_decode(wire)
+    if len(p) < 5:
+        raise ValueError("frame too short")
+    body, crc = p[:-4], struct.unpack("<I", p[-4:])[0]
+    if zlib.crc32(body) != crc:
+        raise ValueError("bad CRC")
+    return body
+
+
+# ---- messages --------------------------------------------------------------------------------
+
+ALGORITHMS = ["aca", "paca", "haca", "ohaca"]
+DEAD_ENDS = ["backtrack", "die"]
+SMOOTHING = ["none", "greedy", "shortest"]
+ERRORS = {
+    1: "BadMap", 2: "MapTooLarge", 3: "StartOutOfBounds", 4: "GoalOutOfBounds",
+    5: "StartBlocked", 6: "GoalBlocked", 7: "BadParam", 8: "NoPath", 9: "Cancelled",
+    10: "NoAntArrived", 16: "BadCrc", 17: "Undecodable", 18: "TooLarge", 19: "NoMap",
+    20: "Busy", 21: "BadChunk", 22: "Internal",
+}
+PARAM_FIELDS = [
+    ("algorithm", "enum"), ("ants", "u"), ("iterations", "u"), ("alpha", "f"), ("beta", "f"),
+    ("rho", "f"), ("q", "f"), ("a", "f"), ("xi", "f"), ("tau0", "f"), ("tau_min", "f"),
+    ("tau_max", "f"), ("patience", "u"), ("seed", "u"), ("dead_end", "enum"),
+    ("smoothing", "enum"), ("tighten", "bool"),
+]
+
+
+def enc_params(p):
+    out = bytearray()
+    for name, kind in PARAM_FIELDS:
+        v = p[name]
+        if kind == "f":
+            out += f32(v)
+        elif kind == "bool":
+            out.append(1 if v else 0)
+        else:
+            out += varint(v)
+    return bytes(out)
+
+
+def dec_params(r):
+    p = {}
+    for name, kind in PARAM_FIELDS:
+        if kind == "f":
+            p[name] = r.f32()
+        elif kind == "bool":
+            p[name] = r.byte() != 0
+        else:
+            p[name] = r.varint()
+    return p
+
+
+def req_hello():
+    return varint(0)
+
+
+def req_set_map(width, height, offset, total_len, chunk):
+    return (varint(1) + varint(width) + varint(height) + varint(offset) + varint(total_len)
+            + byte_str(chunk))
+
+
+def req_set_params(p):
+    return varint(2) + enc_params(p)
+
+
+def req_plan(start, goal, seed=None):
+    s = b"\x00" if seed is None else b"\x01" + varint(seed)
+    return varint(3) + varint(start[0]) + varint(start[1]) + varint(goal[0]) + varint(goal[1]) + s
+
+
+def req_cancel():
+    return varint(4)
+
+
+def req_stats():
+    return varint(5)
+
+
+STATS_FIELDS = ["uptime", "boots", "frames_ok", "frames_bad", "rx_overruns", "rx_bytes",
+                "tx_frames", "plans", "plan_errors", "cancelled", "busy", "last_plan_ticks",
+                "map_width", "map_height", "queued"]
+
+
+def dec_reply(body):
+    r = Reader(body)
+    rid = r.varint()
+    tag = r.varint()
+    if tag == 0:
+        out = {"kind": "Hello", "protocol_version": r.varint(), "firmware_version": r.str(),
+               "board": r.str()}
+        out["capacity"] = {k: r.varint() for k in
+                           ["cells", "max_width", "max_height", "max_chunk", "max_request",
+                            "plan_queue", "tick_hz"]}
+        out["defaults"] = dec_params(r)
+    elif tag == 1:
+        out = {"kind": "Ack"}
+    elif tag == 2:
+        out = {"kind": "Path", "raw_length": r.f32(), "length": r.f32(), "turns": r.varint(),
+               "iterations": r.varint(), "best_iteration": r.varint(), "moves": r.varint(),
+               "ticks": r.varint(), "raw_cells": r.varint()}
+        w = r.bytes()
+        out["waypoints"] = [struct.unpack_from("<HH", w, i) for i in range(0, len(w), 4)]
+        out["directions"] = list(r.bytes())
+    elif tag == 3:
+        code = r.byte()
+        out = {"kind": "Error", "code": code, "name": ERRORS.get(code, "?"),
+               "detail": r.varint(), "limit": r.varint()}
+    elif tag == 4:
+        out = {"kind": "Stats"}
+        for k in STATS_FIELDS:
+            out[k] = r.varint()
+        out["planning"] = r.byte() != 0
+    else:
+        raise ValueError(f"unknown reply {tag}")
+    if not r.done():
+        raise ValueError("trailing bytes")
+    return rid, out
+
+
+# ---- maps ------------------------------------------------------------------------------------
+
+
+def load_map(path):
+    lines = open(path).read().split("\n")
+    i = lines.index("map") + 1
+    rows = [l for l in lines[i:] if l]
+    h, w = len(rows), len(rows[0])
+    bits = bytearray((w * h + 7) // 8)
+    for y, row in enumerate(rows):
+        for x, c in enumerate(row):
+            if c not in ".GS":
+                k = y * w + x
+                bits[k // 8] |= 1 << (k % 8)
+    return w, h, bytes(bits), rows
+
+
+DX = [1, 1, 0, -1, -1, -1, 0, 1]
+DY = [0, 1, 1, 1, 0, -1, -1, -1]
+
+
+def raw_cells(start, dirs):
+    x, y = start
+    out = [(x, y)]
+    for d in dirs:
+        x, y = x + DX[d], y + DY[d]
+        out.append((x, y))
+    return out
+
+
+# ---- connection ------------------------------------------------------------------------------
+
+
+class Device:
+    def __init__(self, host, port, timeout=60.0):
+        deadline = time.time() + 10
+        while True:
+            try:
+                self.s = socket.create_connection((host, port), timeout=timeout)
+                break
+            except OSError:
+                if time.time() > deadline:
+                    raise
+                time.sleep(0.1)
+        self.s.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        self.buf = bytearray()
+        self.next_id = 1
+        self.s.sendall(b"\x00")  # resynchronise the device's frame reader
+
+    def send_raw(self, wire):
+        self.s.sendall(wire)
+
+    def send(self, body, rid=None):
+        if rid is None:
+            rid = self.next_id
+            self.next_id += 1
+        self.send_raw(frame(varint(rid) + body))
+        return rid
+
+    def recv(self):
+        while True:
+            if 0 in self.buf:
+                i = self.buf.index(0)
+                wire, self.buf = bytes(self.buf[:i]), self.buf[i + 1 :]
+                if wire:
+                    return dec_reply(unframe(wire))
+                continue
+            chunk = self.s.recv(65536)
+            if not chunk:
+                raise EOFError("device closed the connection")
+            self.buf += chunk
+
+    def call(self, body):
+        rid = self.send(body)
+        got, reply = self.recv()
+        if got != rid:
+            raise AssertionError(f"reply id {got}, expected {rid}: {reply}")
+        return reply
+
+    def set_map(self, w, h, bits, chunk=128):
+        for off in range(0, len(bits), chunk):
+            r = self.call(req_set_map(w, h, off, len(bits), bits[off : off + chunk]))
+            if r["kind"] != "Ack":
+                return r
+        return {"kind": "Ack"}
+
+
+def parse_point(s):
+    x, y = s.split(",")
+    return int(x), int(y)
+
+
+def show_path(reply, rows, start):
+    if reply["kind"] != "Path":
+        print(reply)
+        return
+    raw = set(raw_cells(start, reply["directions"]))
+    wp = set(reply["waypoints"])
+    for y, row in enumerate(rows):
+        line = []
+        for x, c in enumerate(row):
+            line.append("o" if (x, y) in wp else "*" if (x, y) in raw else "." if c in ".GS" else "#")
+        print(" ".join(line))
+    print(f"raw {reply['raw_length']:.3f}  smoothed {reply['length']:.3f}  {reply['turns']} turns  "
+          f"{reply['iterations']} iterations (best at {reply['best_iteration']})  "
+          f"{reply['ticks']} ticks  waypoints {reply['waypoints']}")
+
+
+# ---- self test -------------------------------------------------------------------------------
+
+
+def expect(reply, kind, code=None):
+    if reply["kind"] != kind or (code is not None and reply.get("name") != code):
+        raise AssertionError(f"expected {kind} {code or ''}, got {reply}")
+    return reply
+
+
+def selftest(dev, map_path):
+    w, h, bits, rows = load_map(map_path)
+    hello = expect(dev.call(req_hello()), "Hello")
+    assert hello["protocol_version"] == 1, hello
+    defaults = hello["defaults"]
+    print("hello:", hello["board"], hello["firmware_version"], hello["capacity"])
+
+    # Before any map: NoMap.
+    st = expect(dev.call(req_stats()), "Stats")
+    if st["map_width"] == 0:
+        expect(dev.call(req_plan((0, 0), (1, 1))), "Error", "NoMap")
+
+    # Map uploads: too large, out-of-sequence chunk, then the real one in small chunks.
+    r = expect(dev.call(req_set_map(40, 40, 0, 200, b"\x00" * 16)), "Error", "MapTooLarge")
+    assert (r["detail"], r["limit"]) == (1600, hello["capacity"]["cells"]), r
+    expect(dev.call(req_set_map(w, h, 5, len(bits), b"\x00")), "Error", "BadChunk")
+    r = expect(dev.call(req_set_map(w, h, 0, 200, b"\x00" * 200)), "Error", "TooLarge")
+    assert (r["detail"], r["limit"]) == (200, hello["capacity"]["max_chunk"]), r
+    expect(dev.set_map(w, h, bits, chunk=17), "Ack")
+
+    # A plan, raw path and waypoints checked against the map.
+    start, goal = (0, 0), (w - 1, h - 1)
+    p = expect(dev.call(req_plan(start, goal)), "Path")
+    cells = raw_cells(start, p["directions"])
+    assert cells[-1] == goal and len(cells) == p["raw_cells"], p
+    assert all(rows[y][x] in ".GS" for x, y in cells), "raw path crosses an obstacle"
+    assert p["waypoints"][0] == start and p["waypoints"][-1] == goal, p
+    print(f"plan: length {p['length']:.3f} raw {p['raw_length']:.3f}, {p['iterations']} "
+          f"iterations, {p['ticks']} ticks")
+
+    # Same seed, same path; bad params refused.
+    again = expect(dev.call(req_plan(start, goal, seed=defaults["seed"])), "Path")
+    assert again["directions"] == p["directions"] and again["waypoints"] == p["waypoints"]
+    bad = dict(defaults, rho=0.0)
+    r = expect(dev.call(req_set_params(bad)), "Error", "BadParam")
+    assert r["detail"] == 4, r
+    expect(dev.call(req_plan((1, 1), goal)), "Error", "StartBlocked") if rows[1][1] not in ".GS" \
+        else None
+    expect(dev.call(req_plan((w, 0), goal)), "Error", "StartOutOfBounds")
+
+    # Busy and Cancel: a long plan, the queue filled, one more refused, then cancel them all.
+    slow = dict(defaults, iterations=2000, patience=0)
+    expect(dev.call(req_set_params(slow)), "Ack")
+    queue = hello["capacity"]["plan_queue"]
+    ids = [dev.send(req_plan(start, goal, seed=s)) for s in range(1, queue + 3)]
+    replies = {}
+    rid, r = dev.recv()  # the refused one comes back at once
+    replies[rid] = r
+    assert r["kind"] == "Error" and r["name"] == "Busy" and rid == ids[-1], (rid, r)
+    st = expect(dev.call(req_stats()), "Stats")
+    assert st["planning"] and st["queued"] == queue, st
+    cancel_id = dev.send(req_cancel())
+    while len(replies) < len(ids) + 1:
+        rid, r = dev.recv()
+        replies[rid] = r
+    expect(replies[cancel_id], "Ack")
+    for i in ids[:-1]:
+        expect(replies[i], "Error", "Cancelled")
+    print(f"busy + cancel: {queue + 1} plans cancelled, 1 refused")
+
+    # A new map during a plan cancels it.
+    pid = dev.send(req_plan(start, goal))
+    time.sleep(0.05)
+    mid = dev.send(req_set_map(w, h, 0, len(bits), bits))
+    got = dict([dev.recv(), dev.recv()])
+    expect(got[pid], "Error", "Cancelled")
+    expect(got[mid], "Ack")
+    expect(dev.call(req_set_params(defaults)), "Ack")
+
+    # Corrupted frames: bad CRC, garbage, oversize; each answered with id 0.
+    body = varint(999) + req_hello()
+    good = cobs_decode(frame(body)[:-1])
+    bad = bytearray(good)
+    bad[1] ^= 0x01
+    dev.send_raw(cobs_encode(bytes(bad)) + b"\x00")
+    rid, r = dev.recv()
+    assert rid == 0 and r["name"] == "BadCrc", (rid, r)
+    dev.send_raw(b"\x05\x01\x02\x00")
+    rid, r = dev.recv()
+    assert rid == 0 and r["name"] == "Undecodable", (rid, r)
+    dev.send_raw(b"\x01" * 600 + b"\x00")
+    rid, r = dev.recv()
+    assert rid == 0 and r["name"] == "TooLarge" and r["detail"] == 600, (rid, r)
+    expect(dev.call(req_hello()), "Hello")
+
+    st = expect(dev.call(req_stats()), "Stats")
+    assert st["frames_bad"] >= 3 and st["busy"] >= 1 and st["cancelled"] >= queue + 2, st
+    print("stats:", {k: v for k, v in st.items() if k != "kind"})
+    print("selftest passed")
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawTextHelpFormatter)
+    ap.add_argument("--host", default="127.0.0.1")
+    ap.add_argument("--port", type=int, default=4444)
+    sub = ap.add_subparsers(dest="cmd", required=True)
+    sub.add_parser("hello")
+    sub.add_parser("stats")
+    sub.add_parser("cancel")
+    pl = sub.add_parser("plan")
+    pl.add_argument("--map", required=True)
+    pl.add_argument("--start", type=parse_point, required=True)
+    pl.add_argument("--goal", type=parse_point, required=True)
+    pl.add_argument("--seed", type=int)
+    pl.add_argument("--repeat", type=int, default=1, help="plan this many times (seeds seed..)")
+    st = sub.add_parser("selftest")
+    st.add_argument("--map", default="maps/complex-26.map")
+    args = ap.parse_args()
+
+    dev = Device(args.host, args.port)
+    if args.cmd == "hello":
+        print(dev.call(req_hello()))
+    elif args.cmd == "stats":
+        print(dev.call(req_stats()))
+    elif args.cmd == "cancel":
+        print(dev.call(req_cancel()))
+    elif args.cmd == "plan":
+        w, h, bits, rows = load_map(args.map)
+        r = dev.set_map(w, h, bits)
+        if r["kind"] != "Ack":
+            print(r)
+            return 1
+        for k in range(args.repeat):
+            seed = None if args.seed is None and k == 0 else (args.seed or 1) + k
+            reply = dev.call(req_plan(args.start, args.goal, seed))
+            show_path(reply, rows, args.start)
+            if reply["kind"] != "Path":
+                return 1
+    elif args.cmd == "selftest":
+        selftest(dev, args.map)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,48 @@
+//! QEMU `mps2-an386`: Cortex-M4 at 25 MHz, 4 MiB flash at 0, 4 MiB RAM at 0x2000_0000, CMSDK APB
+//! UART0 at 0x4000_4000 (its RX interrupt is IRQ 0). Logs and exit go through semihosting, so run
+//! QEMU with `-semihosting-config enable=on,target=native`.
+
+mod systick;
+mod uart;
+
+use defmt_semihosting as _;
+
+use super::Board;
+
+/// System clock of the MPS2 FPGA images, also the SysTick and UART clock.
+pub const SYSCLK_HZ: u32 = 25_000_000;
+
+pub struct Qemu;
+
+impl Board for Qemu {
+    const NAME: &'static str = "qemu-mps2-an386";
+    type Rx = uart::Rx;
+    type Tx = uart::Tx;
+
+    fn init() -> (uart::Rx, uart::Tx) {
+        let cp = defmt::unwrap!(cortex_m::Peripherals::take());
+        systick::init(cp.SYST);
+        uart::init()
+    }
+
+    fn rx_overruns() -> u32 {
+        uart::overruns()
+    }
+
+    fn exit(failure: bool) -> ! {
+        use cortex_m_semihosting::debug::{exit, EXIT_FAILURE, EXIT_SUCCESS};
+        exit(if failure { EXIT_FAILURE } else { EXIT_SUCCESS });
+        // Without a debugger attached semihosting exit returns: reset instead.
+        cortex_m::peripheral::SCB::sys_reset()
+    }
+}
+
+/// Device interrupts: this board has no PAC, so every IRQ lands in cortex-m-rt's default
+/// handler with its number.
+#[cortex_m_rt::exception]
+unsafe fn DefaultHandler(irqn: i16) {
+    match irqn {
+        uart::RX_IRQ_NUMBER => uart::on_rx_interrupt(),
+        _ => defmt::panic!("unexpected interrupt {}", irqn),
+    }
+}

@@ -1,0 +1,160 @@
+//! Interrupt-driven driver for the CMSDK APB UART (ARM DDI0479C, and QEMU's model of it).
+//!
+//! The UART holds one received byte. Its RX interrupt moves bytes into a 1 KiB ring (an
+//! embassy-sync `Pipe`) that the receive task reads. When the ring is full the interrupt stops
+//! taking bytes (RX interrupt disabled) rather than dropping them: the byte waits in the UART and
+//! QEMU holds back the rest of the stream; the reader re-enables the interrupt once it has made
+//! room. Hardware overruns (STATE.RXOVERRUN) are counted. Transmit polls TXFULL and yields while
+//! the UART is busy.
+
+use core::convert::Infallible;
+use core::ptr::{read_volatile, write_volatile};
+use core::sync::atomic::{AtomicBool, AtomicU32, Ordering};
+
+use cortex_m::interrupt::InterruptNumber;
+use cortex_m::peripheral::NVIC;
+use embassy_futures::yield_now;
+use embassy_sync::pipe::Pipe;
+
+use super::SYSCLK_HZ;
+use crate::firmware::state::Raw;
+
+const BASE: usize = 0x4000_4000;
+const DATA: usize = 0x00;
+const STATE: usize = 0x04;
+const CTRL: usize = 0x08;
+/// INTSTATUS when read, INTCLEAR (write 1 to clear) when written.
+const INT: usize = 0x0C;
+const BAUDDIV: usize = 0x10;
+
+const STATE_TX_FULL: u32 = 1 << 0;
+const STATE_RX_FULL: u32 = 1 << 1;
+const STATE_RX_OVERRUN: u32 = 1 << 3;
+const CTRL_TX_EN: u32 = 1 << 0;
+const CTRL_RX_EN: u32 = 1 << 1;
+const CTRL_RX_INT_EN: u32 = 1 << 3;
+const INT_RX: u32 = 1 << 1;
+
+/// Baud rate: meaningless under QEMU (BAUDDIV only has to be >= 16), real on an FPGA board.
+const BAUD: u32 = 115_200;
+
+pub const RX_IRQ_NUMBER: i16 = 0;
+
+#[derive(Clone, Copy)]
+struct Irq(u16);
+
+// SAFETY: 0 is UART0's RX interrupt on mps2-an385/an386, a valid device interrupt number.
+unsafe impl InterruptNumber for Irq {
+    fn number(self) -> u16 {
+        self.0
+    }
+}
+const RX_IRQ: Irq = Irq(RX_IRQ_NUMBER as u16);
+
+static RING: Pipe<Raw, 1024> = Pipe::new();
+static STALLED: AtomicBool = AtomicBool::new(false);
+static OVERRUNS: AtomicU32 = AtomicU32::new(0);
+
+fn read(off: usize) -> u32 {
+    // SAFETY: BASE + off is one of the UART's 32-bit registers (mapped on this board).
+    unsafe { read_volatile((BASE + off) as *const u32) }
+}
+
+fn write(off: usize, v: u32) {
+    // SAFETY: as in `read`; the registers accept any 32-bit write.
+    unsafe { write_volatile((BASE + off) as *mut u32, v) }
+}
+
+pub fn init() -> (Rx, Tx) {
+    write(BAUDDIV, SYSCLK_HZ / BAUD);
+    write(CTRL, CTRL_TX_EN | CTRL_RX_EN | CTRL_RX_INT_EN);
+    // SAFETY: the handler (`on_rx_interrupt`) only touches the ring and the UART, both safe to
+    // use from interrupt context; no critical section relies on this interrupt being masked.
+    unsafe { NVIC::unmask(RX_IRQ) };
+    (Rx { _private: () }, Tx { _private: () })
+}
+
+pub fn overruns() -> u32 {
+    OVERRUNS.load(Ordering::Relaxed)
+}
+
+/// The RX interrupt: move every waiting byte into the ring.
+pub fn on_rx_interrupt() {
+    // Clear first: a byte arriving after the drain below raises the interrupt again.
+    write(INT, INT_RX);
+    loop {
+        let state = read(STATE);
+        if state & STATE_RX_OVERRUN != 0 {
+            write(STATE, STATE_RX_OVERRUN);
+            OVERRUNS.fetch_add(1, Ordering::Relaxed);
+        }
+        if state & STATE_RX_FULL == 0 {
+            break;
+        }
+        if RING.free_capacity() == 0 {
+            // Leave the byte in the UART; `Rx::read` resumes once it has made room.
+            critical_section::with(|_| write(CTRL, read(CTRL) & !CTRL_RX_INT_EN));
+            STALLED.store(true, Ordering::Release);
+            break;
+        }
+        let byte = read(DATA) as u8;
+        let _ = RING.try_write(&[byte]);
+    }
+}
+
+/// The receiving half.
+pub struct Rx {
+    _private: (),
+}
+
+/// The transmitting half.
+pub struct Tx {
+    _private: (),
+}
+
+impl embedded_io_async::ErrorType for Rx {
+    type Error = Infallible;
+}
+
+impl embedded_io_async::ErrorType for Tx {
+    type Error = Infallible;
+}
+
+impl embedded_io_async::Read for Rx {
+    async fn read(&mut self, buf: &mut [u8]) -> Result<usize, Infallible> {
+        if buf.is_empty() {
+            return Ok(0);
+        }
+        let n = RING.read(buf).await;
+        if STALLED.swap(false, Ordering::AcqRel) {
+            critical_section::with(|_| write(CTRL, read(CTRL) | CTRL_RX_INT_EN));
+            // The waiting byte raised no new interrupt: take it now.
+            NVIC::pend(RX_IRQ);
+        }
+        Ok(n)
+    }
+}
+
+impl embedded_io_async::Write for Tx {
+    async fn write(&mut self, buf: &[u8]) -> Result<usize, Infallible> {
+        let mut n = 0;
+        for &b in buf {
+            while read(STATE) & STATE_TX_FULL != 0 {
+                if n > 0 {
+                    return Ok(n);
+                }
+                yield_now().await;
+            }
+            write(DATA, u32::from(b));
+            n += 1;
+        }
+        Ok(n)
+    }
+
+    async fn flush(&mut self) -> Result<(), Infallible> {
+        while read(STATE) & STATE_TX_FULL != 0 {
+            yield_now().await;
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,61 @@
+//! The firmware: three embassy tasks around the planning core, talking the protocol of
+//! [`ohaca::protocol`] over a UART.
+//!
+//! ```text
+//!   UART rx --> [rx task] --decode--> Hello / Stats / SetParams / SetMap / Cancel: answered here
+//!                  |                  Plan: queued (JOBS, 4 deep; full -> Busy)
+//!                  v
+//!              [planner task] one Run::step() per iteration, then yield; checks for cancellation
+//!                  |
+//!   UART tx <-- [tx task] <-- OUT channel (small replies by value, Path frames pre-encoded)
+//! ```
+//!
+//! Everything board-specific (UART, time driver, log sink, exit) is behind [`board::Board`].
+
+mod board;
+mod plan;
+mod rx;
+mod state;
+mod tx;
+
+use embassy_executor::Spawner;
+use static_cell::ConstStaticCell;
+
+use board::Board;
+use ohaca::planner::Storage;
+
+/// The planner's workspace: maps of up to [`state::CELLS`] cells (zero-initialised, so it lives
+/// in `.bss`).
+static STORAGE: ConstStaticCell<Storage<{ state::CELLS }>> = ConstStaticCell::new(Storage::new());
+
+defmt::timestamp!("{=u64:us}", embassy_time::Instant::now().as_micros());
+
+/// Bring up the board and spawn the tasks.
+pub fn run(spawner: Spawner) {
+    let (rx, tx) = board::Active::init();
+    let boots = state::count_boot();
+    defmt::info!(
+        "ohaca {} on {}: boot {}, {} cells, storage {} bytes",
+        env!("CARGO_PKG_VERSION"),
+        board::Active::NAME,
+        boots,
+        state::CELLS,
+        core::mem::size_of::<Storage<{ state::CELLS }>>()
+    );
+    let storage = STORAGE.take();
+    spawner.spawn(defmt::unwrap!(tx::tx_task(tx)));
+    spawner.spawn(defmt::unwrap!(plan::planner_task(storage)));
+    spawner.spawn(defmt::unwrap!(rx::rx_task(rx)));
+}
+
+#[panic_handler]
+fn panic(info: &core::panic::PanicInfo) -> ! {
+    defmt::error!("panic: {}", defmt::Display2Format(info));
+    board::Active::exit(true)
+}
+
+#[cortex_m_rt::exception]
+unsafe fn HardFault(frame: &cortex_m_rt::ExceptionFrame) -> ! {
+    defmt::error!("hard fault at pc {=u32:#010x}", frame.pc());
+    board::Active::exit(true)
+}
