@@ -133,7 +133,7 @@ impl Colony<'_, '_, '_> {
         let mut may_tighten = false;
         *visited.get_mut(ci)? = stamp;
         while ci != goal {
-            let eta = self.heuristic.weights(cur);
+            let eta = self.heuristic.row(cur);
             let mut mask = *self.moves.get(ci)?;
             let mut cand_dir = [0u8; 8];
             let mut cand_w = [0.0f32; 8];
@@ -142,7 +142,9 @@ impl Colony<'_, '_, '_> {
             let mut seen = 0u32;
             // Visit the allowed moves only (set bits of the mask, lowest first).
             while mask != 0 {
-                let di = mask.trailing_zeros() as usize;
+                // `& 7`: the mask is non-zero, so this is the index itself, and the compiler
+                // knows it is in range for the 8-entry tables below.
+                let di = mask.trailing_zeros() as usize & 7;
                 mask &= mask - 1;
                 let ni = ci.wrapping_add_signed(*offsets.get(di)?);
                 if *visited.get(ni)? == stamp {
@@ -150,7 +152,7 @@ impl Colony<'_, '_, '_> {
                     continue;
                 }
                 let t = *tau.get((4 * ci).wrapping_add_signed(*slots.get(di)?))?;
-                let w = pow_alpha(t, self.alpha) * eta.get(di)?;
+                let w = pow_alpha(t, self.alpha) * eta.get(di);
                 *cand_dir.get_mut(n)? = di as u8;
                 *cand_w.get_mut(n)? = w;
                 total += w;

@@ -14,9 +14,9 @@
 //! 3. **`d(P, G)` is the octile distance**, the length of the shortest obstacle-free
 //!    8-connected path and so the same metric as the objective (eqs. 1-2). Its change over one
 //!    move is `ds + sqrt(2) dk` with small integers `ds` in `-2..=2` and `dk` in `-1..=1`, so
-//!    every weight the ants can need is one of 15 numbers, computed once per plan into a table
-//!    of 63 x 8 entries ([`Heuristic`]): no `powf` or `expf` in the inner loop, one load per
-//!    candidate, and bit-identical on every platform. The last form of the paper's
+//!    every weight the ants can need is one of 15 numbers (30 with the step length), computed
+//!    once per plan ([`Heuristic`]) and looked up through a compile-time class table: no `powf`
+//!    or `expf` in the inner loop, and bit-identical on every platform. The last form of the paper's
 //!    eq. (10), `xi d(P,G) n_PG / d_ij`, is a vector and is not used.
 //!
 //! Plain ACA uses `eta_ij = 1 / d_ij` alone (eq. 5): 1 for a straight step, `1/sqrt 2` for a
@@ -42,78 +42,118 @@ pub fn octile(p: Point, g: Point) -> f32 {
     s as f32 + k as f32 * SQRT_2
 }
 
-/// Keys of the weight table: see [`Heuristic::key`].
+/// Number of cell classes: see [`Heuristic::key`].
 const KEYS: usize = 3 * 3 * 7;
 
-/// The precomputed `eta^beta` table of one plan.
+/// Size of the weight table: 15 octile changes x straight/diagonal, then zeros (the last entry
+/// stands for classes that cannot occur). A power of two so lookups need no bounds check.
+const WEIGHTS: usize = 32;
+
+/// For every cell class and direction, which of the [`WEIGHTS`] applies. Computed at compile time.
 ///
 /// The change of octile distance over move `d` depends on the cell's offset `(dx, dy)` from the
 /// goal only through `sign(dx)`, `sign(dy)` and `|dx| - |dy|` clamped to `-3..=3` (one move
-/// changes `|dx| - |dy|` by at most 2, so beyond 3 its sign cannot flip). That gives 63 keys, and
-/// the table holds the 8 weights of every key: an ant computes the key once per step and then
-/// reads one `f32` per candidate.
+/// changes `|dx| - |dy|` by at most 2, so beyond 3 its sign cannot flip): 63 classes. Every class
+/// occurs for some offset in `-5..=5`.
+// Evaluated at compile time: an index out of range would fail the build, never panic at run time.
+#[allow(clippy::indexing_slicing)]
+static CLASS: [[u8; 8]; KEYS] = {
+    let mut t = [[(WEIGHTS - 1) as u8; 8]; KEYS];
+    let mut dy = -5i32;
+    while dy <= 5 {
+        let mut dx = -5i32;
+        while dx <= 5 {
+            let key = key_of(dx, dy);
+            let (s0, k0) = octile_offset(dx, dy);
+            let mut d = 0usize;
+            while d < 8 {
+                let (s1, k1) = octile_offset(dx + DX[d], dy + DY[d]);
+                // ds in -2..=2, dk in -1..=1 (see the module docs), diagonal moves after straight.
+                t[key][d] = (((s1 - s0 + 2) * 3 + (k1 - k0 + 1)) as usize + 15 * (d % 2)) as u8;
+                d += 1;
+            }
+            dx += 1;
+        }
+        dy += 1;
+    }
+    t
+};
+
+/// Class of a goal offset (see [`CLASS`]).
+const fn key_of(dx: i32, dy: i32) -> usize {
+    let sx = dx.signum() + 1;
+    let sy = dy.signum() + 1;
+    let diff = dx.abs() - dy.abs();
+    let diff = if diff < -3 {
+        -3
+    } else if diff > 3 {
+        3
+    } else {
+        diff
+    };
+    ((sx * 3 + sy) * 7 + diff + 3) as usize
+}
+
+/// The precomputed `eta^beta` of one plan: 30 numbers (a 128-byte table), indexed through the
+/// compile-time class table, so an ant computes its cell's class once per step and then reads
+/// two bytes-and-a-float per candidate.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Heuristic {
     goal: Point,
-    /// `[key][direction]`, normalised so the largest entry is 1.
-    table: [[f32; 8]; KEYS],
+    /// By octile change `(ds + 2) * 3 + (dk + 1)`, straight moves then diagonal moves, then 0;
+    /// normalised so the largest entry is 1.
+    weights: [f32; WEIGHTS],
+}
+
+/// The 8 candidate weights of one cell (see [`Heuristic::row`]).
+#[derive(Clone, Copy, Debug)]
+pub struct Row<'h> {
+    class: &'static [u8; 8],
+    weights: &'h [f32; WEIGHTS],
+}
+
+impl Row<'_> {
+    /// `eta^beta` of the move in direction `d` (taken modulo 8).
+    #[inline]
+    pub fn get(&self, d: usize) -> f32 {
+        // `& 7` and `& 31` keep both indices in range, so the compiler drops the bounds checks.
+        let c = self.class.get(d & 7).copied().unwrap_or(0);
+        self.weights
+            .get(usize::from(c) & (WEIGHTS - 1))
+            .copied()
+            .unwrap_or(0.0)
+    }
 }
 
 impl Heuristic {
-    /// The table for goal `goal`. With `attract = false` (plain ACA) only the step distance
+    /// The weights for goal `goal`. With `attract = false` (plain ACA) only the step distance
     /// counts; otherwise the goal attraction `a^(xi * change of octile distance)` multiplies it.
     /// Everything is raised to `beta`. Inputs are assumed validated (`0 < a <= 1`, finite
     /// `xi >= 0`, `0 <= beta <= 16`).
     pub fn new(goal: Point, attract: bool, a: f32, xi: f32, beta: f32) -> Self {
         let diag_step = libm::powf(SQRT_2, -beta);
-        // The 15 possible weights, by (ds, dk) of the octile decomposition.
-        let mut by_change = [[0.0f32; 3]; 5];
-        for (i, row) in by_change.iter_mut().enumerate() {
-            for (j, w) in row.iter_mut().enumerate() {
-                let change = (i as f32 - 2.0) + (j as f32 - 1.0) * SQRT_2;
-                *w = if attract {
-                    libm::powf(a, xi * beta * change)
-                } else {
-                    1.0
-                };
-            }
-        }
-        let mut table = [[0.0f32; 8]; KEYS];
-        // Every key occurs for some offset in -5..=5 (|dx| - |dy| reaches +-3 there).
-        for dy in -5i32..=5 {
-            for dx in -5i32..=5 {
-                let Some(row) = table.get_mut(Self::key_of(dx, dy)) else {
-                    continue;
-                };
-                let (s0, k0) = octile_offset(dx, dy);
-                for (d, w) in row.iter_mut().enumerate() {
-                    let (ex, ey) = (
-                        DX.get(d).copied().unwrap_or(0),
-                        DY.get(d).copied().unwrap_or(0),
-                    );
-                    let (s1, k1) = octile_offset(dx + ex, dy + ey);
-                    let att = by_change
-                        .get((s1 - s0 + 2) as usize)
-                        .and_then(|r| r.get((k1 - k0 + 1) as usize))
-                        .copied()
-                        .unwrap_or(0.0);
-                    *w = att * if d % 2 == 1 { diag_step } else { 1.0 };
-                }
-            }
+        let mut weights = [0.0f32; WEIGHTS];
+        for (i, w) in weights.iter_mut().enumerate().take(30) {
+            let change = ((i % 15) / 3) as f32 - 2.0 + ((i % 3) as f32 - 1.0) * SQRT_2;
+            let att = if attract {
+                libm::powf(a, xi * beta * change)
+            } else {
+                1.0
+            };
+            *w = att * if i >= 15 { diag_step } else { 1.0 };
         }
         // Normalise so weights never overflow when multiplied by pheromone; an infinite entry
         // (absurd parameters) becomes 1, the rest shrink accordingly (possibly to 0).
-        let max = table
+        let max = weights
             .iter()
-            .flatten()
             .filter(|w| w.is_finite())
             .fold(0.0f32, |m, &w| m.max(w));
         if max > 0.0 {
-            for w in table.iter_mut().flatten() {
+            for w in weights.iter_mut() {
                 *w = if w.is_finite() { *w / max } else { 1.0 };
             }
         }
-        Heuristic { goal, table }
+        Heuristic { goal, weights }
     }
 
     /// The goal this table attracts to.
@@ -121,43 +161,40 @@ impl Heuristic {
         self.goal
     }
 
-    fn key_of(dx: i32, dy: i32) -> usize {
-        let sx = dx.signum() + 1;
-        let sy = dy.signum() + 1;
-        let diff = (dx.abs() - dy.abs()).clamp(-3, 3) + 3;
-        ((sx * 3 + sy) * 7 + diff) as usize
-    }
-
-    /// The table key of cell `p` (its offset class relative to the goal).
+    /// The class of cell `p` (its offset class relative to the goal).
     #[inline]
     pub fn key(&self, p: Point) -> usize {
-        Self::key_of(
+        key_of(
             i32::from(p.x) - i32::from(self.goal.x),
             i32::from(p.y) - i32::from(self.goal.y),
         )
     }
 
-    /// `eta^beta` of the 8 moves from cell `p`, by direction.
+    /// `eta^beta` of the 8 moves from cell `p`.
     #[inline]
-    pub fn weights(&self, p: Point) -> &[f32; 8] {
-        const NONE: [f32; 8] = [0.0; 8];
-        self.table.get(self.key(p)).unwrap_or(&NONE)
+    pub fn row(&self, p: Point) -> Row<'_> {
+        const NONE: [u8; 8] = [(WEIGHTS - 1) as u8; 8];
+        Row {
+            class: CLASS.get(self.key(p)).unwrap_or(&NONE),
+            weights: &self.weights,
+        }
     }
 
     /// `eta^beta` for moving in direction `d` from `p`.
     #[inline]
     pub fn weight(&self, p: Point, d: Dir) -> f32 {
-        self.weights(p)
-            .get(usize::from(d & 7))
-            .copied()
-            .unwrap_or(0.0)
+        self.row(p).get(usize::from(d & 7))
     }
 }
 
-/// Octile decomposition of an offset.
-fn octile_offset(dx: i32, dy: i32) -> (i32, i32) {
+/// Octile decomposition of an offset: `(straight, diagonal)` steps.
+const fn octile_offset(dx: i32, dy: i32) -> (i32, i32) {
     let (ax, ay) = (dx.abs(), dy.abs());
-    (ax.max(ay) - ax.min(ay), ax.min(ay))
+    if ax >= ay {
+        (ax - ay, ay)
+    } else {
+        (ay - ax, ax)
+    }
 }
 
 #[cfg(test)]
@@ -233,7 +270,7 @@ mod tests {
     #[test]
     fn extreme_parameters_stay_finite() {
         let h = Heuristic::new(Point::new(3, 3), true, 1e-30, 1e6, 16.0);
-        for w in h.table.iter().flatten() {
+        for w in h.weights.iter() {
             assert!(w.is_finite() && *w >= 0.0 && *w <= 1.0);
         }
     }
