@@ -8,6 +8,7 @@ checking the firmware by hand and from scripts; the real host tool is `ohaca sen
   scripts/ohaca_client.py --port 4444 plan --map maps/complex-26.map --start 0,0 --goal 25,25
   scripts/ohaca_client.py --port 4444 stats
   scripts/ohaca_client.py --port 4444 selftest     # every request and error path, asserts
+  scripts/ohaca_client.py --port 4444 stack        # the deepest-stack requests, then Stats.stack_peak
 """
 
 import argparse
@@ -135,6 +136,7 @@ def unframe(wire):
 
 # ---- messages --------------------------------------------------------------------------------
 
+PROTOCOL_VERSION = 2
 ALGORITHMS = ["aca", "paca", "haca", "ohaca"]
 DEAD_ENDS = ["backtrack", "die"]
 SMOOTHING = ["none", "greedy", "shortest"]
@@ -237,6 +239,7 @@ def dec_reply(body):
         for k in STATS_FIELDS:
             out[k] = r.varint()
         out["planning"] = r.byte() != 0
+        out["stack_peak"] = r.varint()
     else:
         raise ValueError(f"unknown reply {tag}")
     if not r.done():
@@ -364,7 +367,7 @@ def expect(reply, kind, code=None):
 def selftest(dev, map_path):
     w, h, bits, rows = load_map(map_path)
     hello = expect(dev.call(req_hello()), "Hello")
-    assert hello["protocol_version"] == 1, hello
+    assert hello["protocol_version"] == PROTOCOL_VERSION, hello
     defaults = hello["defaults"]
     print("hello:", hello["board"], hello["firmware_version"], hello["capacity"])
 
@@ -448,8 +451,81 @@ def selftest(dev, map_path):
 
     st = expect(dev.call(req_stats()), "Stats")
     assert st["frames_bad"] >= 3 and st["busy"] >= 1 and st["cancelled"] >= queue + 2, st
+    assert 0 < st["stack_peak"] < 64 * 1024, st
     print("stats:", {k: v for k, v in st.items() if k != "kind"})
     print("selftest passed")
+
+
+# ---- stack high-water mark -------------------------------------------------------------------
+
+
+def synthetic_maps():
+    """Maps for the worst cases: (name, rows, start, goal)."""
+    open32 = ["." * 32] * 32
+    # Corridors on the even rows, joined by one gap a wall row, alternately at the right and the
+    # left end: a path through every free row, about 530 cells.
+    snake = []
+    for y in range(32):
+        if y % 2 == 0 and y < 31:
+            snake.append("." * 32)
+        else:
+            gap = 31 if (y // 2) % 2 == 0 else 0
+            snake.append("".join("." if x == gap and y < 31 else "@" for x in range(32)))
+    return [
+        ("open-32x32", open32, (0, 0), (31, 31)),
+        ("snake-32x32", snake, (0, 0), (0, 30)),
+        ("row-1024x1", ["." * 1024], (0, 0), (1023, 0)),
+    ]
+
+
+def rows_to_bits(rows):
+    h, w = len(rows), len(rows[0])
+    bits = bytearray((w * h + 7) // 8)
+    for y, row in enumerate(rows):
+        for x, c in enumerate(row):
+            if c not in ".GS":
+                k = y * w + x
+                bits[k // 8] |= 1 << (k % 8)
+    return w, h, bytes(bits)
+
+
+def stack_cases(defaults):
+    """Parameter sets that exercise every code path of a plan: each algorithm, each smoothing,
+    dead ends that kill ants, full runs without early stop."""
+    d = dict(defaults)
+    return [
+        ("ohaca shortest", dict(d)),
+        ("ohaca greedy", dict(d, smoothing=SMOOTHING.index("greedy"))),
+        ("ohaca none", dict(d, smoothing=SMOOTHING.index("none"), tighten=False)),
+        ("aca full run", dict(d, algorithm=ALGORITHMS.index("aca"), patience=0)),
+        ("paca", dict(d, algorithm=ALGORITHMS.index("paca"))),
+        ("haca", dict(d, algorithm=ALGORITHMS.index("haca"))),
+        ("aca die", dict(d, algorithm=ALGORITHMS.index("aca"), dead_end=DEAD_ENDS.index("die"))),
+    ]
+
+
+def stack_probe(dev, map_path):
+    """Run the requests that go deepest into the stack; return Stats.stack_peak."""
+    hello = expect(dev.call(req_hello()), "Hello")
+    defaults = hello["defaults"]
+    w, h, bits, _ = load_map(map_path)
+    maps = [(map_path, w, h, bits, (0, 0), (w - 1, h - 1))]
+    for name, rows, start, goal in synthetic_maps():
+        maps.append((name, *rows_to_bits(rows), start, goal))
+    for name, w, h, bits, start, goal in maps:
+        if w * h > hello["capacity"]["cells"]:
+            continue
+        expect(dev.set_map(w, h, bits), "Ack")
+        for label, params in stack_cases(defaults):
+            expect(dev.call(req_set_params(params)), "Ack")
+            r = dev.call(req_plan(start, goal))
+            st = expect(dev.call(req_stats()), "Stats")
+            what = (f"{r['raw_cells']} cells, {len(r['waypoints'])} waypoints, "
+                    f"{r['iterations']} iterations" if r["kind"] == "Path" else r.get("name"))
+            print(f"  {name:<22} {label:<16} {what:<45} stack peak {st['stack_peak']}")
+    expect(dev.call(req_set_params(defaults)), "Ack")
+    st = expect(dev.call(req_stats()), "Stats")
+    return st["stack_peak"]
 
 
 def main():
@@ -468,6 +544,8 @@ def main():
     pl.add_argument("--repeat", type=int, default=1, help="plan this many times (seeds seed..)")
     st = sub.add_parser("selftest")
     st.add_argument("--map", default="maps/complex-26.map")
+    sp = sub.add_parser("stack", help="run the deepest-stack requests, print Stats.stack_peak")
+    sp.add_argument("--map", default="maps/complex-26.map")
     args = ap.parse_args()
 
     dev = Device(args.host, args.port)
@@ -491,6 +569,8 @@ def main():
                 return 1
     elif args.cmd == "selftest":
         selftest(dev, args.map)
+    elif args.cmd == "stack":
+        print(f"stack_peak {stack_probe(dev, args.map)}")
     return 0
 
 

@@ -15,6 +15,14 @@
 //! | [`planning`] | one planning run on a loaded map, timed, as a [`output::PlanReport`] |
 //! | [`output`] | the JSON report (a stable contract) and the ASCII renderer |
 //! | [`exit`] | the tool's exit codes |
+//! | [`input`] | the map flags of `plan`/`render`/`experiment`: any map format, prepared, start/goal in cells or metres |
+//! | [`rosmap`] | ROS `map_server` maps (YAML + PGM/PNG) and plain images as maps |
+//! | [`frame`] | a map's metric frame: cell <-> metres (ROS map frame) |
+//! | [`gridops`] | obstacle inflation and resampling to coarser cells |
+//! | [`trace`] | a planning run that keeps its convergence curve and final pheromone |
+//! | [`draw`] | pictures: the map with paths (and pheromone), the convergence chart; SVG or PNG |
+//! | [`experiment`] | the paper's experiments: many seeds per algorithm, CSV, summary, pictures |
+//! | [`link`] | the firmware link: a blocking protocol client over TCP or a serial port |
 //!
 //! ## Panic freedom
 //! Like the core, nothing reachable from a file, a command line or a parameter set panics:
@@ -41,11 +49,19 @@
 )]
 
 pub mod args;
+pub mod draw;
 pub mod exit;
+pub mod experiment;
+pub mod frame;
+pub mod gridops;
+pub mod input;
+pub mod link;
 pub mod map;
 pub mod output;
 pub mod planning;
+pub mod rosmap;
 pub mod storage;
+pub mod trace;
 
 pub use args::{parse_point, ParamArgs};
 pub use map::{Map, MapError};

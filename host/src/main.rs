@@ -34,6 +34,8 @@ struct Cli {
 enum Command {
     /// Plan a path on a map file and print it (ASCII picture, or JSON with --json)
     Plan(cmd::plan::Args),
+    /// Plan on the firmware over TCP (QEMU) or a serial port; prints what `plan` prints
+    Send(cmd::send::Args),
 }
 
 fn main() -> ExitCode {
@@ -43,6 +45,7 @@ fn main() -> ExitCode {
     };
     let code = match cli.command {
         Command::Plan(args) => cmd::plan::run(&args),
+        Command::Send(args) => cmd::send::run(&args),
     };
     ExitCode::from(code)
 }

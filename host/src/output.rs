@@ -20,6 +20,8 @@
 //! | `params` | object | every parameter ([`ParamsReport`]) |
 //! | `error` | string | only when `found` is false: why |
 //!
+//! | `waypoints_m` | `[[x, y], ...]` | only for maps with a resolution (ROS YAML): `waypoints` in metres, ROS map frame ([`LocatedReport`]) |
+//!
 //! `x` is the column, `y` the row from the top. Numbers that describe a path are null exactly
 //! when no path was found. The struct's fields are public and it derives `Deserialize`, so a
 //! report can be built from plain fields (a firmware reply) or read back from JSON.
@@ -223,6 +225,46 @@ impl PlanReport {
     }
 }
 
+/// A [`PlanReport`] with the waypoints in metres appended as `waypoints_m` (after every
+/// other key) when the map has a metric frame; without one it prints exactly the report.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct LocatedReport<'a> {
+    /// The report.
+    #[serde(flatten)]
+    pub report: &'a PlanReport,
+    /// Waypoints in metres, `[x, y]`, ROS map frame.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub waypoints_m: Option<&'a [[f64; 2]]>,
+}
+
+impl LocatedReport<'_> {
+    /// One line of JSON (no trailing newline).
+    pub fn to_json(&self) -> String {
+        serde_json::to_string(self).unwrap_or_else(|_| self.report.to_json())
+    }
+}
+
+/// Waypoints as CSV: a header line, then `x,y` per waypoint: cells (header `x,y`), or metres
+/// (header `x_m,y_m`) when `metres` is given.
+pub fn waypoints_csv(waypoints: &[[u16; 2]], metres: Option<&[[f64; 2]]>) -> String {
+    let mut s = String::new();
+    match metres {
+        Some(m) => {
+            s.push_str("x_m,y_m\n");
+            for [x, y] in m {
+                let _ = writeln!(s, "{x},{y}");
+            }
+        }
+        None => {
+            s.push_str("x,y\n");
+            for [x, y] in waypoints {
+                let _ = writeln!(s, "{x},{y}");
+            }
+        }
+    }
+    s
+}
+
 /// The map as characters, with the path drawn on it: `#` obstacle, `.` free, `*` raw path,
 /// `o` waypoint, `S` start, `G` goal (later marks win). Points outside the map are ignored.
 /// One line per row, cells separated by a space, each line ending in `\n`.
@@ -391,6 +433,36 @@ mod tests {
         assert!(j.contains("\"raw\":[[0,0],[1,1],[2,1]]"), "{j}");
         assert!(j.contains("\"raw_length\":2.4142137"), "{j}");
         assert_eq!(serde_json::from_str::<PlanReport>(&j).unwrap(), report());
+    }
+
+    #[test]
+    fn located_report_appends_metres() {
+        let r = report();
+        let plain = LocatedReport {
+            report: &r,
+            waypoints_m: None,
+        };
+        assert_eq!(plain.to_json(), r.to_json());
+        let m = [[0.025, 1.5], [-2.0, 0.0]];
+        let j = LocatedReport {
+            report: &r,
+            waypoints_m: Some(&m),
+        }
+        .to_json();
+        assert!(j.starts_with(&r.to_json()[..r.to_json().len() - 1]), "{j}");
+        assert!(j.ends_with(",\"waypoints_m\":[[0.025,1.5],[-2.0,0.0]]}"), "{j}");
+        let back: PlanReport = serde_json::from_str(&j).unwrap();
+        assert_eq!(back, r);
+    }
+
+    #[test]
+    fn csv_waypoints() {
+        assert_eq!(waypoints_csv(&[[0, 0], [2, 1]], None), "x,y\n0,0\n2,1\n");
+        assert_eq!(
+            waypoints_csv(&[[0, 0]], Some(&[[0.5, -1.25]])),
+            "x_m,y_m\n0.5,-1.25\n"
+        );
+        assert_eq!(waypoints_csv(&[], None), "x,y\n");
     }
 
     #[test]

@@ -6,8 +6,9 @@
 //!                  |                  Plan: queued (JOBS, 4 deep; full -> Busy)
 //!                  v
 //!              [planner task] one Run::step() per iteration, then yield; checks for cancellation
-//!                  |
-//!   UART tx <-- [tx task] <-- OUT channel (small replies by value, Path frames pre-encoded)
+//!                  |            path frames: streamed into the UART a piece at a time --+
+//!                  v                                                                     |
+//!   UART tx <-- [tx task] <-- OUT channel (small replies by value)  <--------------------+
 //! ```
 //!
 //! Everything board-specific (UART, time driver, log sink, exit) is behind [`board::Board`].
@@ -15,11 +16,13 @@
 mod board;
 mod plan;
 mod rx;
+mod stack;
 mod state;
 mod tx;
 
 use embassy_executor::Spawner;
-use static_cell::ConstStaticCell;
+use embassy_sync::mutex::Mutex;
+use static_cell::{ConstStaticCell, StaticCell};
 
 use board::Board;
 use ohaca::planner::Storage;
@@ -27,6 +30,9 @@ use ohaca::planner::Storage;
 /// The planner's workspace: maps of up to [`state::CELLS`] cells (zero-initialised, so it lives
 /// in `.bss`).
 static STORAGE: ConstStaticCell<Storage<{ state::CELLS }>> = ConstStaticCell::new(Storage::new());
+
+/// The UART's transmitting half, shared by the transmitter and the planner.
+static TX: StaticCell<state::TxPort> = StaticCell::new();
 
 defmt::timestamp!("{=u64:us}", embassy_time::Instant::now().as_micros());
 
@@ -42,9 +48,11 @@ pub fn run(spawner: Spawner) {
         state::CELLS,
         core::mem::size_of::<Storage<{ state::CELLS }>>()
     );
+    defmt::info!("stack: {} bytes, {} used", stack::size(), stack::peak());
     let storage = STORAGE.take();
-    spawner.spawn(defmt::unwrap!(tx::tx_task(tx)));
-    spawner.spawn(defmt::unwrap!(plan::planner_task(storage)));
+    let port = TX.init(Mutex::new(tx));
+    spawner.spawn(defmt::unwrap!(tx::tx_task(port)));
+    spawner.spawn(defmt::unwrap!(plan::planner_task(storage, port)));
     spawner.spawn(defmt::unwrap!(rx::rx_task(rx)));
 }
 

@@ -1,23 +1,31 @@
 //! The planning task: takes plan requests from the queue and runs them one iteration at a time,
 //! yielding to the executor after every iteration so frames keep arriving and `Cancel` works.
+//! A path is streamed into the UART as it is encoded ([`PathStream`]), a piece at a time: no
+//! buffer for a whole frame (up to 5 KiB).
 
 use core::sync::atomic::Ordering;
 
 use embassy_futures::yield_now;
 use embassy_time::Instant;
+use embedded_io_async::Write;
 
 use ohaca::grid::Grid;
 use ohaca::planner::{Run, Storage};
-use ohaca::protocol::{encode_reply, ErrorCode, ErrorReply, PathReply, Reply, Waypoints};
+use ohaca::protocol::{ErrorCode, ErrorReply, PathReply, PathStream, Reply, Waypoints};
 
-use super::state::{self, count, Job, Out, CELLS, JOBS, MAP, OUT, PATH_FRAME, PLANNING};
+use super::stack;
+use super::state::{self, count, Job, TxPort, CELLS, JOBS, MAP, PLANNING};
+use super::tx::sent_one;
+
+/// Bytes of a path frame encoded per write to the UART.
+const PIECE: usize = 64;
 
 #[embassy_executor::task]
-pub async fn planner_task(storage: &'static mut Storage<CELLS>) {
+pub async fn planner_task(storage: &'static mut Storage<CELLS>, port: &'static TxPort) {
     loop {
         let job = JOBS.receive().await;
         PLANNING.store(true, Ordering::Relaxed);
-        let result = plan(storage, &job).await;
+        let result = plan(storage, &job, port).await;
         PLANNING.store(false, Ordering::Relaxed);
         match result {
             Ok(ticks) => count(|s| {
@@ -34,11 +42,16 @@ pub async fn planner_task(storage: &'static mut Storage<CELLS>) {
                 state::reply(job.id, Reply::Error(e)).await;
             }
         }
+        defmt::info!("stack peak {} of {} bytes", stack::peak(), stack::size());
     }
 }
 
 /// Run one job and send its path; returns the ticks it took.
-async fn plan(storage: &mut Storage<CELLS>, job: &Job) -> Result<u64, ErrorReply> {
+async fn plan(
+    storage: &mut Storage<CELLS>,
+    job: &Job,
+    port: &'static TxPort,
+) -> Result<u64, ErrorReply> {
     let cancelled = || ErrorReply::new(ErrorCode::Cancelled);
     if state::cancelled(job.generation) {
         return Err(cancelled());
@@ -50,8 +63,13 @@ async fn plan(storage: &mut Storage<CELLS>, job: &Job) -> Result<u64, ErrorReply
     let grid = Grid::new(map.width, map.height, &map.bits)?;
     let t0 = Instant::now();
     let mut run = Run::new(&grid, job.start, job.goal, &job.params, storage.workspace())?;
+    let t_new = Instant::now();
+    // Ticks spent inside `Run::step`, without the yields between iterations.
+    let mut in_steps = 0u64;
     loop {
+        let t = Instant::now();
         let more = run.step();
+        in_steps += t.elapsed().as_ticks();
         yield_now().await;
         if state::cancelled(job.generation) {
             defmt::info!(
@@ -65,17 +83,22 @@ async fn plan(storage: &mut Storage<CELLS>, job: &Job) -> Result<u64, ErrorReply
             break;
         }
     }
+    let t_finish = Instant::now();
     let plan = run.finish()?;
-    let ticks = t0.elapsed().as_ticks();
+    let t_end = Instant::now();
+    let ticks = (t_end - t0).as_ticks();
     defmt::info!(
-        "plan {}: {} iterations, length {}, {} waypoints, {} ticks",
+        "plan {}: {} iterations, length {}, {} waypoints, {} ticks (new {}, steps {}, finish {})",
         job.id,
         plan.iterations,
         plan.length,
         plan.waypoints().len(),
-        ticks
+        ticks,
+        (t_new - t0).as_ticks(),
+        in_steps,
+        (t_end - t_finish).as_ticks()
     );
-    let reply = Reply::Path(PathReply {
+    let reply = PathReply {
         raw_length: plan.raw_length,
         length: plan.length,
         turns: plan.turns,
@@ -86,22 +109,28 @@ async fn plan(storage: &mut Storage<CELLS>, job: &Job) -> Result<u64, ErrorReply
         raw_cells: u32::try_from(plan.raw_len()).unwrap_or(u32::MAX),
         waypoints: Waypoints::Points(plan.waypoints()),
         directions: plan.directions(),
-    });
-    // Waits until the transmitter has sent the previous path.
-    let mut frame = PATH_FRAME.lock().await;
-    match encode_reply(job.id, &reply, &mut frame.buf) {
-        Ok(n) => {
-            frame.len = n;
-            OUT.send(Out::Frame(frame)).await;
-            Ok(ticks)
-        }
-        Err(e) => {
-            defmt::error!("path reply: {}", defmt::Display2Format(&e));
-            Err(ErrorReply::with(
-                ErrorCode::Internal,
-                plan.waypoints().len() as u32,
-                plan.directions().len() as u32,
-            ))
+    };
+    let mut stream = PathStream::new(job.id, &reply).map_err(|e| {
+        defmt::error!("path reply: {}", defmt::Display2Format(&e));
+        ErrorReply::with(
+            ErrorCode::Internal,
+            plan.waypoints().len() as u32,
+            plan.directions().len() as u32,
+        )
+    })?;
+    // The frame goes out while the plan's buffers (in `storage`) are still borrowed, so the next
+    // plan starts once it is sent.
+    let mut piece = [0u8; PIECE];
+    let mut tx = port.lock().await;
+    let mut sent = true;
+    while !stream.is_done() {
+        let n = stream.fill(&mut piece);
+        if tx.write_all(piece.get(..n).unwrap_or(&[])).await.is_err() {
+            sent = false; // the host drops the cut frame at the next delimiter
+            break;
         }
     }
+    drop(tx);
+    sent_one(sent);
+    Ok(ticks)
 }

@@ -7,13 +7,14 @@ use core::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::blocking_mutex::Mutex as BlockingMutex;
 use embassy_sync::channel::Channel;
-use embassy_sync::mutex::{Mutex, MutexGuard};
+use embassy_sync::mutex::Mutex;
 
 use ohaca::grid::Point;
 use ohaca::planner::Params;
-use ohaca::protocol::{Reply, StatsReply, MAX_REPLY_WIRE};
+use ohaca::protocol::{Reply, StatsReply};
 
 use super::board::{self, Board};
+use super::stack;
 
 /// Largest map, in cells (32 x 32).
 pub const CELLS: usize = 1024;
@@ -46,20 +47,13 @@ pub struct ActiveMap {
     pub bits: [u8; MAP_BYTES],
 }
 
-/// An encoded reply frame too large to pass by value (a path).
-pub struct Frame {
-    pub buf: [u8; MAX_REPLY_WIRE],
-    pub len: usize,
-}
+/// A small reply (every reply but a path) for the transmitter: the request id and the reply.
+pub struct Out(pub u32, pub Reply<'static>);
 
-/// What the transmitter sends.
-pub enum Out {
-    /// A small reply, encoded by the transmitter.
-    Reply(u32, Reply<'static>),
-    /// A frame encoded by the planner into [`PATH_FRAME`]; the lock is released once it is sent,
-    /// so the next path waits for this one.
-    Frame(MutexGuard<'static, Raw, Frame>),
-}
+/// The UART's transmitting half, shared by the transmitter (small replies) and the planner (which
+/// streams each path straight into it, a piece at a time): whoever holds the lock sends one whole
+/// frame, so frames never interleave.
+pub type TxPort = Mutex<Raw, board::Tx>;
 
 pub static MAP: BlockingMutex<Raw, Cell<Option<ActiveMap>>> = BlockingMutex::new(Cell::new(None));
 /// Bumped by `Cancel` and by every new map: plans received under an older value are cancelled.
@@ -67,10 +61,6 @@ pub static GENERATION: AtomicU32 = AtomicU32::new(0);
 pub static PLANNING: AtomicBool = AtomicBool::new(false);
 pub static JOBS: Channel<Raw, Job, PLAN_QUEUE> = Channel::new();
 pub static OUT: Channel<Raw, Out, OUT_QUEUE> = Channel::new();
-pub static PATH_FRAME: Mutex<Raw, Frame> = Mutex::new(Frame {
-    buf: [0; MAX_REPLY_WIRE],
-    len: 0,
-});
 static STATS: BlockingMutex<Raw, Cell<StatsReply>> = BlockingMutex::new(Cell::new(StatsReply {
     uptime: 0,
     boots: 0,
@@ -88,6 +78,7 @@ static STATS: BlockingMutex<Raw, Cell<StatsReply>> = BlockingMutex::new(Cell::ne
     map_height: 0,
     queued: 0,
     planning: false,
+    stack_peak: 0,
 }));
 
 /// Update the counters.
@@ -109,6 +100,7 @@ pub fn stats() -> StatsReply {
     }
     s.queued = u8::try_from(JOBS.len()).unwrap_or(u8::MAX);
     s.planning = PLANNING.load(Ordering::Relaxed);
+    s.stack_peak = stack::peak();
     s
 }
 
@@ -124,7 +116,7 @@ pub fn cancel_all() {
 
 /// Send a small reply (waits while the transmitter is behind).
 pub async fn reply(id: u32, r: Reply<'static>) {
-    OUT.send(Out::Reply(id, r)).await;
+    OUT.send(Out(id, r)).await;
 }
 
 /// Boot counter in RAM that survives a reset but not a power cycle (`.uninit` is not zeroed by

@@ -6,14 +6,19 @@
 /// CRC-32/ISO-HDLC (the zlib / Ethernet CRC: reflected polynomial `0xEDB88320`, initial value and
 /// final xor `0xFFFF_FFFF`). Bitwise, table-less: a few hundred bytes of code, ~8 shifts a byte.
 pub fn crc32(data: &[u8]) -> u32 {
-    let mut crc = !0u32;
-    for &b in data {
-        crc ^= u32::from(b);
-        for _ in 0..8 {
-            crc = (crc >> 1) ^ (0xEDB8_8320 & 0u32.wrapping_sub(crc & 1));
-        }
+    !data.iter().fold(CRC32_INIT, |crc, &b| crc32_step(crc, b))
+}
+
+/// The CRC register before the first byte (the result is `!register` after the last one).
+pub(crate) const CRC32_INIT: u32 = !0;
+
+/// Feed one byte into the CRC register: [`crc32`] a byte at a time, for streamed frames.
+pub(crate) fn crc32_step(mut crc: u32, b: u8) -> u32 {
+    crc ^= u32::from(b);
+    for _ in 0..8 {
+        crc = (crc >> 1) ^ (0xEDB8_8320 & 0u32.wrapping_sub(crc & 1));
     }
-    !crc
+    crc
 }
 
 /// Most bytes COBS adds to `len` payload bytes (one code byte, plus one per 254 bytes).
@@ -76,8 +81,12 @@ pub(crate) fn cobs_decode_in_place(buf: &mut [u8]) -> Option<usize> {
         if end > n || buf.get(r..end)?.contains(&0) {
             return None;
         }
-        // `w <= r` always (each block loses its code byte), so this only moves bytes left.
-        buf.copy_within(r..end, w);
+        // `w <= r` always (each block loses its code byte), so this only moves bytes left. Byte
+        // by byte rather than `copy_within`, which keeps a panic path the compiler cannot drop.
+        for i in r..end {
+            let b = *buf.get(i)?;
+            *buf.get_mut(w + (i - r))? = b;
+        }
         w += run;
         r = end;
         if code != 0xFF && r < n {

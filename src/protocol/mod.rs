@@ -36,15 +36,17 @@ use crate::grid::Point;
 use crate::planner::Params;
 
 mod frame;
+mod stream;
 mod wire;
 
 pub use frame::{cobs_overhead, crc32, wire_len, Feed, FrameReader};
+pub use stream::PathStream;
 use wire::{ParamsDef, PointDef};
 pub use wire::{Waypoints, WAYPOINT_BYTES};
 
 /// Protocol version, reported in [`HelloReply::protocol_version`]. Bumped on any change to the
-/// bytes of an existing message.
-pub const VERSION: u16 = 1;
+/// bytes of an existing message (2: [`StatsReply::stack_peak`]).
+pub const VERSION: u16 = 2;
 
 /// The id of replies to frames whose request id could not be read. Hosts should not use it.
 pub const UNKNOWN_ID: u32 = 0;
@@ -62,7 +64,8 @@ pub const MAX_DIRECTIONS: usize = 1024;
 pub const MAX_REQUEST: usize = 256;
 
 /// Largest reply payload (postcard bytes plus CRC) a host must accept: a [`PathReply`] with
-/// [`MAX_WAYPOINTS`] waypoints and [`MAX_DIRECTIONS`] directions fits.
+/// [`MAX_WAYPOINTS`] waypoints and [`MAX_DIRECTIONS`] directions fits. (A device need not hold
+/// one: [`PathStream`] encodes a path frame piece by piece.)
 pub const MAX_REPLY: usize = 5248;
 
 /// Largest request frame on the wire, delimiter included.
@@ -447,6 +450,9 @@ pub struct StatsReply {
     pub queued: u8,
     /// True while a plan runs.
     pub planning: bool,
+    /// Most stack the device has used since boot, in bytes (its high-water mark, interrupts
+    /// included; 0 if the device does not measure it).
+    pub stack_peak: u32,
 }
 
 /// Why a message could not be encoded.
@@ -581,9 +587,11 @@ fn encode<T: Serialize>(id: u32, msg: &T, out: &mut [u8]) -> Result<usize, Encod
         return Err(EncodeError::Serialize);
     }
     let crc = crc32(out.get(src..src + body).ok_or(too_small)?);
-    out.get_mut(src + body..src + payload)
-        .ok_or(too_small)?
-        .copy_from_slice(&crc.to_le_bytes());
+    let crc_slot = out.get_mut(src + body..src + payload).ok_or(too_small)?;
+    // Byte by byte rather than `copy_from_slice`, which keeps a panic path for unequal lengths.
+    for (d, b) in crc_slot.iter_mut().zip(crc.to_le_bytes()) {
+        *d = b;
+    }
     let n = frame::cobs_encode_in_place(out, src, payload).ok_or(too_small)?;
     *out.get_mut(n).ok_or(too_small)? = 0;
     Ok(n + 1)

@@ -167,6 +167,7 @@ fn replies() -> Vec<Reply<'static>> {
             frames_ok: u32::MAX,
             planning: true,
             queued: 4,
+            stack_peak: u32::MAX,
             ..StatsReply::default()
         }),
     ];
@@ -319,6 +320,85 @@ fn largest_messages_fit_their_limits() {
         }
     }
     assert_eq!(got.unwrap().unwrap(), (u32::MAX, format!("{r:?}")));
+}
+
+/// The frame [`PathStream`] produces, read `piece` bytes at a time.
+fn streamed(id: u32, p: &PathReply<'_>, piece: usize) -> Vec<u8> {
+    let mut s = PathStream::new(id, p).unwrap();
+    let mut out = vec![];
+    let mut buf = vec![0u8; piece];
+    while !s.is_done() {
+        let n = s.fill(&mut buf);
+        assert!(n == piece || s.is_done(), "a short piece before the end");
+        out.extend_from_slice(&buf[..n]);
+    }
+    assert_eq!(s.fill(&mut buf), 0);
+    assert!(s.is_done());
+    out
+}
+
+#[test]
+fn path_stream_is_byte_exact() {
+    let mut rng = Lcg(7);
+    // Lengths around COBS's 254-byte blocks, bytes with and without zeros, every id size.
+    let mut cases: Vec<(Vec<Point>, Vec<u8>)> = vec![
+        (vec![], vec![]),
+        (WPTS.to_vec(), DIRS.to_vec()),
+        (
+            vec![Point::new(u16::MAX, u16::MAX); MAX_WAYPOINTS],
+            vec![7; MAX_DIRECTIONS],
+        ),
+        (
+            vec![Point::new(0, 0); MAX_WAYPOINTS],
+            vec![0; MAX_DIRECTIONS],
+        ),
+    ];
+    for n in [
+        1usize, 60, 61, 62, 63, 64, 200, 250, 251, 252, 253, 254, 255, 256, 508, 509, 1000,
+    ] {
+        let pts = (0..n / 4 + 1)
+            .map(|_| Point::new(rng.next() as u16 % 300 + 1, rng.next() as u16 % 300 + 1))
+            .collect();
+        let dirs = (0..n).map(|_| rng.byte() % 8).collect();
+        cases.push((pts, dirs));
+        let dirs_nonzero = (0..n).map(|_| rng.byte() % 7 + 1).collect();
+        cases.push((vec![Point::new(257, 513)], dirs_nonzero));
+    }
+    for (i, (pts, dirs)) in cases.iter().enumerate() {
+        for id in [0, 1, 300, u32::MAX] {
+            let p = PathReply {
+                ticks: u64::from(rng.next()) << (i % 32),
+                moves: if i % 2 == 0 { 0 } else { u64::MAX },
+                raw_length: if i % 3 == 0 { 0.0 } else { 41.799 },
+                waypoints: Waypoints::Points(pts),
+                directions: dirs,
+                ..path()
+            };
+            let want = enc_rep(id, &Reply::Path(p));
+            for piece in [1, 2, 7, 64, 255, 256, 6000] {
+                assert_eq!(
+                    streamed(id, &p, piece),
+                    want,
+                    "case {i} id {id} piece {piece}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn path_stream_refuses_what_encode_reply_refuses() {
+    let wp = vec![Point::new(u16::MAX, u16::MAX); MAX_WAYPOINTS + 40];
+    let dirs = vec![7u8; MAX_DIRECTIONS];
+    let p = PathReply {
+        waypoints: Waypoints::Points(&wp),
+        directions: &dirs,
+        ..path()
+    };
+    let mut buf = vec![0u8; MAX_REPLY_WIRE];
+    let whole = encode_reply(1, &Reply::Path(p), &mut buf);
+    assert!(matches!(whole, Err(EncodeError::BufferTooSmall { .. })));
+    assert_eq!(PathStream::new(1, &p).err(), whole.err());
 }
 
 #[test]
@@ -627,7 +707,7 @@ const EXAMPLE_WAYPOINTS: [Point; 4] = [
 ];
 const EXAMPLE_DIRECTIONS: [u8; 4] = [0, 0, 1, 2];
 /// Ticks (µs of virtual time) the QEMU firmware reported for the example plan.
-const EXAMPLE_TICKS: u64 = 1689;
+const EXAMPLE_TICKS: u64 = 1649;
 
 fn example_path() -> PathReply<'static> {
     PathReply {
@@ -644,7 +724,30 @@ fn example_path() -> PathReply<'static> {
     }
 }
 
-/// The exchange of the document: Hello, SetMap (the 4x3 map of the crate docs), Plan.
+/// What the QEMU firmware answered to `Stats` after the example's first three requests.
+fn example_stats() -> StatsReply {
+    StatsReply {
+        uptime: 22_327,
+        boots: 1,
+        frames_ok: 4,
+        frames_bad: 0,
+        rx_overruns: 0,
+        rx_bytes: 45,
+        tx_frames: 3,
+        plans: 1,
+        plan_errors: 0,
+        cancelled: 0,
+        busy: 0,
+        last_plan_ticks: EXAMPLE_TICKS,
+        map_width: 4,
+        map_height: 3,
+        queued: 0,
+        planning: false,
+        stack_peak: 1556,
+    }
+}
+
+/// The exchange of the document: Hello, SetMap (the 4x3 map of the crate docs), Plan, Stats.
 fn example() -> Vec<(u32, Request<'static>, Reply<'static>)> {
     vec![
         (1, Request::Hello, Reply::Hello(hello())),
@@ -668,6 +771,7 @@ fn example() -> Vec<(u32, Request<'static>, Reply<'static>)> {
             },
             Reply::Path(example_path()),
         ),
+        (4, Request::Stats, Reply::Stats(example_stats())),
     ]
 }
 
@@ -720,7 +824,7 @@ fn protocol_doc_example_is_exact() {
             n += 1;
         }
     }
-    assert_eq!(n, 3);
+    assert_eq!(n, example().len());
 }
 
 #[test]
@@ -834,6 +938,7 @@ fn request_fields(id: u32, r: &Request<'_>) -> Vec<(String, Vec<u8>)> {
             ));
             v.push((format!("  seed = {seed:?}"), ser(&seed)));
         }
+        Request::Stats => v.push(("Request::Stats (variant 5)".into(), vec![5])),
         _ => panic!("not used by the example"),
     }
     v
@@ -920,6 +1025,43 @@ fn reply_fields(id: u32, r: &Reply<'_>) -> Vec<(String, Vec<u8>)> {
                 format!("  directions: {:?} (E E SE S)", p.directions),
                 ser(p.directions),
             ));
+        }
+        Reply::Stats(s) => {
+            v.push(("Reply::Stats (variant 4)".into(), vec![4]));
+            let fields: [(&str, Vec<u8>, String); 17] = [
+                ("uptime", ser(&s.uptime), s.uptime.to_string()),
+                ("boots", ser(&s.boots), s.boots.to_string()),
+                ("frames_ok", ser(&s.frames_ok), s.frames_ok.to_string()),
+                ("frames_bad", ser(&s.frames_bad), s.frames_bad.to_string()),
+                (
+                    "rx_overruns",
+                    ser(&s.rx_overruns),
+                    s.rx_overruns.to_string(),
+                ),
+                ("rx_bytes", ser(&s.rx_bytes), s.rx_bytes.to_string()),
+                ("tx_frames", ser(&s.tx_frames), s.tx_frames.to_string()),
+                ("plans", ser(&s.plans), s.plans.to_string()),
+                (
+                    "plan_errors",
+                    ser(&s.plan_errors),
+                    s.plan_errors.to_string(),
+                ),
+                ("cancelled", ser(&s.cancelled), s.cancelled.to_string()),
+                ("busy", ser(&s.busy), s.busy.to_string()),
+                (
+                    "last_plan_ticks",
+                    ser(&s.last_plan_ticks),
+                    s.last_plan_ticks.to_string(),
+                ),
+                ("map_width", ser(&s.map_width), s.map_width.to_string()),
+                ("map_height", ser(&s.map_height), s.map_height.to_string()),
+                ("queued", ser(&s.queued), s.queued.to_string()),
+                ("planning", ser(&s.planning), s.planning.to_string()),
+                ("stack_peak", ser(&s.stack_peak), s.stack_peak.to_string()),
+            ];
+            for (name, b, val) in fields {
+                v.push((format!("  {name} = {val}"), b));
+            }
         }
         _ => panic!("not used by the example"),
     }

@@ -1,6 +1,7 @@
 //! The subcommands, one module each, plus the output helpers they share.
 
 pub mod plan;
+pub mod send;
 
 use std::io::Write;
 

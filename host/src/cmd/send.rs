@@ -1,0 +1,453 @@
+//! `ohaca send`: plan on the firmware. Connects to a device (`--tcp HOST:PORT`, e.g. QEMU's
+//! UART, or `--serial DEVICE`), says Hello, sends the parameters and the map, plans, and prints
+//! the result exactly as `ohaca plan` does: the picture, or with `--json` the same JSON keys
+//! plus `ticks` (device time, in the device's `tick_hz` units) and `device` (its board name).
+//! `elapsed_us` is the round trip of the plan request as the host saw it.
+//!
+//! `--goals FILE` plans many requests over one connection, pipelined, and prints one JSON line
+//! per request, in file order. Each line of the file is `SX,SY GX,GY` (start and goal) or
+//! `GX,GY` (a goal from `--start`); `#` starts a comment, blank lines are skipped.
+//!
+//! Exit codes as `ohaca plan`: 0 path found (every path, with `--goals`); 1 no path (some
+//! request, with `--goals`); 2 bad input (map, parameters, start/goal, goals file, a map larger
+//! than the device holds), a device error, a timeout or a lost connection, with one `error:`
+//! line on stderr.
+
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use ohaca::protocol::{ErrorCode, ErrorReply};
+use ohaca::{Error, Params, Point};
+use ohaca_host::link::{
+    core_error, DeviceInfo, DevicePath, Link, LinkError, PlanJob, Transport, DEFAULT_BAUD,
+};
+use ohaca_host::output::{format_us, micros, render, xy, ParamsReport, PlanReport};
+use ohaca_host::{exit, parse_point, Map, ParamArgs};
+use serde::Serialize;
+
+use super::{bad_input, print};
+
+/// Arguments of `ohaca send`.
+#[derive(clap::Args, Debug)]
+#[command(group(clap::ArgGroup::new("device").required(true).args(["tcp", "serial"])))]
+pub struct Args {
+    /// Device on a TCP port, e.g. QEMU's UART (scripts/qemu-serve.sh): HOST:PORT
+    #[arg(long, value_name = "HOST:PORT")]
+    pub tcp: Option<String>,
+    /// Device on a serial port, e.g. /dev/ttyUSB0 (8N1, no flow control)
+    #[arg(long, value_name = "DEVICE")]
+    pub serial: Option<String>,
+    /// Serial line speed
+    #[arg(long, value_name = "N", default_value_t = DEFAULT_BAUD)]
+    pub baud: u32,
+    /// Seconds to wait for each reply (and for the connection)
+    #[arg(long, value_name = "SECONDS", default_value = "10", value_parser = parse_timeout)]
+    pub timeout: Duration,
+    /// Map file: Moving AI `.map`, or a text grid (`.`/`0` free, `#`/`1` blocked)
+    #[arg(long, value_name = "FILE")]
+    pub map: PathBuf,
+    /// Start cell: column,row with 0,0 the top-left cell
+    #[arg(long, value_name = "X,Y", value_parser = parse_point, allow_hyphen_values = true,
+          required_unless_present = "goals")]
+    pub start: Option<Point>,
+    /// Goal cell: column,row
+    #[arg(long, value_name = "X,Y", value_parser = parse_point, allow_hyphen_values = true,
+          required_unless_present = "goals", conflicts_with = "goals")]
+    pub goal: Option<Point>,
+    /// Plan every line of FILE (`SX,SY GX,GY`, or `GX,GY` from --start; `#` comments) over one
+    /// connection; prints one JSON line per request, in order
+    #[arg(long, value_name = "FILE")]
+    pub goals: Option<PathBuf>,
+    /// Print one JSON object instead of the picture
+    #[arg(long)]
+    pub json: bool,
+    #[command(flatten)]
+    pub params: ParamArgs,
+}
+
+/// `--timeout`: positive seconds, at most a day.
+fn parse_timeout(s: &str) -> Result<Duration, String> {
+    let v: f64 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("expected seconds, found `{s}`"))?;
+    if !(v > 0.0 && v <= 86_400.0) {
+        return Err(format!("timeout must be in (0, 86400] seconds, found {s}"));
+    }
+    Duration::try_from_secs_f64(v).map_err(|e| e.to_string())
+}
+
+/// What `send --json` prints: the `plan` report's keys, then `ticks` and `device`.
+#[derive(Serialize)]
+struct SendReport<'a> {
+    #[serde(flatten)]
+    report: &'a PlanReport,
+    /// Device time of the plan (`tick_hz` units), null if no path.
+    ticks: Option<u64>,
+    /// The device's board name.
+    device: &'a str,
+}
+
+impl SendReport<'_> {
+    fn to_json(&self) -> String {
+        serde_json::to_string(self).unwrap_or_else(|e| {
+            format!(
+                "{{\"found\":false,\"error\":{}}}",
+                serde_json::Value::String(e.to_string())
+            )
+        })
+    }
+}
+
+/// Run `ohaca send`; returns the exit code.
+pub fn run(args: &Args) -> u8 {
+    match Session::prepare(args).and_then(|s| s.run(args)) {
+        Ok(code) => code,
+        Err(msg) => bad_input(msg),
+    }
+}
+
+/// The connected state of one `send`.
+struct Session {
+    /// `--tcp` or `--serial`, for messages.
+    target: String,
+    map: Map,
+    params: Params,
+    jobs: Vec<PlanJob>,
+}
+
+/// One line of a goals file.
+fn parse_goal_line(line: &str, start: Option<Point>) -> Result<Option<PlanJob>, String> {
+    let text = line.split('#').next().unwrap_or("");
+    let words: Vec<&str> = text.split_whitespace().collect();
+    let point = |w: &str| parse_point(w).map_err(|e| e.to_string());
+    let (s, g) = match words.as_slice() {
+        [] => return Ok(None),
+        [g] => (
+            start.ok_or("a goal without a start: give `SX,SY GX,GY`, or --start")?,
+            point(g)?,
+        ),
+        [s, g] => (point(s)?, point(g)?),
+        _ => return Err(format!("expected `SX,SY GX,GY`, found `{}`", text.trim())),
+    };
+    Ok(Some(PlanJob {
+        start: s,
+        goal: g,
+        seed: None,
+    }))
+}
+
+/// Every request of a goals file.
+fn load_goals(path: &Path, start: Option<Point>) -> Result<Vec<PlanJob>, String> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| format!("{}: cannot read the file: {e}", path.display()))?;
+    let mut jobs = Vec::new();
+    for (i, line) in text.lines().enumerate() {
+        match parse_goal_line(line, start) {
+            Ok(Some(j)) => jobs.push(j),
+            Ok(None) => {}
+            Err(e) => return Err(format!("{}, line {}: {e}", path.display(), i + 1)),
+        }
+    }
+    if jobs.is_empty() {
+        return Err(format!("{}: no start/goal pairs", path.display()));
+    }
+    Ok(jobs)
+}
+
+/// A map the device cannot hold, in words.
+fn too_large(map_path: &Path, map: &Map, info: &DeviceInfo) -> String {
+    let c = &info.capacity;
+    format!(
+        "{}: map too large for the device: {}x{} = {} cells, but {} holds at most {} cells \
+         (at most {} wide, {} high); use a smaller map",
+        map_path.display(),
+        map.width,
+        map.height,
+        map.cells(),
+        info.board,
+        c.cells,
+        c.max_width,
+        c.max_height
+    )
+}
+
+impl Session {
+    /// Everything that can be checked before connecting.
+    fn prepare(args: &Args) -> Result<Session, String> {
+        let map = Map::load(&args.map).map_err(|e| e.to_string())?;
+        let params = args.params.params();
+        params.validate().map_err(|e| e.to_string())?;
+        let jobs = match (&args.goals, args.start, args.goal) {
+            (Some(file), start, _) => load_goals(file, start)?,
+            (None, Some(start), Some(goal)) => vec![PlanJob {
+                start,
+                goal,
+                seed: None,
+            }],
+            // clap requires --start and --goal without --goals.
+            _ => return Err("give --start and --goal, or --goals".into()),
+        };
+        let target = args.tcp.as_deref().or(args.serial.as_deref()).unwrap_or("");
+        Ok(Session {
+            target: target.to_string(),
+            map,
+            params,
+            jobs,
+        })
+    }
+
+    /// `error: <target>: <what>`.
+    fn fail(&self, e: LinkError) -> String {
+        match e {
+            LinkError::Open { .. } => e.to_string(),
+            e => format!("{}: {e}", self.target),
+        }
+    }
+
+    fn run(self, args: &Args) -> Result<u8, String> {
+        let fail = |e: LinkError| self.fail(e);
+        match (&args.tcp, &args.serial) {
+            (Some(addr), _) => {
+                let link = Link::tcp(addr, args.timeout).map_err(fail)?;
+                self.talk(args, link)
+            }
+            (None, Some(dev)) => {
+                let link = Link::serial(dev, args.baud, args.timeout).map_err(fail)?;
+                self.talk(args, link)
+            }
+            (None, None) => Err("give --tcp HOST:PORT or --serial DEVICE".into()),
+        }
+    }
+
+    fn talk<T: Transport>(&self, args: &Args, mut link: Link<T>) -> Result<u8, String> {
+        let fail = |e: LinkError| self.fail(e);
+        let info = link.hello().map_err(fail)?;
+        let c = &info.capacity;
+        if self.map.cells() > c.cells as usize
+            || self.map.width > c.max_width
+            || self.map.height > c.max_height
+        {
+            return Err(too_large(&args.map, &self.map, &info));
+        }
+        link.set_params(&self.params).map_err(fail)?;
+        link.set_map(&self.map).map_err(|e| match e {
+            LinkError::Device { error, .. } if error.code == ErrorCode::MapTooLarge => {
+                too_large(&args.map, &self.map, &info)
+            }
+            e => fail(e),
+        })?;
+        let code = if args.goals.is_some() {
+            self.stream(&mut link, &info).map_err(fail)?
+        } else {
+            self.single(args, &mut link, &info)?
+        };
+        let strays = link.take_strays();
+        if let Some(first) = strays.first() {
+            eprintln!(
+                "warning: skipped {} unexpected frame(s) from the device (first: {first})",
+                link.stray_count()
+            );
+        }
+        Ok(code)
+    }
+
+    /// One plan: picture or JSON.
+    fn single<T: Transport>(
+        &self,
+        args: &Args,
+        link: &mut Link<T>,
+        info: &DeviceInfo,
+    ) -> Result<u8, String> {
+        let Some(job) = self.jobs.first() else {
+            return Err("nothing to plan".into());
+        };
+        let t0 = Instant::now();
+        let result = match link.plan(job.start, job.goal, job.seed) {
+            Ok(p) => Ok(p),
+            Err(LinkError::Device { error, .. }) => Err(error),
+            Err(e) => return Err(self.fail(e)),
+        };
+        let outcome = self.report(job, result, t0.elapsed());
+        let (report, ticks) = match outcome {
+            Outcome::Report(r, t) => (r, t),
+            Outcome::BadInput(msg) => return Err(msg),
+        };
+        let code = if report.found {
+            exit::FOUND
+        } else {
+            exit::NO_PATH
+        };
+        if args.json {
+            let mut s = SendReport {
+                report: &report,
+                ticks,
+                device: &info.board,
+            }
+            .to_json();
+            s.push('\n');
+            print(&s);
+        } else {
+            let p = &report.params;
+            let mut s = format!(
+                "{}, ({},{}) -> ({},{}), {} seed {}, planned on {} (firmware {})\n",
+                args.map.display(),
+                job.start.x,
+                job.start.y,
+                job.goal.x,
+                job.goal.y,
+                p.algorithm,
+                p.seed,
+                info.board,
+                info.firmware_version
+            );
+            s.push_str(&render(&self.map, job.start, job.goal, &report));
+            if let Some(t) = ticks {
+                let hz = u64::from(info.capacity.tick_hz.max(1));
+                let us = u64::try_from(u128::from(t) * 1_000_000 / u128::from(hz))
+                    .unwrap_or(u64::MAX);
+                s.push_str(&format!(
+                    "device time {} ({t} ticks at {hz} Hz), round trip {}\n",
+                    format_us(us),
+                    format_us(report.elapsed_us)
+                ));
+            }
+            print(&s);
+        }
+        Ok(code)
+    }
+
+    /// Many plans, pipelined; one JSON line each, in order.
+    fn stream<T: Transport>(&self, link: &mut Link<T>, info: &DeviceInfo) -> Result<u8, LinkError> {
+        let mut code = exit::FOUND;
+        link.plan_each(&self.jobs, |i, o| {
+            let Some(job) = self.jobs.get(i) else { return };
+            let (report, ticks) = match self.report(job, o.result, o.round_trip) {
+                Outcome::Report(r, t) => {
+                    if !r.found {
+                        code = code.max(exit::NO_PATH);
+                    }
+                    (r, t)
+                }
+                Outcome::BadInput(msg) => {
+                    code = exit::BAD_INPUT;
+                    (
+                        PlanReport::not_found(&self.params, msg, None, o.round_trip),
+                        None,
+                    )
+                }
+            };
+            let mut s = SendReport {
+                report: &report,
+                ticks,
+                device: &info.board,
+            }
+            .to_json();
+            s.push('\n');
+            print(&s);
+        })?;
+        Ok(code)
+    }
+
+    /// The `plan`-style report of one device answer.
+    fn report(
+        &self,
+        job: &PlanJob,
+        result: Result<DevicePath, ErrorReply>,
+        round_trip: Duration,
+    ) -> Outcome {
+        let params = Params {
+            seed: job.seed.unwrap_or(self.params.seed),
+            ..self.params
+        };
+        let path = match result {
+            Ok(p) => p,
+            Err(e) => {
+                return match core_error(&e) {
+                    Some(err @ Error::NoPath) => Outcome::Report(
+                        PlanReport::not_found(&params, err, Some(0), round_trip),
+                        None,
+                    ),
+                    Some(err @ Error::NoAntArrived) => Outcome::Report(
+                        PlanReport::not_found(&params, err, None, round_trip),
+                        None,
+                    ),
+                    Some(err @ (Error::OutOfBounds(_) | Error::Blocked(_))) => {
+                        Outcome::BadInput(format!(
+                            "{err} (start {},{}, goal {},{}, map {}x{})",
+                            job.start.x,
+                            job.start.y,
+                            job.goal.x,
+                            job.goal.y,
+                            self.map.width,
+                            self.map.height
+                        ))
+                    }
+                    Some(err) => Outcome::BadInput(format!("device: {err}")),
+                    None => Outcome::BadInput(format!(
+                        "device refused the plan: {e} (error code {})",
+                        e.code.code()
+                    )),
+                };
+            }
+        };
+        let raw = match path.raw(job.start) {
+            Ok(r) => r,
+            Err(e) => return Outcome::BadInput(e.to_string()),
+        };
+        if raw.last() != Some(&job.goal) || path.waypoints.last() != Some(&job.goal) {
+            return Outcome::BadInput(format!(
+                "bad path from the device: it does not end at the goal {},{}",
+                job.goal.x, job.goal.y
+            ));
+        }
+        let report = PlanReport {
+            found: true,
+            raw: raw.into_iter().map(xy).collect(),
+            waypoints: path.waypoints.iter().copied().map(xy).collect(),
+            raw_length: Some(path.raw_length),
+            length: Some(path.length),
+            turns: Some(path.turns),
+            iterations: Some(path.iterations),
+            best_iteration: Some(path.best_iteration),
+            moves: Some(path.moves),
+            elapsed_us: micros(round_trip),
+            params: ParamsReport::from(&params),
+            error: None,
+        };
+        Outcome::Report(report, Some(path.ticks))
+    }
+}
+
+/// A device answer as a report (with its ticks), or a bad-input message.
+enum Outcome {
+    Report(PlanReport, Option<u64>),
+    BadInput(String),
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn goal_lines() {
+        let s = Some(Point::new(1, 2));
+        assert_eq!(parse_goal_line("  # nothing", None), Ok(None));
+        assert_eq!(parse_goal_line("", None), Ok(None));
+        let j = parse_goal_line("3,4 5,6 # pair", None).unwrap().unwrap();
+        assert_eq!((j.start, j.goal), (Point::new(3, 4), Point::new(5, 6)));
+        let j = parse_goal_line("7,8", s).unwrap().unwrap();
+        assert_eq!((j.start, j.goal), (Point::new(1, 2), Point::new(7, 8)));
+        assert!(parse_goal_line("7,8", None).is_err());
+        assert!(parse_goal_line("1,2 3,4 5,6", None).is_err());
+        assert!(parse_goal_line("1;2 3,4", None).is_err());
+    }
+
+    #[test]
+    fn timeouts() {
+        assert_eq!(parse_timeout("2.5"), Ok(Duration::from_millis(2500)));
+        for bad in ["0", "-1", "nan", "inf", "x", "1e9"] {
+            assert!(parse_timeout(bad).is_err(), "{bad}");
+        }
+    }
+}

@@ -1,0 +1,436 @@
+//! Real robot maps: ROS `map_server` maps (a YAML file and its PGM or PNG image) and plain
+//! black-and-white images.
+//!
+//! ## ROS `map_server` YAML
+//! ```yaml
+//! image: lab.pgm            # relative to the YAML file's folder (or absolute)
+//! resolution: 0.05          # metres per pixel, > 0
+//! origin: [-10.0, -10.0, 0.0]   # x, y, yaw of the lower-left pixel (yaw optional, radians)
+//! negate: 0                 # optional, 0 or 1 (also true/false)
+//! occupied_thresh: 0.65     # optional, in [0, 1]
+//! free_thresh: 0.196        # optional, in [0, 1], at most occupied_thresh
+//! mode: trinary             # optional: trinary (default), scale or raw
+//! ```
+//! Other keys are ignored. Each pixel's value `v` (0-255; the mean of R, G, B for colour images)
+//! becomes an occupancy probability `p = (255 - v) / 255`, or `v / 255` with `negate`; then
+//! `p > occupied_thresh` is **blocked**, `p < free_thresh` is **free**, anything else is
+//! **unknown**, as in ROS. In `scale` mode a pixel that is not fully opaque is unknown too (ROS's
+//! rule); in `raw` mode the value itself is the occupancy in percent (`0..=100`, compared with the
+//! thresholds times 100) and values above 100 are unknown. Unknown cells become blocked unless
+//! [`Unknown::Free`] is asked for (`--unknown free`). The standard `map_saver` output (254 free,
+//! 0 occupied, 205 unknown) is read as intended.
+//!
+//! Image row 0 is the **top** of the map (the planner's `y = 0`), while ROS's origin is the
+//! **lower-left** pixel: [`crate::frame::Frame`] does that flip.
+//!
+//! ## Plain images
+//! A PNG or PGM given directly as the map (no YAML): a pixel is blocked when it is darker than
+//! 50 % (mean of R, G, B below 127.5; a transparent pixel counts as white). Such a map has no
+//! resolution: positions are cells.
+
+use std::path::{Path, PathBuf};
+
+use image::RgbaImage;
+use serde_norway::Value;
+
+use crate::frame::Frame;
+use crate::input::InputError;
+use crate::map::{Map, MAX_SIDE};
+
+/// What to do with cells whose occupancy is between the thresholds (ROS's "unknown", usually the
+/// unexplored area).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum Unknown {
+    /// Unknown cells are obstacles (the safe default).
+    #[default]
+    Blocked,
+    /// Unknown cells are free.
+    Free,
+}
+
+/// How pixel values are read (ROS's `mode`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Mode {
+    /// Occupied, free or unknown by the thresholds.
+    Trinary,
+    /// As trinary, and a pixel that is not fully opaque is unknown.
+    Scale,
+    /// The value is the occupancy in percent; above 100 is unknown.
+    Raw,
+}
+
+/// The fields of a `map_server` YAML file.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RosMeta {
+    /// The image file, resolved against the YAML file's folder.
+    pub image: PathBuf,
+    /// Metres per pixel.
+    pub resolution: f64,
+    /// x, y, yaw of the lower-left pixel.
+    pub origin: [f64; 3],
+    /// Dark means free instead of occupied.
+    pub negate: bool,
+    /// Occupancy above this is blocked.
+    pub occupied_thresh: f64,
+    /// Occupancy below this is free.
+    pub free_thresh: f64,
+    /// How values are read.
+    pub mode: Mode,
+}
+
+/// One pixel's class.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Occupancy {
+    /// Free space.
+    Free,
+    /// An obstacle.
+    Occupied,
+    /// Neither (unexplored).
+    Unknown,
+}
+
+/// A short description of a YAML value for error messages.
+fn show(v: &Value) -> String {
+    match v {
+        Value::Null => "nothing".to_string(),
+        Value::Bool(b) => format!("`{b}`"),
+        Value::Number(n) => format!("`{n}`"),
+        Value::String(s) => format!("`{s}`"),
+        Value::Sequence(s) => format!("a list of {}", s.len()),
+        Value::Mapping(_) => "a mapping".to_string(),
+        Value::Tagged(t) => format!("a tagged value `{}`", t.tag),
+    }
+}
+
+fn number(v: &Value) -> Option<f64> {
+    v.as_f64().filter(|f| f.is_finite())
+}
+
+impl RosMeta {
+    /// Parse the YAML text of a `map_server` map; `yaml` is the file's path (for the image's
+    /// folder). The error is the problem only (the caller adds the file name).
+    pub fn parse(text: &str, yaml: &Path) -> Result<RosMeta, String> {
+        let doc: Value =
+            serde_norway::from_str(text).map_err(|e| format!("not valid YAML: {e}"))?;
+        let Some(fields) = doc.as_mapping() else {
+            return Err(format!(
+                "expected a mapping of fields (image, resolution, origin, ...), found {}",
+                show(&doc)
+            ));
+        };
+        let field = |name: &str| fields.get(name);
+        let bad = |name: &str, want: &str, v: &Value| {
+            format!("field `{name}` must be {want}, found {}", show(v))
+        };
+
+        let image = match field("image") {
+            None => return Err("missing field `image` (the PGM or PNG file)".to_string()),
+            Some(v) => match v.as_str() {
+                Some(s) if !s.trim().is_empty() => s.trim().to_string(),
+                _ => return Err(bad("image", "a file name", v)),
+            },
+        };
+        let image_path = Path::new(&image);
+        let image = if image_path.is_absolute() {
+            image_path.to_path_buf()
+        } else {
+            yaml.parent()
+                .map_or_else(|| image_path.to_path_buf(), |d| d.join(image_path))
+        };
+
+        let resolution = match field("resolution") {
+            None => return Err("missing field `resolution` (metres per pixel)".to_string()),
+            Some(v) => match number(v) {
+                Some(r) if r > 0.0 => r,
+                _ => return Err(bad("resolution", "a number greater than 0", v)),
+            },
+        };
+
+        let origin = match field("origin") {
+            None => return Err("missing field `origin` ([x, y, yaw] of the lower-left pixel)".to_string()),
+            Some(v) => {
+                let want = "a list [x, y, yaw] of numbers";
+                let seq = v.as_sequence().ok_or_else(|| bad("origin", want, v))?;
+                let nums: Option<Vec<f64>> = seq.iter().map(number).collect();
+                match nums.as_deref() {
+                    Some(&[x, y]) => [x, y, 0.0],
+                    Some(&[x, y, yaw]) => [x, y, yaw],
+                    _ => return Err(bad("origin", want, v)),
+                }
+            }
+        };
+
+        let negate = match field("negate") {
+            None => false,
+            Some(v) => match (v.as_i64(), v.as_bool()) {
+                (Some(0), _) | (_, Some(false)) => false,
+                (Some(1), _) | (_, Some(true)) => true,
+                _ => return Err(bad("negate", "0 or 1", v)),
+            },
+        };
+
+        let thresh = |name: &str, default: f64| -> Result<f64, String> {
+            match field(name) {
+                None => Ok(default),
+                Some(v) => match number(v) {
+                    Some(t) if (0.0..=1.0).contains(&t) => Ok(t),
+                    _ => Err(bad(name, "a number in [0, 1]", v)),
+                },
+            }
+        };
+        let occupied_thresh = thresh("occupied_thresh", 0.65)?;
+        let free_thresh = thresh("free_thresh", 0.196)?;
+        if free_thresh > occupied_thresh {
+            return Err(format!(
+                "free_thresh {free_thresh} is greater than occupied_thresh {occupied_thresh}"
+            ));
+        }
+
+        let mode = match field("mode") {
+            None => Mode::Trinary,
+            Some(v) => match v.as_str().map(str::trim) {
+                Some("trinary") => Mode::Trinary,
+                Some("scale") => Mode::Scale,
+                Some("raw") => Mode::Raw,
+                _ => return Err(bad("mode", "trinary, scale or raw", v)),
+            },
+        };
+
+        Ok(RosMeta {
+            image,
+            resolution,
+            origin,
+            negate,
+            occupied_thresh,
+            free_thresh,
+            mode,
+        })
+    }
+
+    /// The class of a pixel with colour mean `value` (0-255) and opacity `alpha` (0-255).
+    pub fn classify(&self, value: f64, alpha: u8) -> Occupancy {
+        let v = if self.negate { 255.0 - value } else { value };
+        let p = match self.mode {
+            Mode::Raw => {
+                let pct = v.round();
+                if pct > 100.0 {
+                    return Occupancy::Unknown;
+                }
+                pct / 100.0
+            }
+            Mode::Trinary | Mode::Scale => (255.0 - v) / 255.0,
+        };
+        if p > self.occupied_thresh {
+            Occupancy::Occupied
+        } else if p < self.free_thresh {
+            if self.mode == Mode::Scale && alpha < 255 {
+                Occupancy::Unknown
+            } else {
+                Occupancy::Free
+            }
+        } else {
+            Occupancy::Unknown
+        }
+    }
+}
+
+/// Mean of R, G and B.
+fn grey(px: &image::Rgba<u8>) -> f64 {
+    let [r, g, b, _] = px.0;
+    (f64::from(r) + f64::from(g) + f64::from(b)) / 3.0
+}
+
+/// Read an image file as RGBA (grey images are replicated into R, G, B).
+pub fn read_image(path: &Path) -> Result<RgbaImage, InputError> {
+    let name = path.display().to_string();
+    let err = |problem: String| InputError::File {
+        path: name.clone(),
+        problem,
+    };
+    let bytes = std::fs::read(path).map_err(|e| err(format!("cannot read the image: {e}")))?;
+    let format = image::guess_format(&bytes)
+        .map_err(|_| err("not a PNG or PGM image (unknown file signature)".to_string()))?;
+    let img = image::load_from_memory_with_format(&bytes, format)
+        .map_err(|e| err(format!("cannot decode the image: {e}")))?;
+    let (w, h) = (img.width(), img.height());
+    if w == 0 || h == 0 {
+        return Err(err("the image is empty".to_string()));
+    }
+    let too_big = |side: &str, v: u32| err(format!("image {side} {v} is more than {MAX_SIDE}"));
+    if usize::try_from(w).map_or(true, |w| w > MAX_SIDE) {
+        return Err(too_big("width", w));
+    }
+    if usize::try_from(h).map_or(true, |h| h > MAX_SIDE) {
+        return Err(too_big("height", h));
+    }
+    Ok(img.to_rgba8())
+}
+
+/// Image sides as `u16` (checked by [`read_image`]).
+fn sides(img: &RgbaImage) -> (u16, u16) {
+    (
+        u16::try_from(img.width()).unwrap_or(u16::MAX),
+        u16::try_from(img.height()).unwrap_or(u16::MAX),
+    )
+}
+
+/// Load a ROS `map_server` map: the YAML file at `yaml` and the image it names. Unknown cells
+/// follow `unknown`.
+pub fn load_ros(yaml: &Path, unknown: Unknown) -> Result<(Map, Frame), InputError> {
+    let name = yaml.display().to_string();
+    let err = |problem: String| InputError::File {
+        path: name.clone(),
+        problem,
+    };
+    let text = std::fs::read_to_string(yaml).map_err(|e| err(format!("cannot read the file: {e}")))?;
+    let meta = RosMeta::parse(&text, yaml).map_err(err)?;
+    if !meta.image.exists() {
+        return Err(err(format!(
+            "image `{}` does not exist",
+            meta.image.display()
+        )));
+    }
+    let img = read_image(&meta.image)?;
+    let (w, h) = sides(&img);
+    let map = Map::from_fn(w, h, |x, y| {
+        let px = img.get_pixel(u32::from(x), u32::from(y));
+        match meta.classify(grey(px), px.0[3]) {
+            Occupancy::Occupied => true,
+            Occupancy::Free => false,
+            Occupancy::Unknown => unknown == Unknown::Blocked,
+        }
+    });
+    let frame = Frame {
+        resolution: meta.resolution,
+        origin: [meta.origin[0], meta.origin[1]],
+        yaw: meta.origin[2],
+        width: w,
+        height: h,
+    };
+    Ok((map, frame))
+}
+
+/// Load a plain image as a map: darker than 50 % is blocked (transparent counts as white).
+pub fn load_image(path: &Path) -> Result<Map, InputError> {
+    let img = read_image(path)?;
+    let (w, h) = sides(&img);
+    Ok(Map::from_fn(w, h, |x, y| {
+        let px = img.get_pixel(u32::from(x), u32::from(y));
+        // Composite over white: value * a + 255 * (1 - a).
+        let a = f64::from(px.0[3]) / 255.0;
+        let v = grey(px) * a + 255.0 * (1.0 - a);
+        v < 127.5
+    }))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn meta(text: &str) -> Result<RosMeta, String> {
+        RosMeta::parse(text, Path::new("/maps/lab.yaml"))
+    }
+
+    const OK: &str = "image: lab.pgm\nresolution: 0.05\norigin: [-1.0, 2.0, 0.0]\n";
+
+    #[test]
+    fn defaults_and_paths() {
+        let m = meta(OK).unwrap();
+        assert_eq!(m.image, Path::new("/maps/lab.pgm"));
+        assert_eq!(m.resolution, 0.05);
+        assert_eq!(m.origin, [-1.0, 2.0, 0.0]);
+        assert!(!m.negate);
+        assert_eq!((m.occupied_thresh, m.free_thresh), (0.65, 0.196));
+        assert_eq!(m.mode, Mode::Trinary);
+        let m = meta("image: /abs/x.png\nresolution: 1\norigin: [0, 0]\nnegate: 1\nmode: raw\nname: lab\n").unwrap();
+        assert_eq!(m.image, Path::new("/abs/x.png"));
+        assert!(m.negate);
+        assert_eq!(m.origin, [0.0, 0.0, 0.0]);
+        assert_eq!(m.mode, Mode::Raw);
+        assert!(meta(&format!("{OK}negate: true\n")).unwrap().negate);
+    }
+
+    #[test]
+    fn field_errors() {
+        let cases = [
+            ("resolution: 1\norigin: [0,0,0]\n", "missing field `image`"),
+            ("image: a.pgm\norigin: [0,0,0]\n", "missing field `resolution`"),
+            ("image: a.pgm\nresolution: 1\n", "missing field `origin`"),
+            (
+                "image: a.pgm\nresolution: 0\norigin: [0,0,0]\n",
+                "field `resolution` must be a number greater than 0, found `0`",
+            ),
+            (
+                "image: a.pgm\nresolution: -0.05\norigin: [0,0,0]\n",
+                "field `resolution` must be a number greater than 0, found `-0.05`",
+            ),
+            (
+                "image: a.pgm\nresolution: abc\norigin: [0,0,0]\n",
+                "field `resolution` must be a number greater than 0, found `abc`",
+            ),
+            (
+                "image: a.pgm\nresolution: .nan\norigin: [0,0,0]\n",
+                "field `resolution` must be a number greater than 0",
+            ),
+            (
+                "image: a.pgm\nresolution: 1\norigin: [0, x, 0]\n",
+                "field `origin` must be a list [x, y, yaw] of numbers, found a list of 3",
+            ),
+            (
+                "image: a.pgm\nresolution: 1\norigin: 5\n",
+                "field `origin` must be a list [x, y, yaw] of numbers, found `5`",
+            ),
+            (
+                "image: a.pgm\nresolution: 1\norigin: [0,0,0]\nnegate: 2\n",
+                "field `negate` must be 0 or 1, found `2`",
+            ),
+            (
+                "image: a.pgm\nresolution: 1\norigin: [0,0,0]\noccupied_thresh: 1.5\n",
+                "field `occupied_thresh` must be a number in [0, 1], found `1.5`",
+            ),
+            (
+                "image: a.pgm\nresolution: 1\norigin: [0,0,0]\nfree_thresh: 0.9\n",
+                "free_thresh 0.9 is greater than occupied_thresh 0.65",
+            ),
+            (
+                "image: a.pgm\nresolution: 1\norigin: [0,0,0]\nmode: fancy\n",
+                "field `mode` must be trinary, scale or raw, found `fancy`",
+            ),
+            (
+                "image: [a]\nresolution: 1\norigin: [0,0,0]\n",
+                "field `image` must be a file name, found a list of 1",
+            ),
+            ("- 1\n- 2\n", "expected a mapping of fields"),
+            ("image: [\n", "not valid YAML"),
+        ];
+        for (text, want) in cases {
+            let e = meta(text).unwrap_err();
+            assert!(e.starts_with(want), "{text:?}: {e}");
+        }
+    }
+
+    #[test]
+    fn classification_follows_ros() {
+        let m = meta(OK).unwrap();
+        assert_eq!(m.classify(254.0, 255), Occupancy::Free);
+        assert_eq!(m.classify(0.0, 255), Occupancy::Occupied);
+        assert_eq!(m.classify(205.0, 255), Occupancy::Unknown, "map_saver's unknown");
+        // p = (255 - 89) / 255 = 0.651 > 0.65; p(90) = 0.647.
+        assert_eq!(m.classify(89.0, 255), Occupancy::Occupied);
+        assert_eq!(m.classify(90.0, 255), Occupancy::Unknown);
+        // p(206) = 0.192 < 0.196.
+        assert_eq!(m.classify(206.0, 255), Occupancy::Free);
+        assert_eq!(m.classify(254.0, 0), Occupancy::Free, "trinary ignores alpha");
+        let neg = RosMeta { negate: true, ..m.clone() };
+        assert_eq!(neg.classify(0.0, 255), Occupancy::Free);
+        assert_eq!(neg.classify(255.0, 255), Occupancy::Occupied);
+        let scale = RosMeta { mode: Mode::Scale, ..m.clone() };
+        assert_eq!(scale.classify(254.0, 128), Occupancy::Unknown);
+        assert_eq!(scale.classify(254.0, 255), Occupancy::Free);
+        let raw = RosMeta { mode: Mode::Raw, ..m };
+        assert_eq!(raw.classify(0.0, 255), Occupancy::Free);
+        assert_eq!(raw.classify(100.0, 255), Occupancy::Occupied);
+        assert_eq!(raw.classify(50.0, 255), Occupancy::Unknown);
+        assert_eq!(raw.classify(255.0, 255), Occupancy::Unknown);
+    }
+}
