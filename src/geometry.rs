@@ -32,13 +32,19 @@ pub fn steps_length(straight: u32, diagonal: u32) -> f32 {
 /// Floor division for a positive divisor.
 #[inline]
 fn floor_div(n: i64, d: i64) -> i64 {
-    n.div_euclid(d)
+    // 32-bit division when the operands fit (every map up to ~16k cells a side): the Cortex-M4
+    // divides 32-bit integers in hardware but 64-bit ones in a library routine.
+    // `checked_`: callers always pass d > 0, but this way no panic path is compiled in.
+    match (i32::try_from(n), i32::try_from(d)) {
+        (Ok(n), Ok(d)) => i64::from(n.checked_div_euclid(d).unwrap_or(0)),
+        _ => n.checked_div_euclid(d).unwrap_or(0),
+    }
 }
 
 /// Ceiling division for a positive divisor.
 #[inline]
 fn ceil_div(n: i64, d: i64) -> i64 {
-    -((-n).div_euclid(d))
+    -floor_div(-n, d)
 }
 
 /// True iff the straight segment between the centres of `a` and `b` touches no blocked (or

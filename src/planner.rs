@@ -146,7 +146,7 @@ impl Default for Params {
             tau0: 1.0,
             tau_min: 0.01,
             tau_max: 100.0,
-            patience: 20,
+            patience: 10,
             seed: 1,
             dead_end: DeadEnd::Backtrack,
             smoothing: SmoothingKind::Shortest,

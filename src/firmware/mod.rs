@@ -38,6 +38,8 @@ defmt::timestamp!("{=u64:us}", embassy_time::Instant::now().as_micros());
 
 /// Bring up the board and spawn the tasks.
 pub fn run(spawner: Spawner) {
+    // Before any interrupt is enabled, so the boot log is the same every time.
+    let boot_stack = stack::peak();
     let (rx, tx) = board::Active::init();
     let boots = state::count_boot();
     defmt::info!(
@@ -48,7 +50,11 @@ pub fn run(spawner: Spawner) {
         state::CELLS,
         core::mem::size_of::<Storage<{ state::CELLS }>>()
     );
-    defmt::info!("stack: {} bytes, {} used", stack::size(), stack::peak());
+    defmt::info!(
+        "stack: {} bytes (RAM above the statics), {} used at boot",
+        stack::size(),
+        boot_stack
+    );
     let storage = STORAGE.take();
     let port = TX.init(Mutex::new(tx));
     spawner.spawn(defmt::unwrap!(tx::tx_task(port)));

@@ -1,6 +1,7 @@
 //! The receive task: splits the UART stream into frames, decodes them, answers everything but
 //! `Plan` at once and queues plans for the planner.
 
+use embassy_futures::yield_now;
 use embassy_sync::channel::TrySendError;
 use embedded_io_async::Read;
 
@@ -115,7 +116,13 @@ impl Session {
                 Err(e) => Reply::Error(e.into()),
             },
             Request::Plan { start, goal, seed } => match self.enqueue(id, start, goal, seed) {
-                Ok(()) => return, // the planner answers
+                Ok(()) => {
+                    // The planner answers. Let it take the plan now if it is idle, before the
+                    // next frame is handled: a burst of plans then fills the queue behind the
+                    // running one, and `Busy` comes exactly when `plan_queue` plans wait.
+                    yield_now().await;
+                    return;
+                }
                 Err(e) => e,
             },
             Request::Cancel => {

@@ -1,6 +1,7 @@
-//! QEMU `mps2-an386`: Cortex-M4 at 25 MHz, 4 MiB flash at 0, 4 MiB RAM at 0x2000_0000, CMSDK APB
-//! UART0 at 0x4000_4000 (its RX interrupt is IRQ 0). Logs and exit go through semihosting, so run
-//! QEMU with `-semihosting-config enable=on,target=native`.
+//! QEMU `mps2-an386`: Cortex-M4 at 25 MHz, 4 MiB flash at 0, 4 MiB RAM at 0x2000_0000 (the
+//! firmware uses 512 KiB and 128 KiB of them, as on the STM32F411: `memory.x`), CMSDK APB UART0 at
+//! 0x4000_4000 (its RX interrupt is IRQ 0). Logs and exit go through semihosting, so run QEMU with
+//! `-semihosting-config enable=on,target=native`.
 
 mod systick;
 mod uart;
