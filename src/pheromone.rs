@@ -94,12 +94,12 @@ impl<'a> Table<'a> {
                 // formatting into the firmware) or `max`/`min` (library calls on the M4, 6% of a
                 // plan). A NaN would land on `lo`.
                 let v = keep * *tv + *dv;
-                *tv = if !(v >= lo) {
-                    lo
-                } else if v > hi {
+                *tv = if v > hi {
                     hi
-                } else {
+                } else if v >= lo {
                     v
+                } else {
+                    lo
                 };
                 *dv = 0.0;
             }

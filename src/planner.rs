@@ -207,6 +207,8 @@ pub struct CurvePoint {
     pub mean: f32,
     /// Shortest raw path found so far.
     pub best_so_far: f32,
+    /// Ants that reached the goal in this iteration (all of them unless they die at dead ends).
+    pub arrived: u16,
 }
 
 /// Every buffer a run needs, borrowed from the caller. Each per-cell buffer must hold at least as
@@ -288,7 +290,7 @@ impl<'a> Workspace<'a> {
 
 /// Fixed-capacity storage for maps of up to `CELLS` cells and convergence curves of `CURVE`
 /// iterations. Put it in a `static` on the device; its size is
-/// `CELLS * Workspace::BYTES_PER_CELL + CURVE * 12` bytes.
+/// `CELLS * Workspace::BYTES_PER_CELL + CURVE * 16` bytes.
 #[derive(Debug)]
 pub struct Storage<const CELLS: usize, const CURVE: usize = 128> {
     tau: [[f32; 4]; CELLS],
@@ -316,6 +318,7 @@ impl<const CELLS: usize, const CURVE: usize> Storage<CELLS, CURVE> {
                 best: 0.0,
                 mean: 0.0,
                 best_so_far: 0.0,
+                arrived: 0,
             }; CURVE],
         }
     }
@@ -613,6 +616,7 @@ impl<'g, 'a> Run<'g, 'a> {
                 inf
             },
             best_so_far: self.best.map_or(inf, |b| b.length()),
+            arrived: u16::try_from(arrived).unwrap_or(u16::MAX),
         };
         if let Some(slot) = curve.get_mut(usize::from(self.iteration)) {
             *slot = point;
@@ -937,7 +941,7 @@ mod tests {
     #[test]
     fn storage_size_is_bytes_per_cell_times_cells() {
         let curve = core::mem::size_of::<CurvePoint>();
-        assert_eq!(curve, 12);
+        assert_eq!(curve, 16);
         assert_eq!(
             core::mem::size_of::<Storage<1024>>(),
             1024 * Workspace::BYTES_PER_CELL + 128 * curve

@@ -77,9 +77,17 @@ pub const MUTED: RGBColor = RGBColor(0x60, 0x60, 0x60);
 
 /// Heat-map colour for `t` in `[0, 1]`: white to deep purple.
 pub fn heat(t: f64) -> RGBColor {
-    let t = if t.is_finite() { t.clamp(0.0, 1.0) } else { 0.0 };
+    let t = if t.is_finite() {
+        t.clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
     // White -> #BCBDDC -> #54278F.
-    let stops = [(255.0, 255.0, 255.0), (188.0, 189.0, 220.0), (84.0, 39.0, 143.0)];
+    let stops = [
+        (255.0, 255.0, 255.0),
+        (188.0, 189.0, 220.0),
+        (84.0, 39.0, 143.0),
+    ];
     let (a, b, u) = if t < 0.5 {
         (stops[0], stops[1], t * 2.0)
     } else {
@@ -113,7 +121,15 @@ pub fn to_svg<P: Picture>(p: &P) -> Result<String, String> {
 pub fn to_rgb<P: Picture>(p: &P) -> Result<Vec<u8>, String> {
     register_font();
     let (w, h) = p.size();
-    let len = usize::try_from(u64::from(w) * u64::from(h) * 3).map_err(|e| e.to_string())?;
+    let bytes = u64::from(w) * u64::from(h) * 3;
+    // 1 GiB of pixels (a 18000 x 18000 picture) is plenty; beyond that, say so instead of
+    // exhausting the memory. SVG has no such limit.
+    if bytes > 1 << 30 {
+        return Err(format!(
+            "{w}x{h} pixels is too large for a PNG; write an SVG"
+        ));
+    }
+    let len = usize::try_from(bytes).map_err(|e| e.to_string())?;
     let mut buf = vec![255u8; len];
     {
         let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
@@ -162,7 +178,11 @@ pub fn save<P: Picture>(p: &P, path: &Path) -> Result<(), String> {
     let bytes = match Format::of(path) {
         Some(Format::Svg) => to_svg(p).map(String::into_bytes),
         Some(Format::Png) => to_png(p),
-        None => return Err(format!("{name}: the picture's name must end in .svg or .png")),
+        None => {
+            return Err(format!(
+                "{name}: the picture's name must end in .svg or .png"
+            ))
+        }
     }
     .map_err(|e| format!("{name}: cannot draw the picture: {e}"))?;
     std::fs::write(path, bytes).map_err(|e| format!("{name}: cannot write the file: {e}"))
@@ -204,14 +224,23 @@ pub struct Layer {
 
 impl Layer {
     /// The layer of a report: output path length and turns on the first line; raw length, the
-    /// iteration of the best path and the seed on the second (or why no path was found).
-    pub fn from_report(algorithm: Algorithm, r: &crate::output::PlanReport) -> Layer {
+    /// iteration of the best path and the seed on the second (or why no path was found). With
+    /// `resolution` (metres per cell) the output length is also given in metres.
+    pub fn from_report(
+        algorithm: Algorithm,
+        r: &crate::output::PlanReport,
+        resolution: Option<f64>,
+    ) -> Layer {
+        let turns = r.turns.map_or_else(|| "-".to_string(), |t| t.to_string());
         let (line1, line2) = match (r.found, r.length, r.raw_length) {
             (true, Some(len), Some(raw)) => (
-                format!(
-                    "length {len:.3}, {} turns",
-                    r.turns.map_or_else(|| "-".to_string(), |t| t.to_string())
-                ),
+                match resolution {
+                    Some(res) => format!(
+                        "{:.2} m ({len:.3} cells), {turns} turns",
+                        f64::from(len) * res
+                    ),
+                    None => format!("length {len:.3}, {turns} turns"),
+                },
                 format!(
                     "raw {raw:.3}, best in iteration {}, seed {}",
                     r.best_iteration
@@ -219,10 +248,7 @@ impl Layer {
                     r.params.seed
                 ),
             ),
-            _ => (
-                "no path".to_string(),
-                r.error.clone().unwrap_or_default(),
-            ),
+            _ => ("no path".to_string(), r.error.clone().unwrap_or_default()),
         };
         Layer {
             algorithm,
@@ -253,6 +279,8 @@ pub struct Scene {
     pub pheromone: Option<Vec<f32>>,
     /// Legend text for the heat map (e.g. which algorithm's pheromone).
     pub pheromone_label: String,
+    /// The map's metric frame, if any: the legend gives the start and goal in metres too.
+    pub frame: Option<crate::frame::Frame>,
 }
 
 /// Where a [`Scene`]'s parts go, in pixels. Public so tests can find a cell's pixels.
@@ -320,8 +348,8 @@ impl Layout {
 
     /// Width of the output path of layer `i` of `n`.
     pub fn path_width(&self, i: usize, n: usize) -> u32 {
-        let base = (self.cell / 6).max(2);
-        let step = (self.cell / 10).max(1);
+        let base = (self.cell / 7).max(2);
+        let step = (self.cell / 12).max(1);
         let rank = u32::try_from(n.saturating_sub(1).saturating_sub(i)).unwrap_or(0);
         base + rank * step
     }
@@ -340,7 +368,11 @@ impl Scene {
         Layout::new(self.map.width, self.map.height, self.legend_lines())
     }
 
-    fn draw_map<DB: DrawingBackend>(&self, a: &DrawingArea<DB, Shift>, l: &Layout) -> Result<(), String> {
+    fn draw_map<DB: DrawingBackend>(
+        &self,
+        a: &DrawingArea<DB, Shift>,
+        l: &Layout,
+    ) -> Result<(), String> {
         let (w, h) = (self.map.width, self.map.height);
         let c = l.cell as i32;
         let (x0, y0) = l.corner(0, 0);
@@ -371,13 +403,16 @@ impl Scene {
                         continue;
                     }
                     let (cx, cy) = l.corner(p.x, p.y);
-                    a.draw(&Rectangle::new([(cx, cy), (cx + c, cy + c)], heat(t).filled()))
-                        .map_err(err)?;
+                    a.draw(&Rectangle::new(
+                        [(cx, cy), (cx + c, cy + c)],
+                        heat(t).filled(),
+                    ))
+                    .map_err(err)?;
                 }
             }
         }
         // Cell borders, when cells are big enough to see them.
-        if l.cell >= 8 {
+        if l.cell >= 12 {
             let line = GRID.stroke_width(1);
             for x in 0..=w {
                 let (px, _) = l.corner(x, 0);
@@ -408,19 +443,28 @@ impl Scene {
                     .map_err(err)?;
             }
         }
-        a.draw(&Rectangle::new([(x0, y0), (x1, y1)], BLOCKED.stroke_width(1)))
-            .map_err(err)?;
+        a.draw(&Rectangle::new(
+            [(x0, y0), (x1, y1)],
+            BLOCKED.stroke_width(1),
+        ))
+        .map_err(err)?;
         // Coordinates along the top and the left.
-        let step = [1u32, 2, 5, 10, 20, 50, 100, 200, 500, 1000, 2000, 5000, 10000, 20000]
-            .into_iter()
-            .find(|k| k * l.cell >= 28)
-            .unwrap_or(50000);
+        let step = [
+            1u32, 2, 5, 10, 20, 50, 100, 200, 500, 1000, 2000, 5000, 10000, 20000,
+        ]
+        .into_iter()
+        .find(|k| k * l.cell >= 28)
+        .unwrap_or(50000);
         let small = font(11.0, MUTED);
         for x in (0..u32::from(w)).step_by(step as usize) {
             let x = x as u16;
             let (px, _) = l.centre(x, 0);
-            a.draw(&Text::new(x.to_string(), (px, y0 - 9), centre(small.clone())))
-                .map_err(err)?;
+            a.draw(&Text::new(
+                x.to_string(),
+                (px, y0 - 9),
+                centre(small.clone()),
+            ))
+            .map_err(err)?;
         }
         for y in (0..u32::from(h)).step_by(step as usize) {
             let y = y as u16;
@@ -435,7 +479,11 @@ impl Scene {
         Ok(())
     }
 
-    fn draw_paths<DB: DrawingBackend>(&self, a: &DrawingArea<DB, Shift>, l: &Layout) -> Result<(), String> {
+    fn draw_paths<DB: DrawingBackend>(
+        &self,
+        a: &DrawingArea<DB, Shift>,
+        l: &Layout,
+    ) -> Result<(), String> {
         let n = self.layers.len();
         let centres = |pts: &[[u16; 2]]| -> Vec<(i32, i32)> {
             pts.iter().map(|&[x, y]| l.centre(x, y)).collect()
@@ -466,7 +514,7 @@ impl Scene {
             }
         }
         // Start and goal on top.
-        let r = ((l.cell * 2 / 5).max(3)) as i32;
+        let r = ((l.cell * 2 / 5).max(6)) as i32;
         for (p, colour, label) in [(self.start, START, "S"), (self.goal, GOAL, "G")] {
             if p.x >= self.map.width || p.y >= self.map.height {
                 continue;
@@ -483,7 +531,11 @@ impl Scene {
         Ok(())
     }
 
-    fn draw_legend<DB: DrawingBackend>(&self, a: &DrawingArea<DB, Shift>, l: &Layout) -> Result<(), String> {
+    fn draw_legend<DB: DrawingBackend>(
+        &self,
+        a: &DrawingArea<DB, Shift>,
+        l: &Layout,
+    ) -> Result<(), String> {
         let x = l.legend_x as i32;
         let mut y = (l.map_y + LEGEND_LINE / 2) as i32;
         let line = LEGEND_LINE as i32;
@@ -498,8 +550,11 @@ impl Scene {
         for (i, layer) in self.layers.iter().enumerate() {
             let colour = algorithm_colour(layer.algorithm);
             let width = l.path_width(i, n).min(12);
-            a.draw(&PathElement::new(swatch(y).to_vec(), colour.stroke_width(width)))
-                .map_err(err)?;
+            a.draw(&PathElement::new(
+                swatch(y).to_vec(),
+                colour.stroke_width(width),
+            ))
+            .map_err(err)?;
             a.draw(&Text::new(
                 format!("{}: {}", display_name(layer.algorithm), layer.line1),
                 (text_x, y),
@@ -507,58 +562,90 @@ impl Scene {
             ))
             .map_err(err)?;
             y += line;
-            a.draw(&Text::new(layer.line2.clone(), (text_x, y - 3), small.clone()))
-                .map_err(err)?;
+            a.draw(&Text::new(
+                layer.line2.clone(),
+                (text_x, y - 3),
+                small.clone(),
+            ))
+            .map_err(err)?;
             y += line;
         }
         y += line / 2;
         let grey = MUTED;
-        a.draw(&PathElement::new(swatch(y).to_vec(), grey.mix(0.55).stroke_width(2)))
-            .map_err(err)?;
+        a.draw(&PathElement::new(
+            swatch(y).to_vec(),
+            grey.mix(0.55).stroke_width(2),
+        ))
+        .map_err(err)?;
         a.draw(&Text::new("raw ant path (thin)", (text_x, y), body.clone()))
             .map_err(err)?;
         y += line;
         a.draw(&PathElement::new(swatch(y).to_vec(), grey.stroke_width(5)))
             .map_err(err)?;
-        a.draw(&Text::new("output path (smoothed for OHACA)", (text_x, y), body.clone()))
-            .map_err(err)?;
+        a.draw(&Text::new(
+            "output path (smoothed for OHACA)",
+            (text_x, y),
+            body.clone(),
+        ))
+        .map_err(err)?;
         y += line;
-        a.draw(&Circle::new((x + 17, y), 5, FREE.filled())).map_err(err)?;
-        a.draw(&Circle::new((x + 17, y), 4, grey.filled())).map_err(err)?;
+        a.draw(&Circle::new((x + 17, y), 5, FREE.filled()))
+            .map_err(err)?;
+        a.draw(&Circle::new((x + 17, y), 4, grey.filled()))
+            .map_err(err)?;
         a.draw(&Text::new("waypoint", (text_x, y), body.clone()))
             .map_err(err)?;
         y += line;
-        for (colour, label, p) in [
-            (START, "start", self.start),
-            (GOAL, "goal", self.goal),
-        ] {
-            a.draw(&Circle::new((x + 17, y), 8, colour.filled())).map_err(err)?;
+        for (colour, label, p) in [(START, "start", self.start), (GOAL, "goal", self.goal)] {
+            a.draw(&Circle::new((x + 17, y), 8, colour.filled()))
+                .map_err(err)?;
+            let metres = self.frame.map_or_else(String::new, |f| {
+                let [mx, my] = f.to_metres(p);
+                format!(" = ({mx:.2}, {my:.2}) m")
+            });
             a.draw(&Text::new(
-                format!("{label} ({},{})", p.x, p.y),
+                format!("{label} ({},{}){metres}", p.x, p.y),
                 (text_x, y),
                 body.clone(),
             ))
             .map_err(err)?;
             y += line;
         }
-        a.draw(&Rectangle::new([(x + 9, y - 8), (x + 25, y + 8)], BLOCKED.filled()))
-            .map_err(err)?;
+        a.draw(&Rectangle::new(
+            [(x + 9, y - 8), (x + 25, y + 8)],
+            BLOCKED.filled(),
+        ))
+        .map_err(err)?;
         a.draw(&Text::new("obstacle", (text_x, y), body.clone()))
             .map_err(err)?;
         y += line;
         if self.pheromone.is_some() {
             for k in 0..34 {
                 let c = heat(f64::from(k) / 33.0);
-                a.draw(&Rectangle::new([(x + k, y - 8), (x + k + 1, y + 8)], c.filled()))
-                    .map_err(err)?;
+                a.draw(&Rectangle::new(
+                    [(x + k, y - 8), (x + k + 1, y + 8)],
+                    c.filled(),
+                ))
+                .map_err(err)?;
             }
-            a.draw(&Rectangle::new([(x, y - 8), (x + 34, y + 8)], MUTED.stroke_width(1)))
-                .map_err(err)?;
-            a.draw(&Text::new("final pheromone (log scale)", (text_x, y), body.clone()))
-                .map_err(err)?;
+            a.draw(&Rectangle::new(
+                [(x, y - 8), (x + 34, y + 8)],
+                MUTED.stroke_width(1),
+            ))
+            .map_err(err)?;
+            a.draw(&Text::new(
+                "final pheromone (log scale)",
+                (text_x, y),
+                body.clone(),
+            ))
+            .map_err(err)?;
             y += line;
-            a.draw(&Text::new(self.pheromone_label.clone(), (text_x, y - 3), small.clone()))
-                .map_err(err)?;
+            a.draw(&Text::new(
+                self.pheromone_label.clone(),
+                (text_x, y - 3),
+                small.clone(),
+            ))
+            .map_err(err)?;
         }
         Ok(())
     }
@@ -667,8 +754,11 @@ impl Picture for Convergence {
             .bold_line_style(GRID.mix(1.0))
             .draw()
             .map_err(err)?;
-        for s in &self.series {
+        // Earlier lines wider, so lines that coincide still show every colour.
+        let n_series = self.series.len();
+        for (i, s) in self.series.iter().enumerate() {
             let colour = algorithm_colour(s.algorithm);
+            let width = 2 + u32::try_from(n_series - 1 - i).unwrap_or(0).min(4);
             let points: Vec<(f64, f64)> = s
                 .values
                 .iter()
@@ -677,11 +767,11 @@ impl Picture for Convergence {
                 .map(|(i, v)| ((i + 1) as f64, *v))
                 .collect();
             chart
-                .draw_series(LineSeries::new(points, colour.stroke_width(3)))
+                .draw_series(LineSeries::new(points, colour.stroke_width(width)))
                 .map_err(err)?
                 .label(display_name(s.algorithm))
                 .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 24, y)], colour.stroke_width(3))
+                    PathElement::new(vec![(x, y), (x + 24, y)], colour.stroke_width(width))
                 });
         }
         chart
@@ -717,6 +807,7 @@ mod tests {
             }],
             pheromone: pheromone.then(|| (0..18).map(|i| 0.01 + i as f32).collect()),
             pheromone_label: "of OHACA".into(),
+            frame: None,
             map,
         }
     }

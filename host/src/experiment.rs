@@ -11,6 +11,9 @@
 //! Definitions used in the summary:
 //! - **success**: the run found a path (with `--dead-end backtrack` that is every run on a
 //!   reachable goal; with `die`, a run where at least one ant arrived).
+//! - **ants arriving**: the share of all ants sent out (ants x iterations, over all runs) that
+//!   reached the goal: 100 % unless ants die at dead ends (`--dead-end die`). The paper's
+//!   "success rate" (89-98 %) reads like this figure.
 //! - **length**: the output path's length (smoothed for OHACA; for ACA/PACA/HACA the raw path's),
 //!   over successful runs; best = minimum, worst = maximum, std dev = sample standard deviation.
 //! - **convergence iteration**: 1-based iteration in which the run's best path was first found
@@ -57,6 +60,10 @@ pub struct RunResult {
     pub report: PlanReport,
     /// Best-so-far raw length per iteration.
     pub best_so_far: Vec<f32>,
+    /// Ants sent out over the run.
+    pub ants_sent: u64,
+    /// Ants that reached the goal.
+    pub ants_arrived: u64,
 }
 
 /// Every run of an experiment, in job order (algorithm by algorithm, seeds ascending).
@@ -115,6 +122,8 @@ pub fn run(
                     seed,
                     report,
                     best_so_far: t.best_so_far,
+                    ants_sent: t.ants_sent,
+                    ants_arrived: t.ants_arrived,
                 }
             })
         })
@@ -135,6 +144,9 @@ pub struct Stats {
     pub runs: usize,
     /// Runs that found a path.
     pub found: usize,
+    /// Share of all ants sent out that reached the goal, in per cent (the paper's "success
+    /// rate" reads like this; below 100 only when ants die at dead ends).
+    pub ant_success: Option<f64>,
     /// Shortest output length.
     pub best: Option<f64>,
     /// Mean output length.
@@ -190,11 +202,17 @@ impl Outcome {
             .iter()
             .filter_map(|r| r.report.iterations.map(f64::from))
             .collect();
-        let times: Vec<f64> = runs.iter().map(|r| r.report.elapsed_us as f64 / 1e3).collect();
+        let times: Vec<f64> = runs
+            .iter()
+            .map(|r| r.report.elapsed_us as f64 / 1e3)
+            .collect();
+        let sent: u64 = runs.iter().map(|r| r.ants_sent).sum();
+        let arrived: u64 = runs.iter().map(|r| r.ants_arrived).sum();
         Stats {
             algorithm: a,
             runs: runs.len(),
             found: ok.len(),
+            ant_success: (sent > 0).then(|| 100.0 * arrived as f64 / sent as f64),
             best: lens.iter().copied().reduce(f64::min),
             mean: m,
             std_dev,
@@ -305,12 +323,10 @@ impl Outcome {
 
     /// The best run of an algorithm: shortest output path, then the lowest seed.
     pub fn best_run(&self, a: Algorithm) -> Option<&RunResult> {
-        self.runs_of(a)
-            .filter(|r| r.report.found)
-            .min_by(|x, y| {
-                let l = |r: &RunResult| r.report.length.unwrap_or(f32::INFINITY);
-                l(x).total_cmp(&l(y)).then(x.seed.cmp(&y.seed))
-            })
+        self.runs_of(a).filter(|r| r.report.found).min_by(|x, y| {
+            let l = |r: &RunResult| r.report.length.unwrap_or(f32::INFINITY);
+            l(x).total_cmp(&l(y)).then(x.seed.cmp(&y.seed))
+        })
     }
 
     /// The picture of an algorithm's best run.
@@ -318,7 +334,7 @@ impl Outcome {
         let sc = &self.scenario;
         let (layer, which) = match self.best_run(a) {
             Some(r) => (
-                Layer::from_report(a, &r.report),
+                Layer::from_report(a, &r.report, sc.frame.map(|f| f.resolution)),
                 format!("best of {} runs (seed {})", self.config.runs, r.seed),
             ),
             None => {
@@ -345,13 +361,14 @@ impl Outcome {
                 sc.goal.x,
                 sc.goal.y
             ),
-            subtitle: format!("{which}; {}", params_line(&self.config.params)),
+            subtitle: format!("{which}; {}", params_brief(&self.config.params)),
             map: sc.map.clone(),
             start: sc.start,
             goal: sc.goal,
             layers: vec![layer],
             pheromone: None,
             pheromone_label: String::new(),
+            frame: sc.frame,
         }
     }
 
@@ -365,7 +382,10 @@ impl Outcome {
             "# Experiment: {}, ({},{}) -> ({},{})\n",
             sc.name, sc.start.x, sc.start.y, sc.goal.x, sc.goal.y
         );
-        let last = c.params.seed.wrapping_add(u64::from(c.runs.saturating_sub(1)));
+        let last = c
+            .params
+            .seed
+            .wrapping_add(u64::from(c.runs.saturating_sub(1)));
         let _ = writeln!(
             s,
             "{} runs per algorithm, seeds {}..={}; map {}x{} cells{}.\n",
@@ -392,8 +412,10 @@ impl Outcome {
                  (everything else in these files does not).\n",
             );
         } else {
-            s.push_str(": not recorded (`--no-timing`), so these files are byte-identical for \
-                        any number of threads.\n");
+            s.push_str(
+                ": not recorded (`--no-timing`), so these files are byte-identical for \
+                        any number of threads.\n",
+            );
         }
         s
     }
@@ -401,12 +423,13 @@ impl Outcome {
     /// The summary table (Markdown), one row per algorithm.
     pub fn table(&self) -> String {
         let mut s = String::from(
-            "| algorithm | success | best length | mean length | std dev | worst length | \
-             mean raw length | mean turns | mean convergence iteration | mean iterations | \
-             mean time (ms) |\n\
-             | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n",
+            "| algorithm | success | ants arriving | best length | mean length | std dev | \
+             worst length | mean raw length | mean turns | mean convergence iteration | \
+             mean iterations | mean time (ms) |\n\
+             | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n",
         );
-        let f = |v: Option<f64>, d: usize| v.map_or_else(|| "-".to_string(), |v| format!("{v:.d$}"));
+        let f =
+            |v: Option<f64>, d: usize| v.map_or_else(|| "-".to_string(), |v| format!("{v:.d$}"));
         for &a in &self.config.algorithms {
             let st = self.stats(a);
             let rate = if st.runs == 0 {
@@ -416,10 +439,11 @@ impl Outcome {
             };
             let _ = writeln!(
                 s,
-                "| {} | {}/{} ({rate:.0} %) | {} | {} | {} | {} | {} | {} | {} | {} | {:.3} |",
+                "| {} | {}/{} ({rate:.0} %) | {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.3} |",
                 draw::display_name(a),
                 st.found,
                 st.runs,
+                st.ant_success.map_or_else(|| "-".to_string(), |v| format!("{v:.1} %")),
                 f(st.best, 3),
                 f(st.mean, 3),
                 f(st.std_dev, 3),
@@ -442,7 +466,8 @@ impl Outcome {
             .map_err(|e| format!("{}: cannot create the folder: {e}", dir.display()))?;
         let text = |name: &str, body: String| -> Result<(), String> {
             let p = dir.join(name);
-            std::fs::write(&p, body).map_err(|e| format!("{}: cannot write the file: {e}", p.display()))
+            std::fs::write(&p, body)
+                .map_err(|e| format!("{}: cannot write the file: {e}", p.display()))
         };
         text("results.csv", self.results_csv())?;
         text("summary.md", self.summary_md())?;
@@ -457,6 +482,19 @@ impl Outcome {
         }
         Ok(())
     }
+}
+
+/// The parameters that matter most, as a short line for picture subtitles.
+pub fn params_brief(p: &Params) -> String {
+    format!(
+        "{} ants, up to {} iterations, patience {}, dead end {}, smoothing {}{}",
+        p.ants,
+        p.iterations,
+        p.patience,
+        dead_end_name(p.dead_end),
+        smoothing_name(p.smoothing),
+        if p.tighten { "" } else { ", no tightening" }
+    )
 }
 
 /// The parameters as one line (for titles and summaries).
@@ -491,8 +529,12 @@ mod tests {
     fn scenario() -> Scenario {
         Scenario {
             name: "t".into(),
-            map: Map::parse("........\n.###....\n....##..\n........\n", "t", Format::Text)
-                .unwrap(),
+            map: Map::parse(
+                "........\n.###....\n....##..\n........\n",
+                "t",
+                Format::Text,
+            )
+            .unwrap(),
             frame: None,
             start: Point::new(0, 0),
             goal: Point::new(7, 3),

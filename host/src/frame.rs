@@ -116,7 +116,10 @@ mod tests {
         let m = f.to_metres(Point::new(0, 0));
         assert!((m[1] - (2.0 + 29.5 * 0.05)).abs() < 1e-12);
         assert_eq!(f.cell([-1.0, 2.0]), Some(Point::new(0, 29)));
-        assert_eq!(f.cell([-1.0 + 0.0499, 2.0 + 0.0499]), Some(Point::new(0, 29)));
+        assert_eq!(
+            f.cell([-1.0 + 0.0499, 2.0 + 0.0499]),
+            Some(Point::new(0, 29))
+        );
         assert_eq!(f.cell([-1.0 + 0.05, 2.0 + 0.05]), Some(Point::new(1, 28)));
     }
 
@@ -125,8 +128,16 @@ mod tests {
         let f = frame(0.0);
         assert_eq!(f.cell([-1.001, 2.5]), None);
         assert_eq!(f.cell([-0.5, 1.999]), None);
-        assert_eq!(f.cell([-1.0 + 2.0, 2.5]), None, "x = width * res is outside");
-        assert_eq!(f.cell([0.0, 2.0 + 1.5]), None, "y = height * res is outside");
+        assert_eq!(
+            f.cell([-1.0 + 2.0, 2.5]),
+            None,
+            "x = width * res is outside"
+        );
+        assert_eq!(
+            f.cell([0.0, 2.0 + 1.5]),
+            None,
+            "y = height * res is outside"
+        );
         assert_eq!(f.cell([f64::NAN, 2.5]), None);
         assert_eq!(f.cell([f64::INFINITY, 2.5]), None);
     }

@@ -154,7 +154,9 @@ mod tests {
 
     #[test]
     fn inflate_matches_brute_force() {
-        let m = Map::from_fn(23, 17, |x, y| (x * 7 + y * 11) % 13 == 0 || (x > 15 && y > 10));
+        let m = Map::from_fn(23, 17, |x, y| {
+            (x * 7 + y * 11) % 13 == 0 || (x > 15 && y > 10)
+        });
         for r in [0.5, 1.0, 1.42, 2.3, 3.0, 4.7] {
             let fast = inflate(&m, r);
             let slow = Map::from_fn(m.width, m.height, |x, y| {
@@ -189,7 +191,11 @@ mod tests {
         // at the bottom (top anchor).
         let m = text("#..\n...\n...\n");
         let b = resample(&m, 2.0, true).unwrap();
-        assert_eq!(b.to_text(), "#.\n..\n", "top coarse row covers fine row 0 only");
+        assert_eq!(
+            b.to_text(),
+            "#.\n..\n",
+            "top coarse row covers fine row 0 only"
+        );
         let t = resample(&m, 2.0, false).unwrap();
         assert_eq!(t.to_text(), "#.\n..\n");
         let m = text("...\n...\n#..\n");
@@ -230,7 +236,10 @@ mod tests {
         assert_eq!((g.width, g.height, g.resolution), (3, 2, 0.1));
         // The coarse lower-left cell's centre is at origin + half a coarse cell.
         let p = g.to_metres(Point::new(0, 1));
-        assert!((p[0] - 1.05).abs() < 1e-12 && (p[1] + 1.95).abs() < 1e-12, "{p:?}");
+        assert!(
+            (p[0] - 1.05).abs() < 1e-12 && (p[1] + 1.95).abs() < 1e-12,
+            "{p:?}"
+        );
         // A fine cell and the coarse cell containing it agree in metres.
         for (x, y) in [(0u16, 2u16), (5, 0), (3, 1)] {
             let m = f.to_metres(Point::new(x, y));

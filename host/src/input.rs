@@ -203,27 +203,27 @@ impl MapArgs {
             frame = frame.map(|f| resample_frame(&f, &coarse, factor));
             map = coarse;
         }
-        let point = |what: &str, cells: Option<Point>, metres: Option<[f64; 2]>| {
-            match (cells, metres, frame) {
-                (Some(p), _, _) => Ok(p),
-                (None, Some(m), Some(f)) => f.cell(m).ok_or_else(|| {
-                    let [x0, x1, y0, y1] = f.extent();
-                    let bounds = if f.yaw == 0.0 {
-                        format!(" (x from {x0} to {x1} m, y from {y0} to {y1} m)")
-                    } else {
-                        String::new()
-                    };
-                    err(format!(
-                        "{what} ({}, {}) m is outside the map{bounds}",
-                        m[0], m[1]
-                    ))
-                }),
-                (None, Some(_), None) => Err(err(format!(
-                    "--{what}-m needs a map with a resolution (a ROS map_server YAML file); \
+        let point = |what: &str, cells: Option<Point>, metres: Option<[f64; 2]>| match (
+            cells, metres, frame,
+        ) {
+            (Some(p), _, _) => Ok(p),
+            (None, Some(m), Some(f)) => f.cell(m).ok_or_else(|| {
+                let [x0, x1, y0, y1] = f.extent();
+                let bounds = if f.yaw == 0.0 {
+                    format!(" (x from {x0} to {x1} m, y from {y0} to {y1} m)")
+                } else {
+                    String::new()
+                };
+                err(format!(
+                    "{what} ({}, {}) m is outside the map{bounds}",
+                    m[0], m[1]
+                ))
+            }),
+            (None, Some(_), None) => Err(err(format!(
+                "--{what}-m needs a map with a resolution (a ROS map_server YAML file); \
                      give --{what} in cells"
-                ))),
-                (None, None, _) => Err(err(format!("no {what} given (--{what} or --{what}-m)"))),
-            }
+            ))),
+            (None, None, _) => Err(err(format!("no {what} given (--{what} or --{what}-m)"))),
         };
         let start = point("start", self.start, self.start_m)?;
         let goal = point("goal", self.goal, self.goal_m)?;
@@ -288,7 +288,11 @@ impl Args for MultiParamArgs {
             a.action(ArgAction::Append)
                 .value_delimiter(',')
                 .visible_alias("algorithms")
-                .help("Planner variants: ohaca, haca, paca, aca; repeat or separate with commas")
+                .hide_default_value(true)
+                .help(
+                    "Planner variants: ohaca, haca, paca, aca; repeat or separate with commas \
+                     [default: render ohaca, experiment all four]",
+                )
         })
     }
 
@@ -330,13 +334,36 @@ mod tests {
         let t = parse(&["--map", "m", "--start", "1,2", "--goal-m", "-1.5,2"]).unwrap();
         assert_eq!(t.m.start, Some(Point::new(1, 2)));
         assert_eq!(t.m.goal_m, Some([-1.5, 2.0]));
-        assert!(parse(&["--map", "m", "--goal", "1,2"]).is_err(), "start missing");
-        assert!(parse(&["--map", "m", "--start", "1,2", "--start-m", "1,2", "--goal", "1,1"]).is_err());
+        assert!(
+            parse(&["--map", "m", "--goal", "1,2"]).is_err(),
+            "start missing"
+        );
+        assert!(parse(&[
+            "--map",
+            "m",
+            "--start",
+            "1,2",
+            "--start-m",
+            "1,2",
+            "--goal",
+            "1,1"
+        ])
+        .is_err());
         let t = parse(&["--map", "m", "--start", "0,0", "--goal", "1,1"]).unwrap();
         assert_eq!(t.m.unknown, Unknown::Blocked);
         let t = parse(&[
-            "--map", "m", "--start", "0,0", "--goal", "1,1", "--unknown", "free", "--inflate",
-            "0.3", "--cell", "0.1",
+            "--map",
+            "m",
+            "--start",
+            "0,0",
+            "--goal",
+            "1,1",
+            "--unknown",
+            "free",
+            "--inflate",
+            "0.3",
+            "--cell",
+            "0.1",
         ])
         .unwrap();
         assert_eq!(

@@ -1,7 +1,7 @@
 //! # ohaca-host — the host side of ohaca
 //!
 //! The library behind the `ohaca` command-line tool, reusable by the tests and by every
-//! subcommand (`plan` today; `send`, `render`, `experiment`, `bench` later). It runs the `no_std`
+//! subcommand (`plan`, `render`, `experiment`, `send`; `bench` later). It runs the `no_std`
 //! core ([`ohaca`]) under std: it loads maps from files, lends the planner heap buffers instead of
 //! a fixed-size `Storage`, and turns results into a stable JSON report or an ASCII picture.
 //!

@@ -557,7 +557,9 @@ impl<T: Transport> Link<T> {
 
     /// Write bytes as they are (a test may send broken frames). Bounded by [`Link::timeout`].
     pub fn send_raw(&mut self, bytes: &[u8]) -> Result<(), LinkError> {
-        self.io.set_io_timeout(self.timeout).map_err(LinkError::Io)?;
+        self.io
+            .set_io_timeout(self.timeout)
+            .map_err(LinkError::Io)?;
         match self.io.write_all(bytes).and_then(|()| self.io.flush()) {
             Ok(()) => Ok(()),
             Err(e) if is_timeout(&e) => Err(LinkError::Timeout {
@@ -735,7 +737,9 @@ impl<T: Transport> Link<T> {
         let mut busy_since: Option<Instant> = None;
         while emitted < jobs.len() {
             while inflight.len() < window {
-                let Some(i) = retry.pop_front().or_else(|| (next < jobs.len()).then_some(next))
+                let Some(i) = retry
+                    .pop_front()
+                    .or_else(|| (next < jobs.len()).then_some(next))
                 else {
                     break;
                 };
@@ -764,16 +768,16 @@ impl<T: Transport> Link<T> {
                 continue;
             }
             let first = inflight.keys().min().copied().unwrap_or(0);
-            let (id, resp) = match self.wait_matching(|id| inflight.contains_key(&id), "Plan", first)
-            {
-                Ok(r) => r,
-                Err(e) => {
-                    for id in inflight.keys() {
-                        self.outstanding.remove(id);
+            let (id, resp) =
+                match self.wait_matching(|id| inflight.contains_key(&id), "Plan", first) {
+                    Ok(r) => r,
+                    Err(e) => {
+                        for id in inflight.keys() {
+                            self.outstanding.remove(id);
+                        }
+                        return Err(e);
                     }
-                    return Err(e);
-                }
-            };
+                };
             let Some((i, sent)) = inflight.remove(&id) else {
                 continue;
             };
@@ -860,9 +864,7 @@ impl<T: Transport> Link<T> {
                 };
                 self.rx_pos += 1;
                 if let Some(frame) = self.reader.push(b).into_frame(MAX_REPLY_WIRE) {
-                    let (got, reply) = frame
-                        .and_then(|f| decode_reply(f))
-                        .map_err(LinkError::Decode)?;
+                    let (got, reply) = frame.and_then(decode_reply).map_err(LinkError::Decode)?;
                     return Ok((got, Response::from(&reply)));
                 }
             }
@@ -906,11 +908,14 @@ mod tests {
     use super::*;
     use ohaca::protocol::{decode_request, encode_reply, RequestReader, Waypoints};
 
+    /// The fake device's script: the replies to one request.
+    type Answer = dyn FnMut(u32, Request<'_>) -> Vec<(u32, Response)>;
+
     /// A fake device: answers requests written to it from a scripted function.
     struct Fake {
         input: RequestReader,
         out: VecDeque<u8>,
-        answer: Box<dyn FnMut(u32, Request<'_>) -> Vec<(u32, Response)>>,
+        answer: Box<Answer>,
         timeouts: u32,
     }
 
@@ -1070,10 +1075,7 @@ mod tests {
         });
         let e = link.stats().unwrap_err();
         assert!(matches!(e, LinkError::Timeout { id: 1, .. }), "{e}");
-        assert_eq!(
-            e.to_string(),
-            "no reply to Stats (request 1) within 0.05 s"
-        );
+        assert_eq!(e.to_string(), "no reply to Stats (request 1) within 0.05 s");
         let m = Map::from_fn(40, 40, |_, _| false);
         let e = link.set_map(&m).unwrap_err();
         assert_eq!(e.code(), Some(ErrorCode::MapTooLarge));
@@ -1197,7 +1199,10 @@ mod tests {
             })
             .collect();
         let out = link.plan_many(&jobs).unwrap();
-        let moves: Vec<u64> = out.iter().map(|o| o.result.as_ref().unwrap().moves).collect();
+        let moves: Vec<u64> = out
+            .iter()
+            .map(|o| o.result.as_ref().unwrap().moves)
+            .collect();
         assert_eq!(moves, vec![0, 1, 2]);
     }
 

@@ -32,8 +32,12 @@ struct Cli {
 
 #[derive(Subcommand, Debug)]
 enum Command {
-    /// Plan a path on a map file and print it (ASCII picture, or JSON with --json)
+    /// Plan a path on a map file and print it (ASCII picture, JSON or CSV: --format)
     Plan(cmd::plan::Args),
+    /// Plan and draw the map with the paths (and the pheromone) into an SVG or PNG file
+    Render(cmd::render::Args),
+    /// Run the algorithms many times each; write CSV, a summary and charts into a folder
+    Experiment(cmd::experiment::Args),
     /// Plan on the firmware over TCP (QEMU) or a serial port; prints what `plan` prints
     Send(cmd::send::Args),
 }
@@ -45,6 +49,8 @@ fn main() -> ExitCode {
     };
     let code = match cli.command {
         Command::Plan(args) => cmd::plan::run(&args),
+        Command::Render(args) => cmd::render::run(&args),
+        Command::Experiment(args) => cmd::experiment::run(&args),
         Command::Send(args) => cmd::send::run(&args),
     };
     ExitCode::from(code)

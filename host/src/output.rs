@@ -450,7 +450,10 @@ mod tests {
         }
         .to_json();
         assert!(j.starts_with(&r.to_json()[..r.to_json().len() - 1]), "{j}");
-        assert!(j.ends_with(",\"waypoints_m\":[[0.025,1.5],[-2.0,0.0]]}"), "{j}");
+        assert!(
+            j.ends_with(",\"waypoints_m\":[[0.025,1.5],[-2.0,0.0]]}"),
+            "{j}"
+        );
         let back: PlanReport = serde_json::from_str(&j).unwrap();
         assert_eq!(back, r);
     }

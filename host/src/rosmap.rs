@@ -147,7 +147,11 @@ impl RosMeta {
         };
 
         let origin = match field("origin") {
-            None => return Err("missing field `origin` ([x, y, yaw] of the lower-left pixel)".to_string()),
+            None => {
+                return Err(
+                    "missing field `origin` ([x, y, yaw] of the lower-left pixel)".to_string(),
+                )
+            }
             Some(v) => {
                 let want = "a list [x, y, yaw] of numbers";
                 let seq = v.as_sequence().ok_or_else(|| bad("origin", want, v))?;
@@ -282,7 +286,8 @@ pub fn load_ros(yaml: &Path, unknown: Unknown) -> Result<(Map, Frame), InputErro
         path: name.clone(),
         problem,
     };
-    let text = std::fs::read_to_string(yaml).map_err(|e| err(format!("cannot read the file: {e}")))?;
+    let text =
+        std::fs::read_to_string(yaml).map_err(|e| err(format!("cannot read the file: {e}")))?;
     let meta = RosMeta::parse(&text, yaml).map_err(err)?;
     if !meta.image.exists() {
         return Err(err(format!(
@@ -342,7 +347,10 @@ mod tests {
         assert!(!m.negate);
         assert_eq!((m.occupied_thresh, m.free_thresh), (0.65, 0.196));
         assert_eq!(m.mode, Mode::Trinary);
-        let m = meta("image: /abs/x.png\nresolution: 1\norigin: [0, 0]\nnegate: 1\nmode: raw\nname: lab\n").unwrap();
+        let m = meta(
+            "image: /abs/x.png\nresolution: 1\norigin: [0, 0]\nnegate: 1\nmode: raw\nname: lab\n",
+        )
+        .unwrap();
         assert_eq!(m.image, Path::new("/abs/x.png"));
         assert!(m.negate);
         assert_eq!(m.origin, [0.0, 0.0, 0.0]);
@@ -354,7 +362,10 @@ mod tests {
     fn field_errors() {
         let cases = [
             ("resolution: 1\norigin: [0,0,0]\n", "missing field `image`"),
-            ("image: a.pgm\norigin: [0,0,0]\n", "missing field `resolution`"),
+            (
+                "image: a.pgm\norigin: [0,0,0]\n",
+                "missing field `resolution`",
+            ),
             ("image: a.pgm\nresolution: 1\n", "missing field `origin`"),
             (
                 "image: a.pgm\nresolution: 0\norigin: [0,0,0]\n",
@@ -414,20 +425,37 @@ mod tests {
         let m = meta(OK).unwrap();
         assert_eq!(m.classify(254.0, 255), Occupancy::Free);
         assert_eq!(m.classify(0.0, 255), Occupancy::Occupied);
-        assert_eq!(m.classify(205.0, 255), Occupancy::Unknown, "map_saver's unknown");
+        assert_eq!(
+            m.classify(205.0, 255),
+            Occupancy::Unknown,
+            "map_saver's unknown"
+        );
         // p = (255 - 89) / 255 = 0.651 > 0.65; p(90) = 0.647.
         assert_eq!(m.classify(89.0, 255), Occupancy::Occupied);
         assert_eq!(m.classify(90.0, 255), Occupancy::Unknown);
         // p(206) = 0.192 < 0.196.
         assert_eq!(m.classify(206.0, 255), Occupancy::Free);
-        assert_eq!(m.classify(254.0, 0), Occupancy::Free, "trinary ignores alpha");
-        let neg = RosMeta { negate: true, ..m.clone() };
+        assert_eq!(
+            m.classify(254.0, 0),
+            Occupancy::Free,
+            "trinary ignores alpha"
+        );
+        let neg = RosMeta {
+            negate: true,
+            ..m.clone()
+        };
         assert_eq!(neg.classify(0.0, 255), Occupancy::Free);
         assert_eq!(neg.classify(255.0, 255), Occupancy::Occupied);
-        let scale = RosMeta { mode: Mode::Scale, ..m.clone() };
+        let scale = RosMeta {
+            mode: Mode::Scale,
+            ..m.clone()
+        };
         assert_eq!(scale.classify(254.0, 128), Occupancy::Unknown);
         assert_eq!(scale.classify(254.0, 255), Occupancy::Free);
-        let raw = RosMeta { mode: Mode::Raw, ..m };
+        let raw = RosMeta {
+            mode: Mode::Raw,
+            ..m
+        };
         assert_eq!(raw.classify(0.0, 255), Occupancy::Free);
         assert_eq!(raw.classify(100.0, 255), Occupancy::Occupied);
         assert_eq!(raw.classify(50.0, 255), Occupancy::Unknown);

@@ -25,6 +25,11 @@ pub struct Traced {
     pub best_so_far: Vec<f32>,
     /// The final pheromone, `[E, SE, S, SW]` per cell, row-major (see [`ohaca::pheromone`]).
     pub pheromone: Option<Vec<[f32; 4]>>,
+    /// Ants sent out over the run (`ants x iterations`).
+    pub ants_sent: u64,
+    /// Ants that reached the goal ([`ohaca::CurvePoint::arrived`], summed); smaller than
+    /// `ants_sent` only when ants die at dead ends.
+    pub ants_arrived: u64,
 }
 
 /// Plan like [`crate::planning::plan_map_in`], keeping the curve and (with `pheromone`) a copy of
@@ -48,17 +53,21 @@ pub fn plan_traced(
                 report: PlanReport::not_found(params, Error::NoPath, Some(0), t0.elapsed()),
                 best_so_far: Vec::new(),
                 pheromone: None,
+                ants_sent: 0,
+                ants_arrived: 0,
             })
         }
         Err(e) => return Err(e.into()),
     };
     while run.step() {}
     let iterations = run.iteration();
-    let (report, best_so_far) = match run.finish() {
+    let ants_sent = u64::from(iterations) * u64::from(params.ants);
+    let (report, best_so_far, ants_arrived) = match run.finish() {
         Ok(plan) => {
             let report = PlanReport::from_plan(&plan, t0.elapsed());
             let curve = plan.curve().iter().map(|c| c.best_so_far).collect();
-            (report, curve)
+            let arrived = plan.curve().iter().map(|c| u64::from(c.arrived)).sum();
+            (report, curve, arrived)
         }
         // Only with `DeadEnd::Die`: no ant ever arrived, so the best so far was never finite.
         Err(Error::NoAntArrived) => (
@@ -69,6 +78,7 @@ pub fn plan_traced(
                 t0.elapsed(),
             ),
             vec![f32::INFINITY; usize::from(iterations)],
+            0,
         ),
         Err(e) => return Err(e.into()),
     };
@@ -82,6 +92,8 @@ pub fn plan_traced(
         report,
         best_so_far,
         pheromone,
+        ants_sent,
+        ants_arrived,
     })
 }
 
@@ -145,7 +157,10 @@ mod tests {
             r
         };
         assert_eq!(strip(t.report.clone()), strip(a));
-        assert_eq!(t.best_so_far.len(), usize::from(t.report.iterations.unwrap()));
+        assert_eq!(
+            t.best_so_far.len(),
+            usize::from(t.report.iterations.unwrap())
+        );
         assert_eq!(
             t.best_so_far.last().copied(),
             t.report.raw_length,
@@ -154,7 +169,10 @@ mod tests {
         assert!(t.best_so_far.windows(2).all(|w| w[1] <= w[0]));
         let tau = t.pheromone.unwrap();
         assert_eq!(tau.len(), m.cells());
-        assert!(tau.iter().flatten().all(|v| *v >= p.tau_min && *v <= p.tau_max));
+        assert!(tau
+            .iter()
+            .flatten()
+            .all(|v| *v >= p.tau_min && *v <= p.tau_max));
         // Something was deposited: the table is not uniform any more.
         assert!(tau.iter().flatten().any(|v| *v != tau[0][0]));
     }
@@ -163,8 +181,15 @@ mod tests {
     fn unreachable_and_dead_ants() {
         let m = Map::parse(".#.\n##.\n...\n", "t", Format::Text).unwrap();
         let mut st = HeapStorage::default();
-        let t = plan_traced(&mut st, &m, Point::new(0, 0), Point::new(2, 2), &Params::default(), true)
-            .unwrap();
+        let t = plan_traced(
+            &mut st,
+            &m,
+            Point::new(0, 0),
+            Point::new(2, 2),
+            &Params::default(),
+            true,
+        )
+        .unwrap();
         assert!(!t.report.found);
         assert!(t.best_so_far.is_empty());
         assert!(t.pheromone.is_none());
@@ -184,8 +209,8 @@ mod tests {
                 seed,
                 ..Params::default()
             };
-            let t = plan_traced(&mut st, &m, Point::new(0, 3), Point::new(9, 3), &p, false)
-                .unwrap();
+            let t =
+                plan_traced(&mut st, &m, Point::new(0, 3), Point::new(9, 3), &p, false).unwrap();
             if !t.report.found {
                 assert_eq!(t.best_so_far, vec![f32::INFINITY; 2]);
             }

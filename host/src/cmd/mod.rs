@@ -1,6 +1,8 @@
 //! The subcommands, one module each, plus the output helpers they share.
 
+pub mod experiment;
 pub mod plan;
+pub mod render;
 pub mod send;
 
 use std::io::Write;

@@ -18,10 +18,13 @@ use std::time::{Duration, Instant};
 
 use ohaca::protocol::{ErrorCode, ErrorReply};
 use ohaca::{Error, Params, Point};
+use ohaca_host::frame::{round_um, Frame};
+use ohaca_host::input::load_map;
 use ohaca_host::link::{
     core_error, DeviceInfo, DevicePath, Link, LinkError, PlanJob, Transport, DEFAULT_BAUD,
 };
-use ohaca_host::output::{format_us, micros, render, xy, ParamsReport, PlanReport};
+use ohaca_host::output::{format_us, micros, render, xy, LocatedReport, ParamsReport, PlanReport};
+use ohaca_host::rosmap::Unknown;
 use ohaca_host::{exit, parse_point, Map, ParamArgs};
 use serde::Serialize;
 
@@ -43,7 +46,8 @@ pub struct Args {
     /// Seconds to wait for each reply (and for the connection)
     #[arg(long, value_name = "SECONDS", default_value = "10", value_parser = parse_timeout)]
     pub timeout: Duration,
-    /// Map file: Moving AI `.map`, or a text grid (`.`/`0` free, `#`/`1` blocked)
+    /// Map file: Moving AI `.map`, a text grid (`.`/`0` free, `#`/`1` blocked), a ROS
+    /// map_server `.yaml` or a PNG/PGM image (unknown and dark cells blocked), as `plan` reads
     #[arg(long, value_name = "FILE")]
     pub map: PathBuf,
     /// Start cell: column,row with 0,0 the top-left cell
@@ -77,11 +81,12 @@ fn parse_timeout(s: &str) -> Result<Duration, String> {
     Duration::try_from_secs_f64(v).map_err(|e| e.to_string())
 }
 
-/// What `send --json` prints: the `plan` report's keys, then `ticks` and `device`.
+/// What `send --json` prints: the `plan` report's keys (`waypoints_m` too, for maps with a
+/// resolution), then `ticks` and `device`.
 #[derive(Serialize)]
 struct SendReport<'a> {
     #[serde(flatten)]
-    report: &'a PlanReport,
+    report: LocatedReport<'a>,
     /// Device time of the plan (`tick_hz` units), null if no path.
     ticks: Option<u64>,
     /// The device's board name.
@@ -112,6 +117,8 @@ struct Session {
     /// `--tcp` or `--serial`, for messages.
     target: String,
     map: Map,
+    /// Where the map's cells are in metres (ROS maps).
+    frame: Option<Frame>,
     params: Params,
     jobs: Vec<PlanJob>,
 }
@@ -175,7 +182,7 @@ fn too_large(map_path: &Path, map: &Map, info: &DeviceInfo) -> String {
 impl Session {
     /// Everything that can be checked before connecting.
     fn prepare(args: &Args) -> Result<Session, String> {
-        let map = Map::load(&args.map).map_err(|e| e.to_string())?;
+        let (map, frame) = load_map(&args.map, Unknown::default()).map_err(|e| e.to_string())?;
         let params = args.params.params();
         params.validate().map_err(|e| e.to_string())?;
         let jobs = match (&args.goals, args.start, args.goal) {
@@ -192,9 +199,24 @@ impl Session {
         Ok(Session {
             target: target.to_string(),
             map,
+            frame,
             params,
             jobs,
         })
+    }
+
+    /// The waypoints in metres (rounded to a micrometre), for maps with a resolution.
+    fn metres(&self, waypoints: &[[u16; 2]]) -> Option<Vec<[f64; 2]>> {
+        let f = self.frame?;
+        Some(
+            waypoints
+                .iter()
+                .map(|&[x, y]| {
+                    let [mx, my] = f.to_metres(Point::new(x, y));
+                    [round_um(mx), round_um(my)]
+                })
+                .collect(),
+        )
     }
 
     /// `error: <target>: <what>`.
@@ -270,7 +292,7 @@ impl Session {
         };
         let outcome = self.report(job, result, t0.elapsed());
         let (report, ticks) = match outcome {
-            Outcome::Report(r, t) => (r, t),
+            Outcome::Report(r, t) => (*r, t),
             Outcome::BadInput(msg) => return Err(msg),
         };
         let code = if report.found {
@@ -279,8 +301,12 @@ impl Session {
             exit::NO_PATH
         };
         if args.json {
+            let metres = self.metres(&report.waypoints);
             let mut s = SendReport {
-                report: &report,
+                report: LocatedReport {
+                    report: &report,
+                    waypoints_m: metres.as_deref(),
+                },
                 ticks,
                 device: &info.board,
             }
@@ -302,10 +328,16 @@ impl Session {
                 info.firmware_version
             );
             s.push_str(&render(&self.map, job.start, job.goal, &report));
+            if let (Some(m), true) = (self.metres(&report.waypoints), report.found) {
+                let pts: Vec<String> = m.iter().map(|[x, y]| format!("({x}, {y})")).collect();
+                s.push_str("waypoints in metres (map frame): ");
+                s.push_str(&pts.join(" "));
+                s.push('\n');
+            }
             if let Some(t) = ticks {
                 let hz = u64::from(info.capacity.tick_hz.max(1));
-                let us = u64::try_from(u128::from(t) * 1_000_000 / u128::from(hz))
-                    .unwrap_or(u64::MAX);
+                let us =
+                    u64::try_from(u128::from(t) * 1_000_000 / u128::from(hz)).unwrap_or(u64::MAX);
                 s.push_str(&format!(
                     "device time {} ({t} ticks at {hz} Hz), round trip {}\n",
                     format_us(us),
@@ -327,7 +359,7 @@ impl Session {
                     if !r.found {
                         code = code.max(exit::NO_PATH);
                     }
-                    (r, t)
+                    (*r, t)
                 }
                 Outcome::BadInput(msg) => {
                     code = exit::BAD_INPUT;
@@ -337,8 +369,12 @@ impl Session {
                     )
                 }
             };
+            let metres = self.metres(&report.waypoints);
             let mut s = SendReport {
-                report: &report,
+                report: LocatedReport {
+                    report: &report,
+                    waypoints_m: metres.as_deref(),
+                },
                 ticks,
                 device: &info.board,
             }
@@ -364,14 +400,13 @@ impl Session {
             Ok(p) => p,
             Err(e) => {
                 return match core_error(&e) {
-                    Some(err @ Error::NoPath) => Outcome::Report(
+                    Some(err @ Error::NoPath) => Outcome::found(
                         PlanReport::not_found(&params, err, Some(0), round_trip),
                         None,
                     ),
-                    Some(err @ Error::NoAntArrived) => Outcome::Report(
-                        PlanReport::not_found(&params, err, None, round_trip),
-                        None,
-                    ),
+                    Some(err @ Error::NoAntArrived) => {
+                        Outcome::found(PlanReport::not_found(&params, err, None, round_trip), None)
+                    }
                     Some(err @ (Error::OutOfBounds(_) | Error::Blocked(_))) => {
                         Outcome::BadInput(format!(
                             "{err} (start {},{}, goal {},{}, map {}x{})",
@@ -415,17 +450,25 @@ impl Session {
             params: ParamsReport::from(&params),
             error: None,
         };
-        Outcome::Report(report, Some(path.ticks))
+        Outcome::found(report, Some(path.ticks))
     }
 }
 
 /// A device answer as a report (with its ticks), or a bad-input message.
 enum Outcome {
-    Report(PlanReport, Option<u64>),
+    Report(Box<PlanReport>, Option<u64>),
     BadInput(String),
 }
 
+impl Outcome {
+    /// A report (found, or a normal "no path").
+    fn found(report: PlanReport, ticks: Option<u64>) -> Self {
+        Outcome::Report(Box::new(report), ticks)
+    }
+}
+
 #[cfg(test)]
+#[allow(clippy::unwrap_used)]
 mod tests {
     use super::*;
 
