@@ -1,13 +1,18 @@
 #!/usr/bin/env bash
-# Run every test of ohaca: core unit tests and doc tests, host-tool tests, property tests,
-# shared-map checks, and the firmware's end-to-end tests under QEMU.
+# Run every test of ohaca: the core's unit tests and doc examples, the protocol's byte-exact
+# document test, the host tool's tests, the exact references and property tests, the shared-map
+# checks, and the firmware under QEMU (end-to-end over its emulated UART, and its golden boot log).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 source scripts/setup.sh
 
-# The core's unit tests and doc examples, on the host.
+# The core (planner + protocol): unit tests and doc examples, on the host.
 cargo test -p ohaca --target host-tuple
-# Host tool, references, properties, shared maps, QEMU end-to-end (release: the shared-map
-# quality runs plan thousands of times).
+# The QEMU firmware the end-to-end tests boot.
 cargo build --release
+# Host tool (incl. QEMU end-to-end tests), references, properties, shared maps. Release: the
+# shared-map checks plan thousands of times.
 cargo test --release -p ohaca-host -p ohaca-host-tests --target host-tuple
+# The firmware's boot log against tests/golden/boot.txt, and the protocol selftest over QEMU.
+scripts/golden-boot.sh --no-build
+scripts/qemu-selftest.sh --no-build

@@ -124,7 +124,9 @@ fn main() -> ExitCode {
          worst raw / opt8 | worst smoothed / any-angle | mean turns | mean best_iteration | \
          mean iterations | mean ant moves |"
     );
-    println!("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |");
+    println!(
+        "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |"
+    );
     let mut bad = Vec::new();
     let t1 = Instant::now();
     let mut all = Vec::new();

@@ -135,6 +135,20 @@ pub fn corners(points: &[Point]) -> Vec<Point> {
     out
 }
 
+/// The first pair `(i, j)` with `j >= i + 2` such that `raw[j]` is one allowed move from `raw[i]`:
+/// a detour that [`ohaca::colony::tighten`] promises to remove. `None` for a tight path.
+pub fn shortcut(map: &Map, raw: &[Point]) -> Option<(usize, usize)> {
+    (0..raw.len()).find_map(|i| {
+        (i + 2..raw.len())
+            .find(|&j| {
+                let dx = i64::from(raw[j].x) - i64::from(raw[i].x);
+                let dy = i64::from(raw[j].y) - i64::from(raw[i].y);
+                step_allowed(map, raw[i], dx, dy)
+            })
+            .map(|j| (i, j))
+    })
+}
+
 /// True if `sub` is a subsequence of `seq` (same order, not necessarily contiguous).
 pub fn is_subsequence(sub: &[Point], seq: &[Point]) -> bool {
     let mut it = seq.iter();
@@ -173,15 +187,28 @@ pub fn check_plan(
             raw.len()
         ));
     }
+    // The ants' tabu list (and tightening) keep the path loop-free.
+    let mut seen = std::collections::HashSet::new();
+    if let Some(p) = raw.iter().find(|p| !seen.insert(**p)) {
+        return Err(format!("raw path visits {p:?} twice"));
+    }
+    // A walk takes at most 2 * cells moves (each cell entered once, left backwards once).
+    let p = &plan.params;
+    let max_moves = u64::from(p.ants) * u64::from(plan.iterations) * 2 * map.cells() as u64;
+    if plan.moves > max_moves {
+        return Err(format!(
+            "{} ant moves, at most {max_moves} possible",
+            plan.moves
+        ));
+    }
     let waypoints = plan.waypoints().to_vec();
     let length = check_waypoints(map, start, goal, &waypoints)?;
     if !is_subsequence(&waypoints, &raw) {
         return Err("waypoints are not a subsequence of the raw path".into());
     }
     // Lengths.
-    let close = |reported: f32, exact: f64| {
-        (f64::from(reported) - exact).abs() <= length_tolerance(exact)
-    };
+    let close =
+        |reported: f32, exact: f64| (f64::from(reported) - exact).abs() <= length_tolerance(exact);
     if !close(plan.raw_length, raw_length) {
         return Err(format!(
             "raw_length {} but the raw path is {raw_length}",
@@ -233,7 +260,6 @@ pub fn check_plan(
         ));
     }
     // Iteration bookkeeping.
-    let p = &plan.params;
     let (its, best_it) = (plan.iterations, plan.best_iteration);
     if its == 0 || its > p.iterations || best_it >= its {
         return Err(format!(
@@ -268,7 +294,9 @@ pub fn check_plan(
                 c.best_so_far
             ));
         }
-        if c.best.is_finite() != c.mean.is_finite() || (c.best.is_finite() && c.mean < c.best * (1.0 - 1e-6)) {
+        if c.best.is_finite() != c.mean.is_finite()
+            || (c.best.is_finite() && c.mean < c.best * (1.0 - 1e-6))
+        {
             return Err(format!("curve[{i}]: mean {} below best {}", c.mean, c.best));
         }
         let first_best = i == usize::from(best_it);
@@ -330,7 +358,13 @@ mod tests {
         assert!((l - (2.0 + 5f64.sqrt())).abs() < 1e-12);
         assert_eq!(count_turns(&[p(0, 0), p(1, 0), p(2, 0), p(3, 1)]), 1);
         assert_eq!(count_turns(&[p(0, 0), p(2, 0), p(1, 0)]), 1);
-        assert!(is_subsequence(&[p(0, 0), p(2, 0)], &[p(0, 0), p(1, 0), p(2, 0)]));
-        assert!(!is_subsequence(&[p(2, 0), p(0, 0)], &[p(0, 0), p(1, 0), p(2, 0)]));
+        assert!(is_subsequence(
+            &[p(0, 0), p(2, 0)],
+            &[p(0, 0), p(1, 0), p(2, 0)]
+        ));
+        assert!(!is_subsequence(
+            &[p(2, 0), p(0, 0)],
+            &[p(0, 0), p(1, 0), p(2, 0)]
+        ));
     }
 }

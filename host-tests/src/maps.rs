@@ -125,8 +125,7 @@ impl Map {
     /// Load a Moving AI `.map` file.
     pub fn load(path: impl AsRef<Path>) -> Result<Map, String> {
         let path = path.as_ref();
-        let text =
-            std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+        let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
         Map::parse(&text).map_err(|e| format!("{}: {e}", path.display()))
     }
 
@@ -235,9 +234,7 @@ fn to_u16(v: usize) -> u16 {
 }
 
 fn parse_num<T: std::str::FromStr>(s: &str, what: &str) -> Result<T, String> {
-    s.trim()
-        .parse()
-        .map_err(|_| format!("bad {what} {s:?}"))
+    s.trim().parse().map_err(|_| format!("bad {what} {s:?}"))
 }
 
 /// One line of a `.scen` file.
@@ -262,9 +259,11 @@ pub struct ScenEntry {
 /// Parse a `.scen` file's text.
 pub fn parse_scen(text: &str) -> Result<Vec<ScenEntry>, String> {
     let mut lines = text.lines().filter(|l| !l.trim().is_empty());
-    match lines.next().map(str::split_whitespace).map(|mut w| {
-        (w.next(), w.next())
-    }) {
+    match lines
+        .next()
+        .map(str::split_whitespace)
+        .map(|mut w| (w.next(), w.next()))
+    {
         Some((Some("version"), Some(v))) if v.starts_with('1') => {}
         other => return Err(format!("expected `version 1`, got {other:?}")),
     }
@@ -302,7 +301,9 @@ pub fn load_scen(path: impl AsRef<Path>) -> Result<Vec<ScenEntry>, String> {
 
 /// The repository's `maps/` directory.
 pub fn maps_dir() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join("maps")
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("..")
+        .join("maps")
 }
 
 /// One start/goal pair on a shared map.
@@ -332,9 +333,12 @@ pub struct MapScenarios {
 /// How many `.scen` scenarios [`scenarios`] takes from each Moving AI map.
 pub const SCEN_PER_MAP: usize = 20;
 
+/// `(file, start, goal, 8-connected optimum, any-angle optimum)` of a fixed pair.
+pub type FixedPair = (&'static str, (u16, u16), (u16, u16), f64, f64);
+
 /// The fixed maps and their start/goal pairs and optima, from `maps/README.md`:
 /// `(file, start, goal, 8-connected optimum, any-angle optimum)`.
-pub const FIXED: [(&str, (u16, u16), (u16, u16), f64, f64); 3] = [
+pub const FIXED: [FixedPair; 3] = [
     ("simple-18", (0, 0), (17, 17), 26.9706, 24.9541),
     ("complex-26", (0, 0), (25, 25), 41.7990, 39.1470),
     ("classic-20", (0, 0), (19, 19), 37.8995, 36.8518),
@@ -448,7 +452,11 @@ mod tests {
         assert_eq!(counts, [1, 1, 1, SCEN_PER_MAP, SCEN_PER_MAP]);
         for m in &all {
             for c in &m.cases {
-                assert!(m.map.is_free(c.start) && m.map.is_free(c.goal), "{}", m.name);
+                assert!(
+                    m.map.is_free(c.start) && m.map.is_free(c.goal),
+                    "{}",
+                    m.name
+                );
             }
             // Largest first.
             for w in m.cases.windows(2) {

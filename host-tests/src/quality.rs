@@ -152,7 +152,12 @@ pub struct Run {
 }
 
 /// Plan one scenario with `params` (whose seed is used as given) and validate the result.
-pub fn run_one(map: &Map, case: &PreparedCase, params: &Params, storage: &mut HeapStorage) -> (Outcome, Duration) {
+pub fn run_one(
+    map: &Map,
+    case: &PreparedCase,
+    params: &Params,
+    storage: &mut HeapStorage,
+) -> (Outcome, Duration) {
     let grid = map.grid();
     let t0 = Instant::now();
     let result = plan(&grid, case.start, case.goal, params, storage.workspace());

@@ -57,17 +57,15 @@ fn step_cost(dx: i64, dy: i64) -> f64 {
 
 /// The allowed neighbours of `p` with their step costs.
 pub fn neighbours(map: &Map, p: Point) -> impl Iterator<Item = (Point, f64)> + '_ {
-    MOVES.iter().filter_map(move |&(dx, dy)| {
-        step_allowed(map, p, dx, dy).then(|| {
+    MOVES
+        .iter()
+        .filter(move |&&(dx, dy)| step_allowed(map, p, dx, dy))
+        .map(move |&(dx, dy)| {
             (
-                Point::new(
-                    (i64::from(p.x) + dx) as u16,
-                    (i64::from(p.y) + dy) as u16,
-                ),
+                Point::new((i64::from(p.x) + dx) as u16, (i64::from(p.y) + dy) as u16),
                 step_cost(dx, dy),
             )
         })
-    })
 }
 
 /// A min-heap entry ordered by `f64` key (then index, for a total order).
@@ -232,7 +230,8 @@ impl<'m> Segments<'m> {
             for x in 0..w {
                 let b = u32::from(map.blocked()[y * w + x]);
                 sum[(y + 1) * (w + 1) + x + 1] =
-                    b + sum[y * (w + 1) + x + 1] + sum[(y + 1) * (w + 1) + x] - sum[y * (w + 1) + x];
+                    b + sum[y * (w + 1) + x + 1] + sum[(y + 1) * (w + 1) + x]
+                        - sum[y * (w + 1) + x];
             }
         }
         Segments { map, sum }
@@ -416,11 +415,10 @@ mod tests {
         ]);
         let s = p(0, 0);
         let d = dijkstra8(&m, s);
-        for i in 0..m.cells() {
-            let a = opt8(&m, s, m.point(i));
-            match a {
-                Some(v) => assert!((v - d[i]).abs() < 1e-9),
-                None => assert!(d[i].is_infinite()),
+        for (i, &di) in d.iter().enumerate() {
+            match opt8(&m, s, m.point(i)) {
+                Some(v) => assert!((v - di).abs() < 1e-9),
+                None => assert!(di.is_infinite()),
             }
         }
     }

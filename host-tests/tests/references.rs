@@ -106,7 +106,8 @@ fn segment_tests_agree_on_every_pair_of_the_fixed_maps() {
 #[test]
 fn segment_corner_cases_agree() {
     // Hand-picked touching cases: exact corner contacts, grazing edges, both orders.
-    let cases: &[(&[&str], (u16, u16), (u16, u16), bool)] = &[
+    type Case = (&'static [&'static str], (u16, u16), (u16, u16), bool);
+    let cases: &[Case] = &[
         (&["...", ".#.", "..."], (0, 0), (2, 2), false),
         (&[".#.", "...", "..."], (0, 0), (2, 2), false),
         (&["...", "...", "#.."], (0, 0), (2, 2), true),
@@ -133,8 +134,16 @@ fn segment_corner_cases_agree() {
         let m = Map::from_rows(rows);
         let (a, b) = (Point::new(a.0, a.1), Point::new(b.0, b.1));
         assert_eq!(segment_clear(&m, a, b), want, "{rows:?} {a:?} {b:?}");
-        assert_eq!(core_clear(&m.grid(), a, b), want, "core: {rows:?} {a:?} {b:?}");
-        assert_eq!(core_clear(&m.grid(), b, a), want, "core: {rows:?} {b:?} {a:?}");
+        assert_eq!(
+            core_clear(&m.grid(), a, b),
+            want,
+            "core: {rows:?} {a:?} {b:?}"
+        );
+        assert_eq!(
+            core_clear(&m.grid(), b, a),
+            want,
+            "core: {rows:?} {b:?} {a:?}"
+        );
     }
 }
 
@@ -186,4 +195,62 @@ proptest! {
             prop_assert!(aa >= reference::euclid(s, g) - 1e-9);
         }
     }
+}
+
+/// Segments far from the origin on a huge map, where the core's exact arithmetic no longer fits
+/// 32 bits (it switches to 64-bit division): still the same answers as the reference.
+#[test]
+fn segment_tests_agree_beyond_32_bit_products() {
+    let (w, h) = (20_000u16, 32_767u16);
+    let cells = usize::from(w) * usize::from(h);
+    let mut bits = vec![0u8; cells.div_ceil(8)];
+    // Sparse obstacles in the band the segments cross (xorshift, fixed seed).
+    let mut x = 0x2545_f491_u32;
+    let mut next = move || {
+        x ^= x << 13;
+        x ^= x >> 17;
+        x ^= x << 5;
+        x
+    };
+    let band = 32_747u16..32_767;
+    // Every third row stays free, so horizontal segments there are clear.
+    for y in band.clone().filter(|y| (y - band.start) % 3 != 0) {
+        for cx in 0..w {
+            if next() % 97 == 0 {
+                let i = usize::from(y) * usize::from(w) + usize::from(cx);
+                bits[i / 8] |= 1 << (i % 8);
+            }
+        }
+    }
+    let grid = ohaca::Grid::new(w, h, &bits).unwrap();
+    let blocked = |cx: i64, cy: i64| {
+        let i = cy as usize * usize::from(w) + cx as usize;
+        bits[i / 8] >> (i % 8) & 1 == 1
+    };
+    let mut clear = 0;
+    for k in 0..200u32 {
+        let (ax, bx) = ((next() % 1000) as u16, w - 1 - (next() % 1000) as u16);
+        let ay = band.start + (next() % 20) as u16;
+        // Mostly shallow segments (often clear), some steeper ones.
+        let by = if k % 4 == 0 {
+            band.start + (next() % 20) as u16
+        } else {
+            ay
+        };
+        let (a, b) = (Point::new(ax, ay), Point::new(bx, by));
+        // The products the core forms exceed i32 here.
+        assert!(
+            (2 * i64::from(ay) + 1) * 2 * (i64::from(bx) - i64::from(ax)) > i64::from(i32::MAX)
+        );
+        let (y0, y1) = (i64::from(ay.min(by)), i64::from(ay.max(by)));
+        let want = (y0..=y1).all(|cy| {
+            (i64::from(ax)..=i64::from(bx))
+                .all(|cx| !blocked(cx, cy) || !reference::touches(a, b, (cx, cy)))
+        });
+        clear += u32::from(want);
+        assert_eq!(core_clear(&grid, a, b), want, "{a:?} -> {b:?}");
+        assert_eq!(core_clear(&grid, b, a), want, "{b:?} -> {a:?}");
+    }
+    // Both answers occur.
+    assert!(clear > 0 && clear < 200, "{clear} of 200 clear");
 }

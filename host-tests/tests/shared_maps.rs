@@ -93,7 +93,11 @@ fn every_shared_run_is_valid() {
             s.invalid.len(),
             s.invalid[0]
         );
-        assert_eq!(s.failed, 0, "{}: {} runs returned an error", p.name, s.failed);
+        assert_eq!(
+            s.failed, 0,
+            "{}: {} runs returned an error",
+            p.name, s.failed
+        );
         assert_eq!(s.valid, s.runs, "{}", p.name);
         // Lower bounds hold by construction (checked per run); the means are sane.
         assert!(s.mean_raw_ratio >= 1.0 - 1e-6 && s.mean_smooth_ratio >= 1.0 - 1e-6);
@@ -120,5 +124,9 @@ fn quality_targets() {
             ));
         }
     }
-    assert!(misses.is_empty(), "quality targets missed:\n{}", misses.join("\n"));
+    assert!(
+        misses.is_empty(),
+        "quality targets missed:\n{}",
+        misses.join("\n")
+    );
 }

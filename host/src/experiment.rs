@@ -443,7 +443,8 @@ impl Outcome {
                 draw::display_name(a),
                 st.found,
                 st.runs,
-                st.ant_success.map_or_else(|| "-".to_string(), |v| format!("{v:.1} %")),
+                st.ant_success
+                    .map_or_else(|| "-".to_string(), |v| format!("{v:.1} %")),
                 f(st.best, 3),
                 f(st.mean, 3),
                 f(st.std_dev, 3),

@@ -116,6 +116,8 @@ pub fn run(args: &Args) -> u8 {
 struct Session {
     /// `--tcp` or `--serial`, for messages.
     target: String,
+    /// The map file as given, for messages.
+    name: String,
     map: Map,
     /// Where the map's cells are in metres (ROS maps).
     frame: Option<Frame>,
@@ -198,6 +200,7 @@ impl Session {
         let target = args.tcp.as_deref().or(args.serial.as_deref()).unwrap_or("");
         Ok(Session {
             target: target.to_string(),
+            name: args.map.display().to_string(),
             map,
             frame,
             params,
@@ -409,7 +412,8 @@ impl Session {
                     }
                     Some(err @ (Error::OutOfBounds(_) | Error::Blocked(_))) => {
                         Outcome::BadInput(format!(
-                            "{err} (start {},{}, goal {},{}, map {}x{})",
+                            "{}: {err} (start {},{}, goal {},{}, map {}x{})",
+                            self.name,
                             job.start.x,
                             job.start.y,
                             job.goal.x,

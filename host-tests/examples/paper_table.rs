@@ -1,0 +1,166 @@
+//! The paper's comparison of ACA, PACA, HACA and OHACA on the simple and complex maps, as
+//! Markdown tables.
+//!
+//! ```text
+//! cargo run --release -p ohaca-host-tests --target host-tuple --example paper_table [-- --seeds N]
+//! ```
+//!
+//! `simple-18` (0,0)->(17,17) and `complex-26` (0,0)->(25,25), seeds `1..=N` (default 30), the
+//! default (paper) parameters otherwise. Two tables: dead ends handled by backtracking (the
+//! default) and by letting the ant die (the paper's behaviour).
+//!
+//! - *success* is the share of runs that returned a path;
+//! - *ants arriving* is the share of first-iteration ants (pheromone still uniform) that reach the
+//!   goal, 50 ants per seed: the paper's "lost ants" measure, which run-level success cannot show
+//!   because a run succeeds as soon as any ant of any iteration arrives;
+//! - lengths are the output lengths (smoothed for OHACA), turns along the output path;
+//! - *convergence* is `best_iteration + 1`, the iteration the best path was first found in;
+//! - *time* is the wall-clock time of one `plan` call on this machine, runs done one at a time.
+
+use std::time::Duration;
+
+use ohaca::colony::Colony;
+use ohaca::heuristic::Heuristic;
+use ohaca::pheromone::Table;
+use ohaca::rng::Xoshiro128pp;
+use ohaca::{Algorithm, DeadEnd, Params};
+use ohaca_host_tests::heap::HeapStorage;
+use ohaca_host_tests::maps::scenarios;
+use ohaca_host_tests::quality::{prepare, run_one, summarize, Prepared, Run};
+
+/// Share of `params.ants` first-iteration ants per seed that reach the goal.
+fn first_iteration_arrivals(prep: &Prepared, params: &Params, seeds: &[u64]) -> f64 {
+    let map = &prep.map;
+    let grid = map.grid();
+    let case = &prep.cases[0];
+    let cells = map.cells();
+    let mut tau_buf = vec![[params.tau0; 4]; cells];
+    let tau = Table::new(map.width(), &mut tau_buf);
+    let heuristic = Heuristic::new(
+        case.goal,
+        params.algorithm.attracts(),
+        params.a,
+        params.xi,
+        params.beta,
+    );
+    let moves: Vec<u8> = (0..cells).map(|i| grid.move_mask(grid.point(i))).collect();
+    let colony = Colony {
+        grid: &grid,
+        start: case.start,
+        goal: case.goal,
+        tau: &tau,
+        heuristic: &heuristic,
+        alpha: params.alpha,
+        dead_end: params.dead_end,
+        moves: &moves,
+    };
+    let (mut arrived, mut total) = (0u64, 0u64);
+    let mut visited = vec![0u8; cells];
+    let mut tour = vec![0u8; cells];
+    for &seed in seeds {
+        let mut rng = Xoshiro128pp::from_u64(seed);
+        for ant in 0..params.ants {
+            // Stamps 1..=255, then clear (as the planner does).
+            let stamp = (ant % 255) as u8 + 1;
+            if stamp == 1 {
+                visited.fill(0);
+            }
+            total += 1;
+            arrived += u64::from(
+                colony
+                    .walk(&mut rng, &mut visited, stamp, &mut tour)
+                    .is_some(),
+            );
+        }
+    }
+    arrived as f64 / total as f64
+}
+
+fn ms(d: Duration) -> f64 {
+    d.as_secs_f64() * 1e3
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let n_seeds: u64 = match args.as_slice() {
+        [] => 30,
+        [flag, n] if flag == "--seeds" => n.parse().expect("--seeds N"),
+        _ => {
+            eprintln!("usage: paper_table [--seeds N]");
+            std::process::exit(2);
+        }
+    };
+    let seeds: Vec<u64> = (1..=n_seeds).collect();
+    let prepared: Vec<Prepared> = prepare(
+        scenarios()
+            .into_iter()
+            .filter(|s| s.name == "simple-18" || s.name == "complex-26")
+            .collect(),
+    );
+    for dead_end in DeadEnd::ALL {
+        println!(
+            "## Paper comparison, dead end = {dead_end}, seeds 1..={n_seeds}, default parameters\n"
+        );
+        println!(
+            "| map | algorithm | success % | ants arriving (1st iteration) % | best | mean | worst | \
+             std dev | mean turns | mean convergence iteration | mean iterations | mean time/plan (ms) |"
+        );
+        println!(
+            "| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |"
+        );
+        for prep in &prepared {
+            let case = &prep.cases[0];
+            for algorithm in Algorithm::ALL {
+                let params = Params {
+                    algorithm,
+                    dead_end,
+                    ..Params::default()
+                };
+                let mut storage = HeapStorage::new(prep.map.cells());
+                let runs: Vec<Run> = seeds
+                    .iter()
+                    .map(|&seed| {
+                        let p = Params { seed, ..params };
+                        let (outcome, time) = run_one(&prep.map, case, &p, &mut storage);
+                        Run {
+                            case: 0,
+                            seed,
+                            outcome,
+                            time,
+                        }
+                    })
+                    .collect();
+                let s = summarize(&runs);
+                assert!(s.invalid.is_empty(), "invalid plans: {:?}", s.invalid);
+                let arriving = first_iteration_arrivals(prep, &params, &seeds);
+                println!(
+                    "| {} | {} | {:.1} | {:.1} | {:.4} | {:.4} | {:.4} | {:.4} | {:.2} | {:.2} | {:.2} | {:.2} |",
+                    prep.name,
+                    algorithm.name().to_uppercase(),
+                    100.0 * s.valid as f64 / s.runs as f64,
+                    100.0 * arriving,
+                    s.best_length,
+                    s.mean_length,
+                    s.worst_length,
+                    s.std_length,
+                    s.mean_turns,
+                    s.mean_best_iteration + 1.0,
+                    s.mean_iterations,
+                    ms(s.mean_time),
+                );
+            }
+        }
+        println!();
+    }
+    for prep in &prepared {
+        let o = prep.cases[0].optima;
+        println!(
+            "{}: exact 8-connected optimum {:.4}, any-angle optimum {:.4}.",
+            prep.name, o.opt8, o.any_angle
+        );
+    }
+    println!(
+        "\nLengths of ACA, PACA and HACA are raw 8-connected lengths; OHACA's are smoothed. \
+         Statistics are over the runs that returned a path."
+    );
+}
