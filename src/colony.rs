@@ -183,6 +183,20 @@ impl Colony<'_, '_, '_> {
             *tour.get_mut(steps)? = d;
             steps += 1;
         }
+        // The loop checks for a second visited neighbour at every cell but the goal; a detour
+        // whose only shortcut ends at the goal (e.g. (0,0) -> (0,1) -> (1,0) on an empty map) is
+        // caught here.
+        if !may_tighten {
+            let mut mask = *self.moves.get(goal)?;
+            let mut seen = 0u32;
+            while mask != 0 {
+                let di = mask.trailing_zeros() as usize & 7;
+                mask &= mask - 1;
+                let ni = goal.wrapping_add_signed(*offsets.get(di)?);
+                seen += u32::from(*visited.get(ni)? == stamp);
+            }
+            may_tighten = seen > 1;
+        }
         let path = tour.get(..steps)?;
         let diagonal = path.iter().filter(|&&d| is_diagonal(d)).count() as u32;
         Some(Walk {

@@ -618,12 +618,11 @@ fn any_angle_sanity_on_the_fixed_map() {
 
 /// `colony::tighten` promises that, with `Params::tighten` on (the default), every ant's path is
 /// straightened: no path cell is one allowed move away from a later, non-consecutive path cell.
-/// The walk only asks for tightening when it "passed next to a visited cell", and that is checked
-/// at every cell *except the goal* (the walk loop ends on arrival), so a detour whose shortcut
-/// ends at the goal is kept. Smallest case: 3x3 empty map, (0,0) -> (1,0), ACA, seed 12, 1 ant,
-/// 1 iteration: raw path (0,0) -> (0,1) -> (1,0), length 1 + sqrt 2, instead of the single step.
+/// The walk only asks for tightening when it "passed next to a visited cell"; that check once
+/// skipped the goal cell, so a detour whose only shortcut ends at the goal was kept (regression
+/// case: 3x3 empty map, (0,0) -> (1,0), ACA, seed 12, 1 ant, 1 iteration gave (0,0) -> (0,1) ->
+/// (1,0) instead of the single step).
 #[test]
-#[ignore = "core bug: walks whose only shortcut ends at the goal are not tightened"]
 fn tightened_paths_have_no_shortcut() {
     use ohaca_host_tests::check::shortcut;
     let m = Map::empty(3, 3);

@@ -4,7 +4,7 @@
 //!
 //! - `every_shared_run_is_valid`: 100 % of the runs return a valid plan (asserted), and the mean
 //!   quality ratios per map are printed (`--nocapture` to see them).
-//! - `quality_targets` (ignored for now): mean raw length within 3 % of the 8-connected optimum
+//! - `quality_targets`: mean raw length within 3 % of the 8-connected optimum
 //!   and mean smoothed length within 2 % of the any-angle optimum, per map.
 //!
 //! Nothing here depends on timing.
@@ -105,7 +105,6 @@ fn every_shared_run_is_valid() {
 }
 
 #[test]
-#[ignore = "quality target, see BENCHMARKS.md"]
 fn quality_targets() {
     let (prepared, summaries) = results();
     print_table(prepared, summaries);
