@@ -2,7 +2,7 @@
 //!
 //! - `full_50x100`: 50 ants x 100 iterations, early stop off (`patience = 0`): a fixed amount of
 //!   work, the number to compare across changes;
-//! - `default`: the default parameters (early stop after 20 stale iterations).
+//! - `default`: the default parameters (early stop after 10 stale iterations).
 //!
 //! Each prints the ant moves of one run first, so ant steps per second = moves / time.
 //!

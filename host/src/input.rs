@@ -176,57 +176,80 @@ pub fn load_map(path: &Path, unknown: Unknown) -> Result<(Map, Option<Frame>), I
     }
 }
 
+/// Load a map file and prepare it for the robot: unknown cells resolved while loading, then
+/// `inflate` (a radius) on the file's own cells, then `cell` resampling (a cell size); both in
+/// metres for maps with a resolution, in cells otherwise. The frame follows the resampling.
+pub fn prepare_map(
+    path: &Path,
+    unknown: Unknown,
+    inflate_by: Option<f64>,
+    cell: Option<f64>,
+) -> Result<(Map, Option<Frame>), InputError> {
+    let (mut map, mut frame) = load_map(path, unknown)?;
+    let unit = frame.map_or(1.0, |f| f.resolution);
+    if let Some(r) = inflate_by {
+        map = inflate(&map, r / unit);
+    }
+    if let Some(size) = cell {
+        let factor = size / unit;
+        let coarse = resample(&map, factor, frame.is_some()).map_err(|e| InputError::File {
+            path: path.display().to_string(),
+            problem: format!(
+                "--cell {size}: {e}{}",
+                frame.map_or_else(String::new, |f| format!(
+                    "; the map's resolution is {} m",
+                    f.resolution
+                ))
+            ),
+        })?;
+        frame = frame.map(|f| resample_frame(&f, &coarse, factor));
+        map = coarse;
+    }
+    Ok((map, frame))
+}
+
+/// A start or goal (`what`) given in cells or in metres, as a cell of the prepared grid.
+/// `name` is the map file, for messages.
+pub fn resolve_point(
+    name: &str,
+    frame: Option<Frame>,
+    what: &str,
+    cells: Option<Point>,
+    metres: Option<[f64; 2]>,
+) -> Result<Point, InputError> {
+    let err = |problem: String| InputError::File {
+        path: name.to_string(),
+        problem,
+    };
+    match (cells, metres, frame) {
+        (Some(p), _, _) => Ok(p),
+        (None, Some(m), Some(f)) => f.cell(m).ok_or_else(|| {
+            let [x0, x1, y0, y1] = f.extent();
+            let bounds = if f.yaw == 0.0 {
+                format!(" (x from {x0} to {x1} m, y from {y0} to {y1} m)")
+            } else {
+                String::new()
+            };
+            err(format!(
+                "{what} ({}, {}) m is outside the map{bounds}",
+                m[0], m[1]
+            ))
+        }),
+        (None, Some(_), None) => Err(err(format!(
+            "--{what}-m needs a map with a resolution (a ROS map_server YAML file); \
+                 give --{what} in cells"
+        ))),
+        (None, None, _) => Err(err(format!("no {what} given (--{what} or --{what}-m)"))),
+    }
+}
+
 impl MapArgs {
-    /// Load and prepare the map, and resolve the start and goal.
+    /// Load and prepare the map ([`prepare_map`]), and resolve the start and goal.
     pub fn load(&self) -> Result<Scenario, InputError> {
         let name = self.map.display().to_string();
-        let err = |problem: String| InputError::File {
-            path: name.clone(),
-            problem,
-        };
-        let (mut map, mut frame) = load_map(&self.map, self.unknown)?;
-        let unit = frame.map_or(1.0, |f| f.resolution);
-        if let Some(r) = self.inflate {
-            map = inflate(&map, r / unit);
-        }
-        if let Some(size) = self.cell {
-            let factor = size / unit;
-            let coarse = resample(&map, factor, frame.is_some()).map_err(|e| {
-                err(format!(
-                    "--cell {size}: {e}{}",
-                    frame.map_or_else(String::new, |f| format!(
-                        "; the map's resolution is {} m",
-                        f.resolution
-                    ))
-                ))
-            })?;
-            frame = frame.map(|f| resample_frame(&f, &coarse, factor));
-            map = coarse;
-        }
-        let point = |what: &str, cells: Option<Point>, metres: Option<[f64; 2]>| match (
-            cells, metres, frame,
-        ) {
-            (Some(p), _, _) => Ok(p),
-            (None, Some(m), Some(f)) => f.cell(m).ok_or_else(|| {
-                let [x0, x1, y0, y1] = f.extent();
-                let bounds = if f.yaw == 0.0 {
-                    format!(" (x from {x0} to {x1} m, y from {y0} to {y1} m)")
-                } else {
-                    String::new()
-                };
-                err(format!(
-                    "{what} ({}, {}) m is outside the map{bounds}",
-                    m[0], m[1]
-                ))
-            }),
-            (None, Some(_), None) => Err(err(format!(
-                "--{what}-m needs a map with a resolution (a ROS map_server YAML file); \
-                     give --{what} in cells"
-            ))),
-            (None, None, _) => Err(err(format!("no {what} given (--{what} or --{what}-m)"))),
-        };
-        let start = point("start", self.start, self.start_m)?;
-        let goal = point("goal", self.goal, self.goal_m)?;
+        let (map, frame) = prepare_map(&self.map, self.unknown, self.inflate, self.cell)?;
+        let start = resolve_point(&name, frame, "start", self.start, self.start_m)?;
+        let goal = resolve_point(&name, frame, "goal", self.goal, self.goal_m)?;
         Ok(Scenario {
             name,
             map,

@@ -1,8 +1,13 @@
 //! `ohaca send`: plan on the firmware. Connects to a device (`--tcp HOST:PORT`, e.g. QEMU's
 //! UART, or `--serial DEVICE`), says Hello, sends the parameters and the map, plans, and prints
-//! the result exactly as `ohaca plan` does: the picture, or with `--json` the same JSON keys
-//! plus `ticks` (device time, in the device's `tick_hz` units) and `device` (its board name).
-//! `elapsed_us` is the round trip of the plan request as the host saw it.
+//! the result as `ohaca plan` does: the picture, the waypoints as CSV, or with `--json` the same
+//! JSON keys plus `ticks` (device time, in the device's `tick_hz` units) and `device` (its board
+//! name). `elapsed_us` is the round trip of the plan request as the host saw it.
+//!
+//! The map flags are `plan`'s (`--unknown`, `--inflate`, `--cell`, `--start-m`, `--goal-m`). A
+//! map larger than the device holds is resampled to the smallest whole number of cells per
+//! coarse cell that fits (a coarse cell is blocked if any cell it covers is), unless `--cell`
+//! was given; a note on stderr says so, and start, goal and output are cells of the coarse grid.
 //!
 //! `--goals FILE` plans many requests over one connection, pipelined, and prints one JSON line
 //! per request, in file order. Each line of the file is `SX,SY GX,GY` (start and goal) or
@@ -19,15 +24,19 @@ use std::time::{Duration, Instant};
 use ohaca::protocol::{ErrorCode, ErrorReply};
 use ohaca::{Error, Params, Point};
 use ohaca_host::frame::{round_um, Frame};
-use ohaca_host::input::load_map;
+use ohaca_host::gridops::{resample, resample_frame};
+use ohaca_host::input::{parse_length, parse_metres, prepare_map, resolve_point};
 use ohaca_host::link::{
     core_error, DeviceInfo, DevicePath, Link, LinkError, PlanJob, Transport, DEFAULT_BAUD,
 };
-use ohaca_host::output::{format_us, micros, render, xy, LocatedReport, ParamsReport, PlanReport};
+use ohaca_host::output::{
+    format_us, micros, render, waypoints_csv, xy, LocatedReport, ParamsReport, PlanReport,
+};
 use ohaca_host::rosmap::Unknown;
 use ohaca_host::{exit, parse_point, Map, ParamArgs};
 use serde::Serialize;
 
+use super::plan::Format;
 use super::{bad_input, print};
 
 /// Arguments of `ohaca send`.
@@ -47,22 +56,44 @@ pub struct Args {
     #[arg(long, value_name = "SECONDS", default_value = "10", value_parser = parse_timeout)]
     pub timeout: Duration,
     /// Map file: Moving AI `.map`, a text grid (`.`/`0` free, `#`/`1` blocked), a ROS
-    /// map_server `.yaml` or a PNG/PGM image (unknown and dark cells blocked), as `plan` reads
+    /// map_server `.yaml` (with its PGM/PNG image) or a PNG/PGM image (dark = blocked), as
+    /// `plan` reads
     #[arg(long, value_name = "FILE")]
     pub map: PathBuf,
-    /// Start cell: column,row with 0,0 the top-left cell
+    /// Start cell: column,row with 0,0 the top-left cell (of the grid after --cell)
     #[arg(long, value_name = "X,Y", value_parser = parse_point, allow_hyphen_values = true,
-          required_unless_present = "goals")]
+          conflicts_with = "start_m")]
     pub start: Option<Point>,
     /// Goal cell: column,row
     #[arg(long, value_name = "X,Y", value_parser = parse_point, allow_hyphen_values = true,
-          required_unless_present = "goals", conflicts_with = "goals")]
+          conflicts_with_all = ["goals", "goal_m"])]
     pub goal: Option<Point>,
+    /// Start in metres, in the ROS map frame (maps with a resolution only)
+    #[arg(long, value_name = "X,Y", value_parser = parse_metres, allow_hyphen_values = true)]
+    pub start_m: Option<[f64; 2]>,
+    /// Goal in metres, in the ROS map frame
+    #[arg(long, value_name = "X,Y", value_parser = parse_metres, allow_hyphen_values = true,
+          conflicts_with = "goals")]
+    pub goal_m: Option<[f64; 2]>,
+    /// ROS maps: cells between free_thresh and occupied_thresh (unexplored) are blocked or free
+    #[arg(long, value_name = "AS", value_enum, default_value_t = Unknown::Blocked)]
+    pub unknown: Unknown,
+    /// Block every cell whose centre is within this radius of an obstacle's centre: metres
+    /// (cells for maps without a resolution)
+    #[arg(long, value_name = "RADIUS", value_parser = parse_length)]
+    pub inflate: Option<f64>,
+    /// Resample to coarser cells of this size: metres (cells for maps without a resolution).
+    /// Without it, a map too large for the device is resampled to fit, with a note on stderr
+    #[arg(long, value_name = "SIZE", value_parser = parse_length)]
+    pub cell: Option<f64>,
     /// Plan every line of FILE (`SX,SY GX,GY`, or `GX,GY` from --start; `#` comments) over one
     /// connection; prints one JSON line per request, in order
     #[arg(long, value_name = "FILE")]
     pub goals: Option<PathBuf>,
-    /// Print one JSON object instead of the picture
+    /// What to print: text (picture), json or csv [default: text; json lines with --goals]
+    #[arg(long, value_enum, value_name = "FORMAT")]
+    pub format: Option<Format>,
+    /// Print one JSON object instead of the picture (same as --format json)
     #[arg(long)]
     pub json: bool,
     #[command(flatten)]
@@ -106,7 +137,7 @@ impl SendReport<'_> {
 
 /// Run `ohaca send`; returns the exit code.
 pub fn run(args: &Args) -> u8 {
-    match Session::prepare(args).and_then(|s| s.run(args)) {
+    match Session::prepare(args).and_then(|mut s| s.run(args)) {
         Ok(code) => code,
         Err(msg) => bad_input(msg),
     }
@@ -123,6 +154,8 @@ struct Session {
     frame: Option<Frame>,
     params: Params,
     jobs: Vec<PlanJob>,
+    /// What to print.
+    format: Format,
 }
 
 /// One line of a goals file.
@@ -181,21 +214,70 @@ fn too_large(map_path: &Path, map: &Map, info: &DeviceInfo) -> String {
     )
 }
 
+/// The smallest whole number of cells per coarse cell (side) that makes `map` fit the device,
+/// with the coarse map; `None` if even a single coarse cell would not (a 0-cell device).
+fn fit_factor(map: &Map, frame: Option<Frame>, info: &DeviceInfo) -> Option<(u16, Map)> {
+    let c = &info.capacity;
+    let fits = |m: &Map| {
+        m.cells() <= c.cells as usize && m.width <= c.max_width && m.height <= c.max_height
+    };
+    (2..=map.width.max(map.height)).find_map(|k| {
+        let coarse = resample(map, f64::from(k), frame.is_some()).ok()?;
+        fits(&coarse).then_some((k, coarse))
+    })
+}
+
+/// Where cell `p` of a fine grid lies in its resampled grid (factor `k`): through the metric
+/// frames when the map has one (the coarse grid is anchored at the lower-left corner), else by
+/// division (anchored at the top-left).
+fn coarse_cell(p: Point, k: u16, fine: Option<Frame>, coarse: Option<Frame>) -> Point {
+    match (fine, coarse) {
+        (Some(f), Some(c)) => c
+            .cell(f.to_metres(p))
+            .unwrap_or(Point::new(p.x / k, p.y / k)),
+        _ => Point::new(p.x / k, p.y / k),
+    }
+}
+
 impl Session {
     /// Everything that can be checked before connecting.
     fn prepare(args: &Args) -> Result<Session, String> {
-        let (map, frame) = load_map(&args.map, Unknown::default()).map_err(|e| e.to_string())?;
+        let format = match (args.json, args.format, args.goals.is_some()) {
+            (true, None | Some(Format::Json), _) => Format::Json,
+            (true, Some(f), _) => {
+                return Err(format!(
+                    "--json means --format json; it cannot be combined with --format {}",
+                    if f == Format::Csv { "csv" } else { "text" }
+                ))
+            }
+            (false, None, true) | (false, Some(Format::Json), true) => Format::Json,
+            (false, Some(_), true) => {
+                return Err("--goals prints one JSON line per request: use --format json".into())
+            }
+            (false, f, false) => f.unwrap_or(Format::Text),
+        };
+        let name = args.map.display().to_string();
+        let (map, frame) = prepare_map(&args.map, args.unknown, args.inflate, args.cell)
+            .map_err(|e| e.to_string())?;
         let params = args.params.params();
         params.validate().map_err(|e| e.to_string())?;
-        let jobs = match (&args.goals, args.start, args.goal) {
-            (Some(file), start, _) => load_goals(file, start)?,
-            (None, Some(start), Some(goal)) => vec![PlanJob {
+        let start = match (args.start, args.start_m) {
+            (None, None) => None,
+            (s, m) => Some(resolve_point(&name, frame, "start", s, m).map_err(|e| e.to_string())?),
+        };
+        let jobs = match (&args.goals, start) {
+            (Some(file), start) => load_goals(file, start)?,
+            (None, Some(start)) => vec![PlanJob {
                 start,
-                goal,
+                goal: resolve_point(&name, frame, "goal", args.goal, args.goal_m)
+                    .map_err(|e| e.to_string())?,
                 seed: None,
             }],
-            // clap requires --start and --goal without --goals.
-            _ => return Err("give --start and --goal, or --goals".into()),
+            (None, None) => {
+                return Err(
+                    "give --start (or --start-m) and --goal (or --goal-m), or --goals".into(),
+                )
+            }
         };
         let target = args.tcp.as_deref().or(args.serial.as_deref()).unwrap_or("");
         Ok(Session {
@@ -205,7 +287,52 @@ impl Session {
             frame,
             params,
             jobs,
+            format,
         })
+    }
+
+    /// Resample the map to fit the device if it is too large and `--cell` was not given (the
+    /// jobs' cells follow); with `--cell`, a map that does not fit is an error.
+    fn fit(&mut self, args: &Args, info: &DeviceInfo) -> Result<(), String> {
+        let c = &info.capacity;
+        if self.map.cells() <= c.cells as usize
+            && self.map.width <= c.max_width
+            && self.map.height <= c.max_height
+        {
+            return Ok(());
+        }
+        if args.cell.is_some() {
+            return Err(too_large(&args.map, &self.map, info));
+        }
+        let Some((k, coarse)) = fit_factor(&self.map, self.frame, info) else {
+            return Err(too_large(&args.map, &self.map, info));
+        };
+        let frame = self
+            .frame
+            .map(|f| resample_frame(&f, &coarse, f64::from(k)));
+        let size = self.frame.map_or_else(String::new, |f| {
+            format!(" ({} m)", f.resolution * f64::from(k))
+        });
+        eprintln!(
+            "note: {}: {}x{} cells do not fit {} ({} cells, at most {}x{}); resampled to {}x{}, \
+             {k}x{k} cells per cell{size}; start, goal and output are cells of the coarse grid",
+            self.name,
+            self.map.width,
+            self.map.height,
+            info.board,
+            c.cells,
+            c.max_width,
+            c.max_height,
+            coarse.width,
+            coarse.height
+        );
+        for job in &mut self.jobs {
+            job.start = coarse_cell(job.start, k, self.frame, frame);
+            job.goal = coarse_cell(job.goal, k, self.frame, frame);
+        }
+        self.map = coarse;
+        self.frame = frame;
+        Ok(())
     }
 
     /// The waypoints in metres (rounded to a micrometre), for maps with a resolution.
@@ -230,7 +357,7 @@ impl Session {
         }
     }
 
-    fn run(self, args: &Args) -> Result<u8, String> {
+    fn run(&mut self, args: &Args) -> Result<u8, String> {
         let fail = |e: LinkError| self.fail(e);
         match (&args.tcp, &args.serial) {
             (Some(addr), _) => {
@@ -245,16 +372,10 @@ impl Session {
         }
     }
 
-    fn talk<T: Transport>(&self, args: &Args, mut link: Link<T>) -> Result<u8, String> {
+    fn talk<T: Transport>(&mut self, args: &Args, mut link: Link<T>) -> Result<u8, String> {
+        let info = link.hello().map_err(|e| self.fail(e))?;
+        self.fit(args, &info)?;
         let fail = |e: LinkError| self.fail(e);
-        let info = link.hello().map_err(fail)?;
-        let c = &info.capacity;
-        if self.map.cells() > c.cells as usize
-            || self.map.width > c.max_width
-            || self.map.height > c.max_height
-        {
-            return Err(too_large(&args.map, &self.map, &info));
-        }
         link.set_params(&self.params).map_err(fail)?;
         link.set_map(&self.map).map_err(|e| match e {
             LinkError::Device { error, .. } if error.code == ErrorCode::MapTooLarge => {
@@ -303,7 +424,10 @@ impl Session {
         } else {
             exit::NO_PATH
         };
-        if args.json {
+        if self.format == Format::Csv {
+            let metres = self.metres(&report.waypoints);
+            print(&waypoints_csv(&report.waypoints, metres.as_deref()));
+        } else if self.format == Format::Json {
             let metres = self.metres(&report.waypoints);
             let mut s = SendReport {
                 report: LocatedReport {
@@ -488,6 +612,76 @@ mod tests {
         assert!(parse_goal_line("7,8", None).is_err());
         assert!(parse_goal_line("1,2 3,4 5,6", None).is_err());
         assert!(parse_goal_line("1;2 3,4", None).is_err());
+    }
+
+    fn device(cells: u32) -> DeviceInfo {
+        DeviceInfo {
+            protocol_version: ohaca::protocol::VERSION,
+            firmware_version: "0".into(),
+            board: "test".into(),
+            capacity: ohaca::protocol::Capacity {
+                cells,
+                max_width: cells as u16,
+                max_height: cells as u16,
+                max_chunk: 128,
+                max_request: 256,
+                plan_queue: 4,
+                tick_hz: 1_000_000,
+            },
+            defaults: Params::default(),
+        }
+    }
+
+    #[test]
+    fn large_maps_are_resampled_by_the_smallest_factor_that_fits() {
+        // 100x75 into 1024 cells: 2 gives 50x38 = 1900, 3 gives 34x25 = 850.
+        let map = Map::from_fn(100, 75, |x, y| x == 50 && y == 10);
+        let (k, coarse) = fit_factor(&map, None, &device(1024)).unwrap();
+        assert_eq!((k, coarse.width, coarse.height), (3, 34, 25));
+        // The blocked cell (50,10) is in coarse cell (16,3).
+        assert!(coarse.is_blocked(Point::new(16, 3)));
+        let blocked = (0..coarse.height)
+            .flat_map(|y| (0..coarse.width).map(move |x| Point::new(x, y)))
+            .filter(|&p| coarse.is_blocked(p))
+            .count();
+        assert_eq!(blocked, 1);
+        assert_eq!(
+            coarse_cell(Point::new(50, 10), k, None, None),
+            Point::new(16, 3)
+        );
+        // A device without cells cannot take any map.
+        assert!(fit_factor(&map, None, &device(0)).is_none());
+    }
+
+    #[test]
+    fn resampled_cells_follow_the_metric_frame() {
+        // 10x9 cells of 0.1 m, origin (-1, -2): the coarse grid (factor 2) is anchored at the
+        // lower-left corner, so rows shift when the height is odd.
+        let fine = Frame {
+            resolution: 0.1,
+            origin: [-1.0, -2.0],
+            yaw: 0.0,
+            width: 10,
+            height: 9,
+        };
+        let map = Map::from_fn(10, 9, |_, _| false);
+        let coarse_map = resample(&map, 2.0, true).unwrap();
+        assert_eq!((coarse_map.width, coarse_map.height), (5, 5));
+        let coarse = resample_frame(&fine, &coarse_map, 2.0);
+        // Bottom-left fine cell (0,8) -> bottom-left coarse cell (0,4); top row 0 -> coarse 0.
+        let c = |x, y| coarse_cell(Point::new(x, y), 2, Some(fine), Some(coarse));
+        assert_eq!(c(0, 8), Point::new(0, 4));
+        assert_eq!(c(9, 0), Point::new(4, 0));
+        // Fine row 7 is row 1 from the bottom: coarse row 0 from the bottom, i.e. row 4.
+        assert_eq!(c(3, 7), Point::new(1, 4));
+        assert_eq!(c(3, 6), Point::new(1, 3));
+        // Every fine cell's centre lies in the coarse cell it is mapped to.
+        for y in 0..9 {
+            for x in 0..10 {
+                let m = fine.to_metres(Point::new(x, y));
+                assert_eq!(coarse.cell(m), Some(c(x, y)));
+            }
+        }
     }
 
     #[test]
