@@ -145,18 +145,20 @@ impl Colony<'_, '_, '_> {
                 // `& 7`: the mask is non-zero, so this is the index itself, and the compiler
                 // knows it is in range for the 8-entry tables below.
                 let di = mask.trailing_zeros() as usize & 7;
-                mask &= mask - 1;
+                mask &= mask.wrapping_sub(1); // mask != 0: clears the lowest set bit
                 let ni = ci.wrapping_add_signed(*offsets.get(di)?);
                 if *visited.get(ni)? == stamp {
-                    seen += 1;
+                    seen = seen.wrapping_add(1); // at most 8: one per bit of the mask
                     continue;
                 }
-                let t = *tau.get((4 * ci).wrapping_add_signed(*slots.get(di)?))?;
+                // `ci` is a cell index (it was checked against `visited`) and the table holds 16
+                // bytes a cell in memory, so `4 * ci` does not wrap (if it did, `get` would fail).
+                let t = *tau.get(ci.wrapping_mul(4).wrapping_add_signed(*slots.get(di)?))?;
                 let w = pow_alpha(t, self.alpha) * eta.get(di);
                 *cand_dir.get_mut(n)? = di as u8;
                 *cand_w.get_mut(n)? = w;
                 total += w;
-                n += 1;
+                n = n.wrapping_add(1); // at most 8, like `seen`
             }
             moves = moves.saturating_add(1);
             // One visited neighbour is the cell we came from; a second one may be a shortcut.
@@ -181,7 +183,7 @@ impl Colony<'_, '_, '_> {
             cur = neighbour(cur, d);
             *visited.get_mut(ci)? = stamp;
             *tour.get_mut(steps)? = d;
-            steps += 1;
+            steps = steps.wrapping_add(1); // < tour.len() + 1: the slot existed
         }
         // The loop checks for a second visited neighbour at every cell but the goal; a detour
         // whose only shortcut ends at the goal (e.g. (0,0) -> (0,1) -> (1,0) on an empty map) is
@@ -191,9 +193,10 @@ impl Colony<'_, '_, '_> {
             let mut seen = 0u32;
             while mask != 0 {
                 let di = mask.trailing_zeros() as usize & 7;
-                mask &= mask - 1;
+                mask &= mask.wrapping_sub(1);
                 let ni = goal.wrapping_add_signed(*offsets.get(di)?);
-                seen += u32::from(*visited.get(ni)? == stamp);
+                // At most 8, one per bit of the mask.
+                seen = seen.wrapping_add(u32::from(*visited.get(ni)? == stamp));
             }
             may_tighten = seen > 1;
         }
@@ -201,7 +204,9 @@ impl Colony<'_, '_, '_> {
         let diagonal = path.iter().filter(|&&d| is_diagonal(d)).count() as u32;
         Some(Walk {
             steps,
-            straight: steps as u32 - diagonal,
+            // diagonal <= steps, and steps < cells < 2^32 (each step enters an unvisited cell), so
+            // the cast is lossless and the difference does not wrap.
+            straight: (steps as u32).wrapping_sub(diagonal),
             diagonal,
             moves,
             may_tighten,
@@ -213,8 +218,9 @@ impl Colony<'_, '_, '_> {
 #[inline]
 fn neighbour(p: Point, d: Dir) -> Point {
     let di = usize::from(d & 7);
-    let x = i32::from(p.x) + DX.get(di).copied().unwrap_or(0);
-    let y = i32::from(p.y) + DY.get(di).copied().unwrap_or(0);
+    // A u16 plus -1..=1: no i32 overflow.
+    let x = i32::from(p.x).wrapping_add(DX.get(di).copied().unwrap_or(0));
+    let y = i32::from(p.y).wrapping_add(DY.get(di).copied().unwrap_or(0));
     Point::new(x as u16, y as u16)
 }
 
@@ -224,7 +230,8 @@ fn neighbour(p: Point, d: Dir) -> Point {
 fn roulette(rng: &mut Xoshiro128pp, w: &[f32], total: f32) -> usize {
     let n = w.len();
     if !(total > 0.0 && total.is_finite()) {
-        return ((u64::from(rng.next_word()) * n as u64) >> 32) as usize;
+        // A 32-bit word times n <= 8 candidates: well below 2^64.
+        return (u64::from(rng.next_word()).wrapping_mul(n as u64) >> 32) as usize;
     }
     let r = rng.next_unit() * total;
     let mut acc = 0.0f32;
@@ -256,7 +263,9 @@ pub fn tighten(
     cells: &mut [Point],
     pos: &mut [u32],
 ) -> Walk {
-    let n = walk.steps + 1;
+    // Cannot wrap for a real walk (steps < cells); were `steps` usize::MAX, `tour.get(..steps)`
+    // below would fail and the walk come back unchanged.
+    let n = walk.steps.wrapping_add(1);
     let offsets = grid.offsets();
     let (Some(cells), Some(path)) = (cells.get_mut(..n), tour.get(..walk.steps)) else {
         return walk;
@@ -275,7 +284,9 @@ pub fn tighten(
     let mut i = 0usize;
     let mut out = 0usize;
     let (mut straight, mut diagonal) = (0u32, 0u32);
-    while i + 1 < n {
+    // `i < n` throughout (it only ever becomes a valid index into `cells`), so no `wrapping_` below
+    // wraps: `out <= i` and `straight + diagonal == out`.
+    while i.wrapping_add(1) < n {
         let Some(&cp) = cells.get(i) else { break };
         let ci = grid.index(cp);
         let mut mask = moves.get(ci).copied().unwrap_or(0);
@@ -283,7 +294,7 @@ pub fn tighten(
         let mut best = (i, 0u8);
         while mask != 0 {
             let d = mask.trailing_zeros() as u8;
-            mask &= mask - 1;
+            mask &= mask.wrapping_sub(1);
             let nb = ci.wrapping_add_signed(offsets.get(usize::from(d)).copied().unwrap_or(0));
             let Some(&j) = pos.get(nb) else { continue };
             let j = j as usize;
@@ -300,11 +311,11 @@ pub fn tighten(
         if let Some(slot) = tour.get_mut(out) {
             *slot = d;
         }
-        out += 1;
+        out = out.wrapping_add(1);
         if is_diagonal(d) {
-            diagonal += 1;
+            diagonal = diagonal.wrapping_add(1);
         } else {
-            straight += 1;
+            straight = straight.wrapping_add(1);
         }
         i = j;
     }

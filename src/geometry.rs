@@ -44,7 +44,8 @@ fn floor_div(n: i64, d: i64) -> i64 {
 /// Ceiling division for a positive divisor.
 #[inline]
 fn ceil_div(n: i64, d: i64) -> i64 {
-    -floor_div(-n, d)
+    // Callers pass |n| < 2^36 (see `segment_clear`), far from `i64::MIN`: the negations are exact.
+    floor_div(n.wrapping_neg(), d).wrapping_neg()
 }
 
 /// True iff the straight segment between the centres of `a` and `b` touches no blocked (or
@@ -55,10 +56,13 @@ pub fn segment_clear(grid: &Grid<'_>, a: Point, b: Point) -> bool {
     // Order by x so the walk goes left to right.
     let (p, q) = if a.x <= b.x { (a, b) } else { (b, a) };
     // Doubled coordinates: the centre of cell x is 2x + 1, the square of cell c spans [2c, 2c + 2].
-    let (x0, y0) = (2 * i64::from(p.x) + 1, 2 * i64::from(p.y) + 1);
-    let (x1, y1) = (2 * i64::from(q.x) + 1, 2 * i64::from(q.y) + 1);
-    let dx = x1 - x0; // >= 0
-    let dy = y1 - y0;
+    // Overflow: doubled coordinates and `dx`, `dy` are below 2^17 in size, so every `y * dx` value
+    // below is below 2^35 in size: none of the `wrapping_` operations here can wrap in i64.
+    let centre = |c: u16| i64::from(c).wrapping_mul(2).wrapping_add(1);
+    let (x0, y0) = (centre(p.x), centre(p.y));
+    let (x1, y1) = (centre(q.x), centre(q.y));
+    let dx = x1.wrapping_sub(x0); // >= 0
+    let dy = y1.wrapping_sub(y0);
     if dx == 0 {
         // Vertical: the line x = 2x0+1 lies strictly inside one column.
         let (lo, hi) = if p.y <= q.y { (p.y, q.y) } else { (q.y, p.y) };
@@ -66,15 +70,17 @@ pub fn segment_clear(grid: &Grid<'_>, a: Point, b: Point) -> bool {
         return (lo..=hi).all(|y| !grid.blocked_xy(x, i32::from(y)));
     }
     for cx in i64::from(p.x)..=i64::from(q.x) {
-        let xa = x0.max(2 * cx);
-        let xb = x1.min(2 * cx + 2);
+        let xa = x0.max(cx.wrapping_mul(2));
+        let xb = x1.min(cx.wrapping_mul(2).wrapping_add(2));
         // y * dx at both ends of this column's piece of the segment (exact rationals).
-        let ya = y0 * dx + (xa - x0) * dy;
-        let yb = y0 * dx + (xb - x0) * dy;
+        let y0dx = y0.wrapping_mul(dx);
+        let ya = y0dx.wrapping_add(xa.wrapping_sub(x0).wrapping_mul(dy));
+        let yb = y0dx.wrapping_add(xb.wrapping_sub(x0).wrapping_mul(dy));
         let (ylo, yhi) = if ya <= yb { (ya, yb) } else { (yb, ya) };
         // Cell cy is touched iff 2cy <= yhi/dx and 2cy + 2 >= ylo/dx.
-        let cy_lo = ceil_div(ylo - 2 * dx, 2 * dx);
-        let cy_hi = floor_div(yhi, 2 * dx);
+        let dx2 = dx.wrapping_mul(2);
+        let cy_lo = ceil_div(ylo.wrapping_sub(dx2), dx2);
+        let cy_hi = floor_div(yhi, dx2);
         for cy in cy_lo..=cy_hi {
             // Coordinates stay within the map's u16 range, so the narrowing is lossless.
             if grid.blocked_xy(cx as i32, cy as i32) {
@@ -99,21 +105,22 @@ pub fn polyline_length(points: &[Point]) -> f32 {
 /// Number of turns (direction changes) along a polyline: points where the incoming and outgoing
 /// segments are not collinear-and-forward.
 pub fn turns(points: &[Point]) -> u32 {
-    let mut n = 0;
+    let mut n = 0u32;
     for w in points.windows(3) {
         if let [a, b, c] = w {
+            // Differences of u16 values and their products (< 2^33) cannot wrap in i64.
             let (ux, uy) = (
-                i64::from(b.x) - i64::from(a.x),
-                i64::from(b.y) - i64::from(a.y),
+                i64::from(b.x).wrapping_sub(i64::from(a.x)),
+                i64::from(b.y).wrapping_sub(i64::from(a.y)),
             );
             let (vx, vy) = (
-                i64::from(c.x) - i64::from(b.x),
-                i64::from(c.y) - i64::from(b.y),
+                i64::from(c.x).wrapping_sub(i64::from(b.x)),
+                i64::from(c.y).wrapping_sub(i64::from(b.y)),
             );
-            let cross = ux * vy - uy * vx;
-            let dot = ux * vx + uy * vy;
+            let cross = ux.wrapping_mul(vy).wrapping_sub(uy.wrapping_mul(vx));
+            let dot = ux.wrapping_mul(vx).wrapping_add(uy.wrapping_mul(vy));
             if cross != 0 || dot <= 0 {
-                n += 1;
+                n = n.saturating_add(1);
             }
         }
     }

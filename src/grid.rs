@@ -13,6 +13,14 @@
 
 use crate::error::Error;
 
+// Cell indices are computed in `usize` from `u16` coordinates: `y * width + x` is at most
+// `65535 * 65535 + 65535 < 2^32`, so with a `usize` of 32 bits or more the wrapping arithmetic
+// below never actually wraps.
+const _: () = assert!(
+    usize::BITS >= 32,
+    "cell indices need a usize of at least 32 bits"
+);
+
 /// A cell coordinate. `x` = column, `y` = row from the top.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Default)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -48,7 +56,7 @@ pub const fn is_diagonal(d: Dir) -> bool {
 /// The direction that undoes `d`.
 #[inline]
 pub const fn opposite(d: Dir) -> Dir {
-    (d + 4) & 7
+    d.wrapping_add(4) & 7
 }
 
 /// A borrowed occupancy grid. See the module docs for the bit layout.
@@ -68,7 +76,9 @@ impl<'a> Grid<'a> {
     /// A grid over `bits` (see the module docs). Fails with [`Error::BadMap`] if a side is zero or
     /// `bits` holds fewer than `width * height` bits.
     pub fn new(width: u16, height: u16, bits: &'a [u8]) -> Result<Self, Error> {
-        let cells = usize::from(width) * usize::from(height);
+        let cells = usize::from(width)
+            .checked_mul(usize::from(height))
+            .ok_or(Error::BadMap)?;
         if cells == 0 || bits.len() < bytes_for(cells) {
             return Err(Error::BadMap);
         }
@@ -94,7 +104,8 @@ impl<'a> Grid<'a> {
     /// `width * height`.
     #[inline]
     pub fn cells(&self) -> usize {
-        usize::from(self.width) * usize::from(self.height)
+        // < 2^32: see the index note at the top of the module.
+        usize::from(self.width).wrapping_mul(usize::from(self.height))
     }
 
     /// The bit buffer this grid reads.
@@ -111,7 +122,10 @@ impl<'a> Grid<'a> {
     /// Row-major index of `p` (which must be inside the map for the result to mean anything).
     #[inline]
     pub fn index(&self, p: Point) -> usize {
-        usize::from(p.y) * usize::from(self.width) + usize::from(p.x)
+        // < 2^32 for any `p`: see the index note at the top of the module.
+        usize::from(p.y)
+            .wrapping_mul(usize::from(self.width))
+            .wrapping_add(usize::from(p.x))
     }
 
     /// The point with row-major index `i`.
@@ -119,10 +133,9 @@ impl<'a> Grid<'a> {
     pub fn point(&self, i: usize) -> Point {
         let w = usize::from(self.width);
         // Both quotients fit in u16 for every index below `cells()`; larger ones are clamped.
-        Point::new(
-            u16::try_from(i % w).unwrap_or(u16::MAX),
-            u16::try_from(i / w).unwrap_or(u16::MAX),
-        )
+        // `w > 0` (checked in `Grid::new`), so the `checked_` forms never fail.
+        let clamp = |v: Option<usize>| v.and_then(|v| u16::try_from(v).ok()).unwrap_or(u16::MAX);
+        Point::new(clamp(i.checked_rem(w)), clamp(i.checked_div(w)))
     }
 
     /// True if cell index `i` is blocked; indices outside the map count as blocked.
@@ -147,8 +160,10 @@ impl<'a> Grid<'a> {
         if x < 0 || y < 0 || x >= i32::from(self.width) || y >= i32::from(self.height) {
             return true;
         }
-        // Non-negative and inside the map, so the casts are lossless.
-        let i = (y as usize) * usize::from(self.width) + x as usize;
+        // Non-negative and inside the map, so the casts are lossless and `i < cells()`.
+        let i = (y as usize)
+            .wrapping_mul(usize::from(self.width))
+            .wrapping_add(x as usize);
         self.blocked_index(i)
     }
 
@@ -159,8 +174,9 @@ impl<'a> Grid<'a> {
         let di = usize::from(d & 7);
         let dx = DX.get(di).copied().unwrap_or(0);
         let dy = DY.get(di).copied().unwrap_or(0);
-        let x = i32::from(p.x) + dx;
-        let y = i32::from(p.y) + dy;
+        // A u16 plus -1..=1: no i32 overflow.
+        let x = i32::from(p.x).wrapping_add(dx);
+        let y = i32::from(p.y).wrapping_add(dy);
         if self.blocked_xy(x, y) {
             return None;
         }
@@ -192,7 +208,8 @@ impl<'a> Grid<'a> {
         for (d, slot) in o.iter_mut().enumerate() {
             let dx = DX.get(d).copied().unwrap_or(0) as isize;
             let dy = DY.get(d).copied().unwrap_or(0) as isize;
-            *slot = dy * w + dx;
+            // |dy|, |dx| <= 1 and w <= 65535: no overflow.
+            *slot = dy.wrapping_mul(w).wrapping_add(dx);
         }
         o
     }
@@ -218,14 +235,15 @@ impl<'a> Grid<'a> {
                 if *mk == 0 {
                     *mk = 1;
                     *slot = i as u32;
-                    *tail += 1;
+                    // `tail < queue.len()` (the slot exists), so this cannot wrap.
+                    *tail = tail.wrapping_add(1);
                 }
             }
         };
         push(queue, mark, &mut tail, start);
         while head < tail {
             let Some(&i) = queue.get(head) else { break };
-            head += 1;
+            head = head.wrapping_add(1); // < tail
             let p = self.point(i as usize);
             if p == goal {
                 return true;

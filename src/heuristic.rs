@@ -29,10 +29,10 @@ use crate::grid::{Dir, Point, DX, DY};
 /// step counts, so the distance is `straight + sqrt(2) * diagonal`.
 #[inline]
 pub fn octile_steps(p: Point, g: Point) -> (i32, i32) {
-    let dx = (i32::from(p.x) - i32::from(g.x)).abs();
-    let dy = (i32::from(p.y) - i32::from(g.y)).abs();
+    let dx = i32::from(p.x.abs_diff(g.x));
+    let dy = i32::from(p.y.abs_diff(g.y));
     let (hi, lo) = if dx >= dy { (dx, dy) } else { (dy, dx) };
-    (hi - lo, lo)
+    (hi.wrapping_sub(lo), lo) // hi >= lo
 }
 
 /// Octile distance from `p` to `g`.
@@ -79,11 +79,12 @@ static CLASS: [[u8; 8]; KEYS] = {
     t
 };
 
-/// Class of a goal offset (see [`CLASS`]).
+/// Class of a goal offset (see [`CLASS`]). Offsets are differences of `u16` coordinates, so
+/// nothing here can overflow: the `wrapping_` operations never wrap.
 const fn key_of(dx: i32, dy: i32) -> usize {
-    let sx = dx.signum() + 1;
-    let sy = dy.signum() + 1;
-    let diff = dx.abs() - dy.abs();
+    let sx = dx.signum().wrapping_add(1);
+    let sy = dy.signum().wrapping_add(1);
+    let diff = dx.abs().wrapping_sub(dy.abs());
     let diff = if diff < -3 {
         -3
     } else if diff > 3 {
@@ -91,7 +92,12 @@ const fn key_of(dx: i32, dy: i32) -> usize {
     } else {
         diff
     };
-    ((sx * 3 + sy) * 7 + diff + 3) as usize
+    // 0..63: sx, sy in 0..=2, diff in -3..=3.
+    sx.wrapping_mul(3)
+        .wrapping_add(sy)
+        .wrapping_mul(7)
+        .wrapping_add(diff)
+        .wrapping_add(3) as usize
 }
 
 /// The precomputed `eta^beta` of one plan: 30 numbers (a 128-byte table), indexed through the
@@ -164,9 +170,10 @@ impl Heuristic {
     /// The class of cell `p` (its offset class relative to the goal).
     #[inline]
     pub fn key(&self, p: Point) -> usize {
+        // Differences of u16 values: no i32 overflow.
         key_of(
-            i32::from(p.x) - i32::from(self.goal.x),
-            i32::from(p.y) - i32::from(self.goal.y),
+            i32::from(p.x).wrapping_sub(i32::from(self.goal.x)),
+            i32::from(p.y).wrapping_sub(i32::from(self.goal.y)),
         )
     }
 
@@ -189,11 +196,12 @@ impl Heuristic {
 
 /// Octile decomposition of an offset: `(straight, diagonal)` steps.
 const fn octile_offset(dx: i32, dy: i32) -> (i32, i32) {
+    // Offsets are small (compile time) or differences of u16 values: no wrap.
     let (ax, ay) = (dx.abs(), dy.abs());
     if ax >= ay {
-        (ax - ay, ay)
+        (ax.wrapping_sub(ay), ay)
     } else {
-        (ay - ax, ax)
+        (ay.wrapping_sub(ax), ax)
     }
 }
 

@@ -24,8 +24,11 @@
 //!
 //! ## Panic freedom
 //! Nothing reachable from a map, a start/goal pair or a parameter set panics: indexing goes
-//! through `get`, arithmetic that can overflow is checked or saturating, and the clippy lints
-//! `unwrap_used`, `expect_used`, `panic` and `indexing_slicing` are denied for the whole crate.
+//! through `get`, and integer arithmetic is `checked_*` where an input can make it overflow,
+//! `saturating_*` for counters and `wrapping_*` only where the value is bounded by construction
+//! (map coordinates are `u16`, so every cell index fits a 32-bit `usize`). The clippy lints
+//! `unwrap_used`, `expect_used`, `panic`, `indexing_slicing` and `arithmetic_side_effects` are
+//! denied for the whole crate.
 //!
 //! ## Example
 //! ```
@@ -55,6 +58,7 @@
     clippy::expect_used,
     clippy::panic,
     clippy::indexing_slicing,
+    clippy::arithmetic_side_effects,
     clippy::unreachable,
     clippy::todo,
     clippy::unimplemented
@@ -65,7 +69,8 @@
         clippy::unwrap_used,
         clippy::indexing_slicing,
         clippy::expect_used,
-        clippy::panic
+        clippy::panic,
+        clippy::arithmetic_side_effects
     )
 )]
 

@@ -20,17 +20,19 @@ pub fn edge(width: u16, p: Point, d: Dir) -> Option<(usize, usize)> {
         (p, d)
     } else {
         let di = usize::from(d);
-        let x = i32::from(p.x) + DX.get(di).copied().unwrap_or(0);
-        let y = i32::from(p.y) + DY.get(di).copied().unwrap_or(0);
+        // A u16 plus -1..=1: no i32 overflow.
+        let x = i32::from(p.x).wrapping_add(DX.get(di).copied().unwrap_or(0));
+        let y = i32::from(p.y).wrapping_add(DY.get(di).copied().unwrap_or(0));
         if x < 0 || y < 0 {
             return None;
         }
-        (Point::new(x as u16, y as u16), d - 4)
+        (Point::new(x as u16, y as u16), d.wrapping_sub(4)) // d >= 4
     };
-    Some((
-        usize::from(q.y) * usize::from(width) + usize::from(q.x),
-        usize::from(slot),
-    ))
+    // At most 65535 * 65535 + 65535 < 2^32: fits the (at least 32-bit) usize, see `crate::grid`.
+    let cell = usize::from(q.y)
+        .wrapping_mul(usize::from(width))
+        .wrapping_add(usize::from(q.x));
+    Some((cell, usize::from(slot)))
 }
 
 /// For each direction, the offset from `4 * cell` to the edge's slot in a flattened table: `d`
@@ -42,7 +44,8 @@ pub fn slot_offsets(offsets: &[isize; 8]) -> [isize; 8] {
         *slot = if d < 4 {
             d as isize
         } else {
-            4 * off + (d as isize - 4)
+            // |off| <= width + 1 <= 65536: no overflow.
+            off.wrapping_mul(4).wrapping_add(d as isize).wrapping_sub(4)
         };
     }
     s

@@ -557,10 +557,10 @@ impl<'g, 'a> Run<'g, 'a> {
                 let b = Best::of(&walk);
                 let len = b.length();
                 sum += len;
-                arrived += 1;
+                arrived = arrived.saturating_add(1);
                 deposit(&mut delta, self.grid, self.start, path, p.q / len);
                 match &mut it_best {
-                    Some((cur, n)) if cur.same_length(&b) => *n += 1,
+                    Some((cur, n)) if cur.same_length(&b) => *n = n.saturating_add(1),
                     Some((cur, _)) if len >= cur.length() => {}
                     _ => {
                         copy_tour(iter_best, path);
@@ -568,7 +568,7 @@ impl<'g, 'a> Run<'g, 'a> {
                     }
                 }
                 match &mut it_worst {
-                    Some((cur, n)) if cur.same_length(&b) => *n += 1,
+                    Some((cur, n)) if cur.same_length(&b) => *n = n.saturating_add(1),
                     Some((cur, _)) if len <= cur.length() => {}
                     _ => {
                         copy_tour(iter_worst, path);
@@ -657,7 +657,7 @@ impl<'g, 'a> Run<'g, 'a> {
         let dist = delta.as_flattened_mut();
         let tour: &'a [Dir] = best_tour.get(..best.steps).ok_or(Error::NoPath)?;
         // Expand the tour into cells.
-        let n = best.steps + 1;
+        let n = best.steps.checked_add(1).ok_or(Error::NoPath)?;
         let pts = points.get_mut(..n).ok_or(Error::NoPath)?;
         for (slot, p) in pts.iter_mut().zip(RawPath::new(start, tour)) {
             *slot = p;
@@ -755,7 +755,8 @@ impl<'a> Plan<'a> {
 
     /// Cells in the raw path (steps + 1).
     pub fn raw_len(&self) -> usize {
-        self.tour.len() + 1
+        // A slice is at most `isize::MAX` long, so this does not wrap.
+        self.tour.len().wrapping_add(1)
     }
 
     /// The output waypoints: first = start, last = goal, no collinear interior points.
@@ -791,8 +792,9 @@ impl Iterator for RawPath<'_> {
         let cur = self.next?;
         self.next = self.dirs.next().map(|&d| {
             let di = usize::from(d & 7);
-            let x = i32::from(cur.x) + DX.get(di).copied().unwrap_or(0);
-            let y = i32::from(cur.y) + DY.get(di).copied().unwrap_or(0);
+            // A u16 plus -1..=1: no i32 overflow.
+            let x = i32::from(cur.x).wrapping_add(DX.get(di).copied().unwrap_or(0));
+            let y = i32::from(cur.y).wrapping_add(DY.get(di).copied().unwrap_or(0));
             Point::new(
                 x.clamp(0, i32::from(u16::MAX)) as u16,
                 y.clamp(0, i32::from(u16::MAX)) as u16,

@@ -69,15 +69,17 @@ impl core::fmt::Display for SmoothingKind {
 
 /// True if `b` lies on the straight line from `a` to `c`, between them.
 fn collinear_between(a: Point, b: Point, c: Point) -> bool {
+    // Differences of u16 values and their products (< 2^33) cannot wrap in i64.
     let (ux, uy) = (
-        i64::from(b.x) - i64::from(a.x),
-        i64::from(b.y) - i64::from(a.y),
+        i64::from(b.x).wrapping_sub(i64::from(a.x)),
+        i64::from(b.y).wrapping_sub(i64::from(a.y)),
     );
     let (vx, vy) = (
-        i64::from(c.x) - i64::from(b.x),
-        i64::from(c.y) - i64::from(b.y),
+        i64::from(c.x).wrapping_sub(i64::from(b.x)),
+        i64::from(c.y).wrapping_sub(i64::from(b.y)),
     );
-    ux * vy - uy * vx == 0 && ux * vx + uy * vy >= 0
+    ux.wrapping_mul(vy) == uy.wrapping_mul(vx)
+        && ux.wrapping_mul(vx).wrapping_add(uy.wrapping_mul(vy)) >= 0
 }
 
 /// Remove interior points of `pts[..n]` that lie straight between their neighbours; returns the
@@ -88,23 +90,29 @@ pub fn drop_collinear(pts: &mut [Point], n: usize) -> usize {
     if n < 3 {
         return n;
     }
+    // Bounds: 3 <= n <= pts.len() and 1 <= k <= i < n, so no `wrapping_` here wraps.
+    let last_i = n.wrapping_sub(1);
     let mut k = 1usize; // pts[..k] is the output so far; pts[k-1] is the last kept point.
-    for i in 1..n - 1 {
-        let (Some(&a), Some(&b), Some(&c)) = (pts.get(k - 1), pts.get(i), pts.get(i + 1)) else {
+    for i in 1..last_i {
+        let (Some(&a), Some(&b), Some(&c)) = (
+            pts.get(k.wrapping_sub(1)),
+            pts.get(i),
+            pts.get(i.wrapping_add(1)),
+        ) else {
             break;
         };
         if !collinear_between(a, b, c) {
             if let Some(slot) = pts.get_mut(k) {
                 *slot = b;
             }
-            k += 1;
+            k = k.wrapping_add(1);
         }
     }
-    let last = pts.get(n - 1).copied();
+    let last = pts.get(last_i).copied();
     if let (Some(last), Some(slot)) = (last, pts.get_mut(k)) {
         *slot = last;
     }
-    k + 1
+    k.wrapping_add(1)
 }
 
 /// Smooth the path `pts[..n]` in place; returns the number of waypoints now in `pts`.
@@ -138,6 +146,8 @@ pub fn smooth(
 
 /// The paper's greedy rule, in place.
 fn greedy(grid: &Grid<'_>, pts: &mut [Point], n: usize) -> usize {
+    // Bounds: 3 <= n <= pts.len() (see `smooth`) and anchor < i, out < i, i <= n, so no
+    // `wrapping_` here wraps.
     let mut out = 1usize; // pts[0] stays.
     let mut anchor = 0usize;
     let mut i = 2usize;
@@ -148,22 +158,22 @@ fn greedy(grid: &Grid<'_>, pts: &mut [Point], n: usize) -> usize {
         if !segment_clear(grid, s, p) {
             // The node before N becomes a waypoint and the new anchor. It is always reachable
             // from the anchor (it was seen on the previous round, or it is the anchor's successor).
-            anchor = i - 1;
+            anchor = i.wrapping_sub(1);
             let Some(&w) = pts.get(anchor) else { break };
             if let Some(slot) = pts.get_mut(out) {
                 *slot = w;
             }
-            out += 1;
+            out = out.wrapping_add(1);
             // Note: anchor < i, and the kept prefix pts[..out] never overtakes the read position
             // because out <= anchor.
         }
-        i += 1;
+        i = i.wrapping_add(1);
     }
-    let last = pts.get(n - 1).copied();
+    let last = pts.get(n.wrapping_sub(1)).copied();
     if let (Some(last), Some(slot)) = (last, pts.get_mut(out)) {
         *slot = last;
     }
-    out + 1
+    out.wrapping_add(1)
 }
 
 /// Shortest subsequence path by dynamic programming, in place.
@@ -181,8 +191,9 @@ fn shortest(
     for j in 1..n {
         let Some(&pj) = pts.get(j) else { break };
         // Default: come from the previous raw cell (always clear: it is a legal move).
-        let (mut best, mut from) = match (dist.get(j - 1), pts.get(j - 1)) {
-            (Some(&d), Some(&p)) => (d + distance(p, pj), j - 1),
+        let before = j.wrapping_sub(1); // j >= 1
+        let (mut best, mut from) = match (dist.get(before), pts.get(before)) {
+            (Some(&d), Some(&p)) => (d + distance(p, pj), before),
             _ => break,
         };
         for i in 0..j.saturating_sub(1) {
@@ -202,7 +213,7 @@ fn shortest(
         }
     }
     // Follow prev from the goal back to the start, reversing the links into "next" links.
-    let mut cur = n - 1;
+    let mut cur = n.wrapping_sub(1); // n >= 3 (see `smooth`)
     let mut next = u32::MAX;
     while let Some(slot) = prev.get_mut(cur) {
         let p = *slot as usize;
@@ -221,7 +232,8 @@ fn shortest(
         if let Some(slot) = pts.get_mut(k) {
             *slot = p;
         }
-        k += 1;
+        // The links only go forward, so at most n cells are visited: k <= n.
+        k = k.wrapping_add(1);
         match prev.get(i) {
             Some(&nx) if nx != u32::MAX => i = nx as usize,
             _ => break,

@@ -35,7 +35,9 @@ pub fn deposit(table: &mut Table<'_>, grid: &Grid<'_>, start: Point, tour: &[Dir
         let (Some(&slot), Some(&off)) = (slots.get(d), offsets.get(d)) else {
             return;
         };
-        table.add_flat((4 * c).wrapping_add_signed(slot), amount);
+        // `c` is a cell index (< cells, and the table's 16 bytes a cell fit in memory), so `4 * c`
+        // does not wrap; a stray index would only be ignored by `add_flat`.
+        table.add_flat(c.wrapping_mul(4).wrapping_add_signed(slot), amount);
         c = c.wrapping_add_signed(off);
     }
 }

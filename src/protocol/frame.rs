@@ -23,13 +23,13 @@ pub(crate) fn crc32_step(mut crc: u32, b: u8) -> u32 {
 
 /// Most bytes COBS adds to `len` payload bytes (one code byte, plus one per 254 bytes).
 pub const fn cobs_overhead(len: usize) -> usize {
-    len / 254 + 1
+    (len / 254).wrapping_add(1) // at most usize::MAX / 254 + 1: no wrap
 }
 
 /// Largest complete frame on the wire (with its delimiter) for a payload of `len` bytes, CRC
-/// included.
+/// included. Saturates at `usize::MAX` for absurd lengths (no buffer is that large).
 pub const fn wire_len(len: usize) -> usize {
-    len + cobs_overhead(len) + 1
+    len.saturating_add(cobs_overhead(len)).saturating_add(1)
 }
 
 /// COBS-encode `buf[src..src + len]` into `buf[0..]`, in place. `src` must be at least
@@ -39,24 +39,26 @@ pub(crate) fn cobs_encode_in_place(buf: &mut [u8], src: usize, len: usize) -> Op
     if src < cobs_overhead(len) || src.checked_add(len)? > buf.len() {
         return None;
     }
+    // No `wrapping_` here wraps: `src + i < src + len <= buf.len()`, `out <= src + i + 1` (the
+    // writes never overtake the reads) and `code <= 0xFE` before it is incremented.
     let mut code_at = 0usize;
     let mut out = 1usize;
     let mut code: u8 = 1;
     for i in 0..len {
-        let b = *buf.get(src + i)?;
+        let b = *buf.get(src.wrapping_add(i))?;
         if b == 0 {
             *buf.get_mut(code_at)? = code;
             code_at = out;
-            out += 1;
+            out = out.wrapping_add(1);
             code = 1;
         } else {
             *buf.get_mut(out)? = b;
-            out += 1;
-            code += 1;
+            out = out.wrapping_add(1);
+            code = code.wrapping_add(1);
             if code == 0xFF {
                 *buf.get_mut(code_at)? = code;
                 code_at = out;
-                out += 1;
+                out = out.wrapping_add(1);
                 code = 1;
             }
         }
@@ -75,8 +77,9 @@ pub(crate) fn cobs_decode_in_place(buf: &mut [u8]) -> Option<usize> {
         if code == 0 {
             return None;
         }
-        r += 1;
-        let run = usize::from(code - 1);
+        // No `wrapping_` in this loop wraps: `r < n` here, `code >= 1`, and `w <= r <= end <= n`.
+        r = r.wrapping_add(1);
+        let run = usize::from(code.wrapping_sub(1));
         let end = r.checked_add(run)?;
         if end > n || buf.get(r..end)?.contains(&0) {
             return None;
@@ -85,13 +88,13 @@ pub(crate) fn cobs_decode_in_place(buf: &mut [u8]) -> Option<usize> {
         // by byte rather than `copy_within`, which keeps a panic path the compiler cannot drop.
         for i in r..end {
             let b = *buf.get(i)?;
-            *buf.get_mut(w + (i - r))? = b;
+            *buf.get_mut(w.wrapping_add(i.wrapping_sub(r)))? = b;
         }
-        w += run;
+        w = w.wrapping_add(run);
         r = end;
         if code != 0xFF && r < n {
             *buf.get_mut(w)? = 0;
-            w += 1;
+            w = w.wrapping_add(1);
         }
     }
     Some(w)

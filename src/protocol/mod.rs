@@ -579,22 +579,26 @@ fn encode<T: Serialize>(id: u32, msg: &T, out: &mut [u8]) -> Result<usize, Encod
     }
     // Serialize at an offset that leaves room for COBS's extra bytes, then encode in place.
     let src = cobs_overhead(payload);
-    let region = out.get_mut(src..src + body).ok_or(too_small)?;
+    // `src + body <= src + payload == need - 1 < have` (`need` did not saturate, or it would
+    // exceed `have`), so neither sum wraps.
+    let body_end = src.wrapping_add(body);
+    let payload_end = src.wrapping_add(payload);
+    let region = out.get_mut(src..body_end).ok_or(too_small)?;
     let written = postcard::to_slice(&value, region)
         .map_err(|_| EncodeError::Serialize)?
         .len();
     if written != body {
         return Err(EncodeError::Serialize);
     }
-    let crc = crc32(out.get(src..src + body).ok_or(too_small)?);
-    let crc_slot = out.get_mut(src + body..src + payload).ok_or(too_small)?;
+    let crc = crc32(out.get(src..body_end).ok_or(too_small)?);
+    let crc_slot = out.get_mut(body_end..payload_end).ok_or(too_small)?;
     // Byte by byte rather than `copy_from_slice`, which keeps a panic path for unequal lengths.
     for (d, b) in crc_slot.iter_mut().zip(crc.to_le_bytes()) {
         *d = b;
     }
     let n = frame::cobs_encode_in_place(out, src, payload).ok_or(too_small)?;
     *out.get_mut(n).ok_or(too_small)? = 0;
-    Ok(n + 1)
+    Ok(n.wrapping_add(1)) // n < out.len()
 }
 
 /// Undo COBS in place and check the CRC; returns the postcard bytes.

@@ -112,7 +112,8 @@ impl<'a> PathStream<'a> {
         // It ends with the two empty byte strings, one zero length byte each: drop them.
         let head_len = n.checked_sub(2).ok_or(EncodeError::Serialize)?;
         let waypoint_bytes = path.waypoints.len().saturating_mul(WAYPOINT_BYTES);
-        let head_len = head_len + put_len(&mut head, head_len, waypoint_bytes)?;
+        // `put_len` writes into `head[head_len..]`, so the sum is at most `HEAD`.
+        let head_len = head_len.wrapping_add(put_len(&mut head, head_len, waypoint_bytes)?);
         let mut mid = [0u8; 5];
         let mid_len = put_len(&mut mid, 0, path.directions.len())?;
         let payload = head_len
@@ -157,13 +158,17 @@ impl<'a> PathStream<'a> {
                 Stage::Gather => self.gather(),
                 Stage::Emit { at, last } => {
                     let byte = match at.checked_sub(1) {
-                        None => self.block_len as u8 + 1, // the code byte (1..=255)
+                        // The code byte: block_len <= 254, so 1..=255 without wrapping.
+                        None => (self.block_len as u8).wrapping_add(1),
                         Some(i) => self.block.get(i).copied().unwrap_or(0),
                     };
                     *slot = byte;
-                    n += 1;
+                    n = n.wrapping_add(1); // < out.len(): the slot existed
                     self.stage = if at < self.block_len {
-                        Stage::Emit { at: at + 1, last }
+                        Stage::Emit {
+                            at: at.wrapping_add(1), // <= block_len <= BLOCK
+                            last,
+                        }
                     } else if last {
                         Stage::Delimiter
                     } else {
@@ -172,7 +177,7 @@ impl<'a> PathStream<'a> {
                 }
                 Stage::Delimiter => {
                     *slot = 0;
-                    n += 1;
+                    n = n.wrapping_add(1); // < out.len(): the slot existed
                     self.stage = Stage::Done;
                 }
                 Stage::Done => break,
@@ -193,7 +198,7 @@ impl<'a> PathStream<'a> {
                     if let Some(slot) = self.block.get_mut(self.block_len) {
                         *slot = b;
                     }
-                    self.block_len += 1;
+                    self.block_len = self.block_len.wrapping_add(1); // < BLOCK before
                     if self.block_len == BLOCK {
                         break false;
                     }
@@ -231,7 +236,7 @@ impl<'a> PathStream<'a> {
                 Part::Crc => {
                     let crc = (!self.crc).to_le_bytes();
                     if let Some(&b) = crc.get(pos) {
-                        self.pos += 1;
+                        self.pos = pos.wrapping_add(1); // pos < 4
                         return Some(b);
                     }
                     None
@@ -240,7 +245,8 @@ impl<'a> PathStream<'a> {
             };
             match byte {
                 Some(b) => {
-                    self.pos += 1;
+                    // `pos` indexed a byte of the current part, so it is below a slice length.
+                    self.pos = pos.wrapping_add(1);
                     self.crc = crc32_step(self.crc, b);
                     return Some(b);
                 }
