@@ -275,7 +275,13 @@ pub fn summarize(runs: &[Run]) -> Summary {
     let max = |f: &dyn Fn(&RunStats) -> f64| valid.iter().map(|s| f(s)).fold(f64::NAN, f64::max);
     let min = |f: &dyn Fn(&RunStats) -> f64| valid.iter().map(|s| f(s)).fold(f64::NAN, f64::min);
     let mean_length = mean(&|s| s.length);
-    let var = mean(&|s| (s.length - mean_length).powi(2));
+    // Sample variance (n - 1), as `ohaca experiment`'s summary.md, so the two tables agree.
+    let count = valid.len() as f64;
+    let var = if count > 1.0 {
+        mean(&|s| (s.length - mean_length).powi(2)) * count / (count - 1.0)
+    } else {
+        0.0
+    };
     let total: Duration = runs.iter().map(|r| r.time).sum();
     Summary {
         runs: runs.len(),

@@ -5,7 +5,8 @@
 //! [`save`] picks the format from the file name (`.svg` or `.png`). PNGs are drawn into an RGB
 //! buffer and encoded with the `image` crate, so nothing depends on the machine: text is set in
 //! the Go font, vendored in `host/assets/` (BSD licence beside it) and registered with plotters
-//! at first use. SVG text names the `sans-serif` family and is shaped by the viewer. Output is a
+//! at first use. SVGs carry the same font as a `data:` URL in an `@font-face` rule
+//! ([`embed_font`]), so browsers set their text in it whatever fonts the machine has. Output is a
 //! pure function of the input (no timestamps, no thread-dependent order).
 //!
 //! ## The map picture
@@ -105,7 +106,7 @@ pub trait Picture {
     fn draw<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>) -> Result<(), String>;
 }
 
-/// The picture as an SVG document.
+/// The picture as an SVG document, with the font embedded (see [`embed_font`]).
 pub fn to_svg<P: Picture>(p: &P) -> Result<String, String> {
     register_font();
     let mut s = String::new();
@@ -114,7 +115,62 @@ pub fn to_svg<P: Picture>(p: &P) -> Result<String, String> {
         p.draw(&root)?;
         root.present().map_err(|e| e.to_string())?;
     }
-    Ok(s)
+    Ok(embed_font(&s))
+}
+
+/// The family name of the font embedded in SVGs.
+pub const SVG_FAMILY: &str = "OhacaGo";
+
+/// Embed the vendored font in an SVG document drawn by plotters: an `@font-face` rule whose
+/// source is the TTF itself as a `data:` URL, and every `font-family="sans-serif"` attribute
+/// turned into `"OhacaGo, sans-serif"`. A viewer with CSS fonts (every browser, also for an SVG
+/// shown through `<img>`) then sets the text in the same font as the PNGs, whatever fonts the
+/// machine has; one without them (e.g. librsvg) falls back to its own sans-serif.
+pub fn embed_font(svg: &str) -> String {
+    let style = format!(
+        "<defs><style>@font-face{{font-family:\"{SVG_FAMILY}\";\
+         src:url(data:font/ttf;base64,{}) format(\"truetype\");}}</style></defs>",
+        base64(FONT)
+    );
+    let family = format!("font-family=\"{SVG_FAMILY}, {FAMILY}\"");
+    let body = svg.replace(&format!("font-family=\"{FAMILY}\""), &family);
+    // After the opening tag `<svg ...>`.
+    match body
+        .find("<svg")
+        .and_then(|i| body.get(i..)?.find('>').map(|j| i + j + 1))
+    {
+        Some(at) => {
+            let (head, tail) = body.split_at(at);
+            format!("{head}\n{style}{tail}")
+        }
+        None => body,
+    }
+}
+
+/// Standard base64 (RFC 4648, with `=` padding).
+pub fn base64(bytes: &[u8]) -> String {
+    const ABC: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    let sym = |v: u32| char::from(*ABC.get((v & 63) as usize).unwrap_or(&b'A'));
+    let mut out = String::with_capacity(bytes.len().div_ceil(3) * 4);
+    for chunk in bytes.chunks(3) {
+        let b = |i: usize| u32::from(chunk.get(i).copied().unwrap_or(0));
+        let n = (b(0) << 16) | (b(1) << 8) | b(2);
+        out.push(sym(n >> 18));
+        out.push(sym(n >> 12));
+        out.push(if chunk.len() > 1 { sym(n >> 6) } else { '=' });
+        out.push(if chunk.len() > 2 { sym(n) } else { '=' });
+    }
+    out
+}
+
+/// Width in pixels of `text` set in the vendored font at `size` (as the PNGs draw it).
+pub fn text_width(text: &str, size: f64) -> u32 {
+    register_font();
+    (FAMILY, size).into_font().box_size(text).map_or_else(
+        // Only if the font could not be read: a generous estimate.
+        |_| (text.chars().count() as f64 * size * 0.62).ceil() as u32,
+        |(w, _)| w,
+    )
 }
 
 /// The picture as RGB pixels, row-major, 3 bytes a pixel.
@@ -231,15 +287,15 @@ impl Layer {
         r: &crate::output::PlanReport,
         resolution: Option<f64>,
     ) -> Layer {
-        let turns = r.turns.map_or_else(|| "-".to_string(), |t| t.to_string());
+        let turns = r.turns.map_or_else(
+            || "- turns".to_string(),
+            |t| crate::output::count(u64::from(t), "turn"),
+        );
         let (line1, line2) = match (r.found, r.length, r.raw_length) {
             (true, Some(len), Some(raw)) => (
                 match resolution {
-                    Some(res) => format!(
-                        "{:.2} m ({len:.3} cells), {turns} turns",
-                        f64::from(len) * res
-                    ),
-                    None => format!("length {len:.3}, {turns} turns"),
+                    Some(res) => format!("{:.2} m ({len:.3} cells), {turns}", f64::from(len) * res),
+                    None => format!("length {len:.3}, {turns}"),
                 },
                 format!(
                     "raw {raw:.3}, best in iteration {}, seed {}",
@@ -306,6 +362,17 @@ const LABEL_W: u32 = 34;
 const LABEL_H: u32 = 18;
 const LEGEND_W: u32 = 340;
 const LEGEND_LINE: u32 = 22;
+/// Legend text starts this far right of the legend's left edge (after the swatches).
+const LEGEND_TEXT_DX: u32 = 44;
+const TITLE_SIZE: f64 = 19.0;
+const SUBTITLE_SIZE: f64 = 13.0;
+const BODY_SIZE: f64 = 15.0;
+const SMALL_SIZE: f64 = 13.0;
+
+/// The first legend line of a layer: the algorithm's name and its numbers.
+fn layer_line1(layer: &Layer) -> String {
+    format!("{}: {}", display_name(layer.algorithm), layer.line1)
+}
 
 impl Layout {
     /// The layout of a `width x height` map with a legend of `legend_lines` lines.
@@ -363,9 +430,36 @@ impl Scene {
         1 + 2 * layers + 1 + 3 + 3 + u32::from(self.pheromone.is_some()) * 2
     }
 
-    /// The scene's layout.
+    /// The scene's layout: [`Layout::new`], widened where a title or legend line would
+    /// otherwise run off the right edge (small maps, long file names).
     pub fn layout(&self) -> Layout {
-        Layout::new(self.map.width, self.map.height, self.legend_lines())
+        let mut l = Layout::new(self.map.width, self.map.height, self.legend_lines());
+        let text_x = l.legend_x + LEGEND_TEXT_DX;
+        let mut lines: Vec<(u32, String, f64)> = vec![
+            (MARGIN, self.title.clone(), TITLE_SIZE),
+            (MARGIN, self.subtitle.clone(), SUBTITLE_SIZE),
+            (text_x, self.pheromone_label.clone(), SMALL_SIZE),
+        ];
+        for layer in &self.layers {
+            lines.push((text_x, layer_line1(layer), BODY_SIZE));
+            lines.push((text_x, layer.line2.clone(), SMALL_SIZE));
+        }
+        for (label, p) in [("start", self.start), ("goal", self.goal)] {
+            lines.push((text_x, self.endpoint_label(label, p), BODY_SIZE));
+        }
+        for (x, text, size) in lines {
+            l.width = l.width.max(x + text_width(&text, size) + MARGIN);
+        }
+        l
+    }
+
+    /// The legend text of the start or the goal: the cell, and metres for maps with a frame.
+    fn endpoint_label(&self, label: &str, p: Point) -> String {
+        let metres = self.frame.map_or_else(String::new, |f| {
+            let [mx, my] = f.to_metres(p);
+            format!(" = ({mx:.2}, {my:.2}) m")
+        });
+        format!("{label} ({},{}){metres}", p.x, p.y)
     }
 
     fn draw_map<DB: DrawingBackend>(
@@ -539,9 +633,9 @@ impl Scene {
         let x = l.legend_x as i32;
         let mut y = (l.map_y + LEGEND_LINE / 2) as i32;
         let line = LEGEND_LINE as i32;
-        let text_x = x + 44;
-        let body = left(font(15.0, INK));
-        let small = left(font(13.0, MUTED));
+        let text_x = x + LEGEND_TEXT_DX as i32;
+        let body = left(font(BODY_SIZE, INK));
+        let small = left(font(SMALL_SIZE, MUTED));
         let swatch = |y: i32| [(x, y), (x + 34, y)];
         a.draw(&Text::new("Paths", (x, y), left(font(16.0, INK))))
             .map_err(err)?;
@@ -555,12 +649,8 @@ impl Scene {
                 colour.stroke_width(width),
             ))
             .map_err(err)?;
-            a.draw(&Text::new(
-                format!("{}: {}", display_name(layer.algorithm), layer.line1),
-                (text_x, y),
-                body.clone(),
-            ))
-            .map_err(err)?;
+            a.draw(&Text::new(layer_line1(layer), (text_x, y), body.clone()))
+                .map_err(err)?;
             y += line;
             a.draw(&Text::new(
                 layer.line2.clone(),
@@ -599,12 +689,8 @@ impl Scene {
         for (colour, label, p) in [(START, "start", self.start), (GOAL, "goal", self.goal)] {
             a.draw(&Circle::new((x + 17, y), 8, colour.filled()))
                 .map_err(err)?;
-            let metres = self.frame.map_or_else(String::new, |f| {
-                let [mx, my] = f.to_metres(p);
-                format!(" = ({mx:.2}, {my:.2}) m")
-            });
             a.draw(&Text::new(
-                format!("{label} ({},{}){metres}", p.x, p.y),
+                self.endpoint_label(label, p),
                 (text_x, y),
                 body.clone(),
             ))
@@ -672,13 +758,13 @@ impl Picture for Scene {
         a.draw(&Text::new(
             self.title.clone(),
             (MARGIN as i32, 16),
-            left(font(19.0, INK)),
+            left(font(TITLE_SIZE, INK)),
         ))
         .map_err(err)?;
         a.draw(&Text::new(
             self.subtitle.clone(),
             (MARGIN as i32, 38),
-            left(font(13.0, MUTED)),
+            left(font(SUBTITLE_SIZE, MUTED)),
         ))
         .map_err(err)?;
         self.draw_map(a, &l)?;
@@ -709,7 +795,8 @@ pub struct Convergence {
 
 impl Picture for Convergence {
     fn size(&self) -> (u32, u32) {
-        (960, 600)
+        // Wider than 960 only when the title would not fit (a long file name).
+        (960.max(text_width(&self.title, 20.0) + 2 * 18 + 8), 600)
     }
 
     fn draw<DB: DrawingBackend>(&self, a: &DrawingArea<DB, Shift>) -> Result<(), String> {
@@ -872,6 +959,12 @@ mod tests {
                 },
             ],
         };
+        // A title longer than the chart widens it.
+        let long = Convergence {
+            title: "a very long name of a map file, ".repeat(6),
+            ..c.clone()
+        };
+        assert!(long.size().0 > 960 && long.size().1 == 600);
         let svg = to_svg(&c).unwrap();
         assert!(svg.contains("OHACA") && svg.contains("iteration"));
         let png = to_png(&c).unwrap();
@@ -887,6 +980,32 @@ mod tests {
             }],
         };
         to_png(&e).unwrap();
+    }
+
+    #[test]
+    fn base64_is_rfc_4648() {
+        for (plain, coded) in [
+            ("", ""),
+            ("f", "Zg=="),
+            ("fo", "Zm8="),
+            ("foo", "Zm9v"),
+            ("foob", "Zm9vYg=="),
+            ("fooba", "Zm9vYmE="),
+            ("foobar", "Zm9vYmFy"),
+        ] {
+            assert_eq!(base64(plain.as_bytes()), coded);
+        }
+        assert_eq!(base64(&[0xFB, 0xFF]), "+/8=");
+    }
+
+    #[test]
+    fn embedding_the_font_keeps_one_document() {
+        let svg =
+            "<svg width=\"1\" height=\"1\">\n<text font-family=\"sans-serif\">a</text>\n</svg>\n";
+        let e = embed_font(svg);
+        assert!(e.starts_with("<svg width=\"1\" height=\"1\">\n<defs><style>@font-face{"));
+        assert!(e.contains("<text font-family=\"OhacaGo, sans-serif\">a</text>"));
+        assert!(e.ends_with("</svg>\n"));
     }
 
     #[test]

@@ -16,58 +16,134 @@ use crate::map::Map;
 
 /// Block every cell whose centre is within `radius` cells (Euclidean, centre to centre) of a
 /// blocked cell's centre. `radius <= 0` (or not finite) leaves the map as it is.
+///
+/// The exact squared distance of every cell to its nearest obstacle comes from a linear-time
+/// distance transform ([`squared_distances`]), so the cost does not grow with the radius: a
+/// radius larger than the map is as cheap as a small one.
 pub fn inflate(map: &Map, radius: f64) -> Map {
     if !(radius.is_finite() && radius > 0.0) {
         return map.clone();
     }
-    let (w, h) = (i64::from(map.width), i64::from(map.height));
-    // A disc of offsets; the epsilon keeps cells exactly on the circle inside.
+    // The epsilon keeps cells exactly on the circle inside.
     let r2 = radius * radius + 1e-9;
-    let reach = radius.floor().min(f64::from(u16::MAX)) as i64;
-    let disc: Vec<(i64, i64)> = (-reach..=reach)
-        .flat_map(|dy| (-reach..=reach).map(move |dx| (dx, dy)))
-        .filter(|&(dx, dy)| ((dx * dx + dy * dy) as f64) <= r2)
+    let d2 = squared_distances(map);
+    Map::from_fn(map.width, map.height, |x, y| {
+        d2.get(usize::from(y) * usize::from(map.width) + usize::from(x))
+            .is_none_or(|&d| d <= r2)
+    })
+}
+
+/// Stands for "no obstacle in reach": larger than any squared distance on a map (at most
+/// 2 x 65535^2), small enough that sums with squares of coordinates stay finite.
+const FAR: f64 = 1e20;
+
+/// Squared Euclidean distance, in cells, from each cell's centre to the nearest blocked cell's
+/// centre (0 on obstacles, at least [`FAR`] when the map has none), row-major.
+///
+/// The separable transform of Felzenszwalb and Huttenlocher ("Distance transforms of sampled
+/// functions", 2012): a 1-D transform down every column, then along every row, `O(width x
+/// height)` in all. Every finite value is an exact integer.
+pub fn squared_distances(map: &Map) -> Vec<f64> {
+    let (w, h) = (usize::from(map.width), usize::from(map.height));
+    let mut d: Vec<f64> = (0..map.height)
+        .flat_map(|y| (0..map.width).map(move |x| (x, y)))
+        .map(|(x, y)| {
+            if map.is_blocked(Point::new(x, y)) {
+                0.0
+            } else {
+                FAR
+            }
+        })
         .collect();
-    let blocked = |x: i64, y: i64| -> bool {
-        match (u16::try_from(x), u16::try_from(y)) {
-            (Ok(x), Ok(y)) => map.is_blocked(Point::new(x, y)),
-            _ => true,
-        }
-    };
-    let mut out = vec![false; map.cells()];
+    let n = w.max(h);
+    let mut line = vec![0.0; n];
+    let mut scratch = Envelope::new(n);
+    // Columns: element `i` of column `x` is cell `i * w + x`; rows: cell `y * w + i`.
+    for x in 0..w {
+        transform_line(&mut d, h, |i| i * w + x, &mut line, &mut scratch);
+    }
     for y in 0..h {
-        for x in 0..w {
-            if !blocked(x, y) {
-                continue;
-            }
-            let i = (y * w + x) as usize;
-            if let Some(c) = out.get_mut(i) {
-                *c = true;
-            }
-            // Only obstacle cells with a free 4-neighbour inside the map can be the nearest
-            // obstacle of a free cell, so the others need not spread.
-            let edge = [(1, 0), (-1, 0), (0, 1), (0, -1)].iter().any(|&(dx, dy)| {
-                let (nx, ny) = (x + dx, y + dy);
-                nx >= 0 && ny >= 0 && nx < w && ny < h && !blocked(nx, ny)
-            });
-            if !edge {
-                continue;
-            }
-            for &(dx, dy) in &disc {
-                let (nx, ny) = (x + dx, y + dy);
-                if nx >= 0 && ny >= 0 && nx < w && ny < h {
-                    if let Some(c) = out.get_mut((ny * w + nx) as usize) {
-                        *c = true;
-                    }
-                }
-            }
+        transform_line(&mut d, w, |i| y * w + i, &mut line, &mut scratch);
+    }
+    d
+}
+
+/// Scratch space of the 1-D transform: the parabolas of the lower envelope (`v`) and the
+/// boundaries between them (`z`).
+struct Envelope {
+    v: Vec<usize>,
+    z: Vec<f64>,
+}
+
+impl Envelope {
+    fn new(n: usize) -> Envelope {
+        Envelope {
+            v: vec![0; n.max(1)],
+            z: vec![0.0; n + 1],
         }
     }
-    Map::from_fn(map.width, map.height, |x, y| {
-        out.get(usize::from(y) * usize::from(map.width) + usize::from(x))
-            .copied()
-            .unwrap_or(true)
-    })
+}
+
+/// The 1-D squared distance transform of the `len` values of `d` at `index(0..len)`, in place:
+/// `d[q] = min over p of (d[p] + (q - p)^2)`.
+fn transform_line(
+    d: &mut [f64],
+    len: usize,
+    index: impl Fn(usize) -> usize,
+    line: &mut [f64],
+    e: &mut Envelope,
+) {
+    if len == 0 {
+        return;
+    }
+    for (i, slot) in line.iter_mut().take(len).enumerate() {
+        *slot = d.get(index(i)).copied().unwrap_or(FAR);
+    }
+    let f = |i: usize| line.get(i).copied().unwrap_or(FAR);
+    let sq = |i: usize| (i as f64) * (i as f64);
+    let (v, z) = (&mut e.v, &mut e.z);
+    let set_v = |v: &mut Vec<usize>, k: usize, p: usize| {
+        if let Some(s) = v.get_mut(k) {
+            *s = p;
+        }
+    };
+    let set_z = |z: &mut Vec<f64>, k: usize, s: f64| {
+        if let Some(t) = z.get_mut(k) {
+            *t = s;
+        }
+    };
+    let mut k = 0usize;
+    set_v(v, 0, 0);
+    set_z(z, 0, f64::NEG_INFINITY);
+    set_z(z, 1, f64::INFINITY);
+    for q in 1..len {
+        let mut s;
+        loop {
+            let p = v.get(k).copied().unwrap_or(0);
+            // Where the parabola rooted at q overtakes the one rooted at p (p < q).
+            s = ((f(q) + sq(q)) - (f(p) + sq(p))) / (2.0 * (q as f64 - p as f64));
+            if k > 0 && s <= z.get(k).copied().unwrap_or(f64::NEG_INFINITY) {
+                k -= 1;
+            } else {
+                break;
+            }
+        }
+        k += 1;
+        set_v(v, k, q);
+        set_z(z, k, s);
+        set_z(z, k + 1, f64::INFINITY);
+    }
+    let mut k = 0usize;
+    for q in 0..len {
+        while z.get(k + 1).is_some_and(|&b| b < q as f64) {
+            k += 1;
+        }
+        let p = v.get(k).copied().unwrap_or(0);
+        let dq = q as f64 - p as f64;
+        if let Some(slot) = d.get_mut(index(q)) {
+            *slot = dq * dq + f(p);
+        }
+    }
 }
 
 /// Why a map cannot be resampled.
@@ -169,6 +245,52 @@ mod tests {
                 })
             });
             assert_eq!(fast, slow, "radius {r}");
+        }
+    }
+
+    #[test]
+    fn distances_are_exact() {
+        let m = Map::from_fn(31, 9, |x, y| {
+            (x * 5 + y * 3) % 17 == 0 || (x == 30 && y == 8)
+        });
+        let d = squared_distances(&m);
+        for y in 0..m.height {
+            for x in 0..m.width {
+                let want = (0..m.height)
+                    .flat_map(|by| (0..m.width).map(move |bx| (bx, by)))
+                    .filter(|&(bx, by)| m.is_blocked(Point::new(bx, by)))
+                    .map(|(bx, by)| {
+                        (f64::from(x) - f64::from(bx)).powi(2)
+                            + (f64::from(y) - f64::from(by)).powi(2)
+                    })
+                    .fold(f64::INFINITY, f64::min);
+                let got = d[usize::from(y) * 31 + usize::from(x)];
+                assert_eq!(got, want, "{x},{y}");
+            }
+        }
+        // No obstacle: everything is far, nothing is inflated.
+        let free = Map::from_fn(7, 3, |_, _| false);
+        assert!(squared_distances(&free).iter().all(|&v| v >= FAR));
+        assert_eq!(inflate(&free, 1e6), free);
+        // One row, one column.
+        let row = text("..#....\n");
+        assert_eq!(
+            squared_distances(&row),
+            vec![4.0, 1.0, 0.0, 1.0, 4.0, 9.0, 16.0]
+        );
+        assert_eq!(inflate(&row, 2.0).to_text(), "#####..\n");
+    }
+
+    #[test]
+    fn a_huge_radius_is_cheap_and_blocks_everything() {
+        // The old disc-of-offsets inflation allocated (2r + 1)^2 offsets: at r = 1e9 cells that
+        // was the whole memory. Now the cost does not depend on the radius.
+        let m = Map::from_fn(300, 200, |x, y| x == 150 && y == 100);
+        for r in [1e3, 1e9, f64::MAX] {
+            let t = std::time::Instant::now();
+            let i = inflate(&m, r);
+            assert!(i.to_text().chars().all(|c| c == '#' || c == '\n'), "r {r}");
+            assert!(t.elapsed().as_secs() < 20, "r {r}: {:?}", t.elapsed());
         }
     }
 

@@ -140,8 +140,10 @@ pub struct PlanReport {
     /// Output waypoints, `[x, y]`, start to goal.
     pub waypoints: Vec<[u16; 2]>,
     /// Length of the raw path.
+    #[serde(serialize_with = "serialize_length")]
     pub raw_length: Option<f32>,
     /// Length through the waypoints.
+    #[serde(serialize_with = "serialize_length")]
     pub length: Option<f32>,
     /// Turns along the waypoints.
     pub turns: Option<u32>,
@@ -158,6 +160,22 @@ pub struct PlanReport {
     /// Why no path was found (absent when `found`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub error: Option<String>,
+}
+
+/// `v` with a negative zero made positive: a path of one cell has length `0`, not `-0` (the
+/// core's sum of no segments can be `-0.0`, which JSON, CSV and text would show as `-0`).
+pub fn unsigned_zero(v: f32) -> f32 {
+    if v == 0.0 {
+        0.0
+    } else {
+        v
+    }
+}
+
+/// Serialize a length with [`unsigned_zero`] applied, so every report (`plan`, `send`) prints
+/// `0.0` for a one-cell path.
+fn serialize_length<S: serde::Serializer>(v: &Option<f32>, s: S) -> Result<S::Ok, S::Error> {
+    v.map(unsigned_zero).serialize(s)
 }
 
 /// `[x, y]` of a point.
@@ -177,8 +195,8 @@ impl PlanReport {
             found: true,
             raw: plan.raw().map(xy).collect(),
             waypoints: plan.waypoints().iter().copied().map(xy).collect(),
-            raw_length: Some(plan.raw_length),
-            length: Some(plan.length),
+            raw_length: Some(unsigned_zero(plan.raw_length)),
+            length: Some(unsigned_zero(plan.length)),
             turns: Some(plan.turns),
             iterations: Some(plan.iterations),
             best_iteration: Some(plan.best_iteration),
@@ -324,19 +342,30 @@ pub fn format_us(us: u64) -> String {
     }
 }
 
+/// `n thing` or `n things`.
+pub fn count(n: u64, thing: &str) -> String {
+    if n == 1 {
+        format!("1 {thing}")
+    } else {
+        format!("{n} {thing}s")
+    }
+}
+
 /// A short summary of a report: lengths, turns, iterations, time (two lines, each ending in
 /// `\n`).
 pub fn summary(r: &PlanReport) -> String {
     let mut s = String::new();
-    let n = |v: Option<f32>| v.map_or_else(|| "-".to_string(), |v| format!("{v:.3}"));
+    let n =
+        |v: Option<f32>| v.map_or_else(|| "-".to_string(), |v| format!("{:.3}", unsigned_zero(v)));
     if r.found {
         let _ = writeln!(
             s,
-            "raw length {}   waypoint path {} ({} waypoints)   {} turns",
+            "raw length {}   waypoint path {} ({})   {}",
             n(r.raw_length),
             n(r.length),
-            r.waypoints.len(),
-            r.turns.map_or_else(|| "-".to_string(), |t| t.to_string()),
+            count(r.waypoints.len() as u64, "waypoint"),
+            r.turns
+                .map_or_else(|| "- turns".to_string(), |t| count(u64::from(t), "turn")),
         );
     } else {
         let _ = writeln!(

@@ -316,6 +316,48 @@ fn start_equals_goal() {
     assert_eq!(v["raw_length"], 0.0);
 }
 
+#[test]
+fn a_one_cell_path_has_length_zero_not_minus_zero() {
+    // The core sums no segments into -0.0 for OHACA's smoothed path; the tool prints 0.
+    for alg in ["ohaca", "haca", "aca"] {
+        let (o, v) = plan_json(&complex(), "7,7", "7,7", &["--algorithm", alg]);
+        assert_eq!(o.status.code(), Some(0));
+        let text = stdout(&o);
+        assert!(
+            text.contains("\"raw_length\":0.0,\"length\":0.0,"),
+            "{alg}: {text}"
+        );
+        assert!(!text.contains("-0"), "{alg}: {text}");
+        assert!(v["length"].as_f64().unwrap().is_sign_positive());
+    }
+    let o = ohaca(&[
+        "plan",
+        "--map",
+        complex().to_str().unwrap(),
+        "--start",
+        "7,7",
+        "--goal",
+        "7,7",
+    ]);
+    let text = stdout(&o);
+    assert!(
+        text.contains("raw length 0.000   waypoint path 0.000 (1 waypoint)   0 turns"),
+        "{text}"
+    );
+    let o = ohaca(&[
+        "plan",
+        "--map",
+        complex().to_str().unwrap(),
+        "--start",
+        "7,7",
+        "--goal",
+        "7,7",
+        "--format",
+        "csv",
+    ]);
+    assert_eq!(stdout(&o), "x,y\n7,7\n");
+}
+
 /// One bad-input case: a map file's content (None = do not create the file), extra arguments,
 /// and substrings the single stderr line must contain.
 struct Bad {

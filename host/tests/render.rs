@@ -3,6 +3,8 @@
 
 mod common;
 
+use std::path::Path;
+
 use common::*;
 use ohaca::{Algorithm, Point};
 use ohaca_host::draw::{algorithm_colour, Layout, BLOCKED};
@@ -280,4 +282,132 @@ fn no_path_still_draws_and_exits_1() {
     ]);
     assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
     assert!(image::open(&out).is_ok());
+}
+
+#[test]
+fn a_long_title_widens_a_small_map_picture() {
+    // A 6 x 3 map under a long folder name: the picture used to be as wide as the map and the
+    // legend only, so the title ran off the right edge.
+    let dir = tempfile::tempdir().unwrap();
+    let deep = dir
+        .path()
+        .join("a-folder-with-a-rather-long-name-for-the-robot-maps-of-the-second-floor");
+    std::fs::create_dir(&deep).unwrap();
+    let map = deep.join("tiny-map-of-the-corridor.txt");
+    std::fs::write(&map, "......\n.##...\n......\n").unwrap();
+    let out = dir.path().join("t.png");
+    let o = ohaca(&[
+        "render",
+        "--map",
+        map.to_str().unwrap(),
+        "--start",
+        "0,0",
+        "--goal",
+        "5,2",
+        "--algorithm",
+        "aca,paca,haca,ohaca",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let img = image::open(&out).unwrap().to_rgb8();
+    let m = Map::load(&map).unwrap();
+    let plain = Layout::new(m.width, m.height, 1 + 2 * 4 + 1 + 3 + 3);
+    assert!(img.width() > plain.width, "widened: {}", img.width());
+    // The map stays where the plain layout puts it (same height, same cells).
+    assert_eq!(img.height(), plain.height);
+    let (cx, cy) = plain.corner(1, 1);
+    assert_eq!(
+        img.get_pixel(cx as u32 + 3, cy as u32 + 3).0,
+        [BLOCKED.0, BLOCKED.1, BLOCKED.2]
+    );
+    // The title (rows 6..30) has ink, and none in the right margin.
+    let ink = |x0: u32, x1: u32| {
+        (6..30).any(|y| (x0..x1).any(|x| img.get_pixel(x, y).0.iter().any(|&c| c < 200)))
+    };
+    assert!(ink(16, 200));
+    assert!(!ink(img.width() - 12, img.width()), "title clipped");
+    // One turn is "1 turn".
+    let svg = dir.path().join("t.svg");
+    let o = ohaca(&[
+        "render",
+        "--map",
+        map.to_str().unwrap(),
+        "--start",
+        "0,0",
+        "--goal",
+        "5,2",
+        "--out",
+        svg.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let text = std::fs::read_to_string(&svg).unwrap();
+    assert!(text.contains(", 1 turn\n"), "{text}");
+}
+
+/// Standard base64 decoding (the test's own, to check the tool's encoder).
+fn unbase64(s: &str) -> Vec<u8> {
+    let val = |c: u8| match c {
+        b'A'..=b'Z' => c - b'A',
+        b'a'..=b'z' => c - b'a' + 26,
+        b'0'..=b'9' => c - b'0' + 52,
+        b'+' => 62,
+        b'/' => 63,
+        _ => panic!("not base64: {c}"),
+    };
+    let bytes: Vec<u8> = s.bytes().filter(|&c| c != b'=').collect();
+    let mut out = Vec::new();
+    for chunk in bytes.chunks(4) {
+        let mut n = 0u32;
+        for (i, &c) in chunk.iter().enumerate() {
+            n |= u32::from(val(c)) << (18 - 6 * i);
+        }
+        out.extend_from_slice(&n.to_be_bytes()[1..chunk.len()]);
+    }
+    out
+}
+
+#[test]
+fn svg_embeds_the_font() {
+    let dir = tempfile::tempdir().unwrap();
+    let map = write_map(dir.path());
+    let out = dir.path().join("f.svg");
+    let o = ohaca(&[
+        "render",
+        "--map",
+        map.to_str().unwrap(),
+        "--start",
+        "0,4",
+        "--goal",
+        "11,4",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let svg = std::fs::read_to_string(&out).unwrap();
+    // The vendored TTF, byte for byte, in an @font-face rule inside the document.
+    let start = svg.find("base64,").expect("a data: URL") + "base64,".len();
+    let end = start + svg[start..].find(')').unwrap();
+    let font =
+        std::fs::read(Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/Go-Regular.ttf")).unwrap();
+    assert!(
+        unbase64(&svg[start..end]) == font,
+        "the embedded font is Go Regular"
+    );
+    assert!(svg.contains("@font-face{font-family:\"OhacaGo\""));
+    assert!(svg.find("<defs>").unwrap() < svg.find("<text").unwrap());
+    // Every text asks for it first (the viewer's sans-serif only as a fallback).
+    let families: Vec<&str> = svg
+        .split("font-family=\"")
+        .skip(1)
+        .map(|s| &s[..s.find('"').unwrap()])
+        .collect();
+    assert!(!families.is_empty());
+    assert!(
+        families.iter().all(|f| *f == "OhacaGo, sans-serif"),
+        "{families:?}"
+    );
+    // Still one well-formed document.
+    assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"));
+    assert_eq!(svg.matches("<svg").count(), 1);
 }

@@ -433,3 +433,62 @@ fn clear_errors_exit_2() {
         stderr(&o)
     );
 }
+
+#[test]
+fn inflation_radius_larger_than_the_map_is_fast() {
+    // The inflation used to allocate a disc of (2r + 1)^2 offsets, r in cells: 1000 m at
+    // 0.05 m per cell was 1.6e9 offsets, and the tool died of memory exhaustion. Now it is a
+    // distance transform whose cost does not depend on r.
+    let dir = tempfile::tempdir().unwrap();
+    let row = [F; 40];
+    let mut mid = [F; 40];
+    mid[20] = O;
+    let yaml = ros_map(
+        dir.path(),
+        "big",
+        &[&row, &row, &mid, &row, &row],
+        0.05,
+        [0.0, 0.0],
+        "",
+    );
+    let t = std::time::Instant::now();
+    let o = ohaca(&[
+        "plan",
+        "--map",
+        yaml.to_str().unwrap(),
+        "--start",
+        "0,0",
+        "--goal",
+        "39,4",
+        "--inflate",
+        "1000",
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("big.yaml: start is on an obstacle"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(t.elapsed().as_secs() < 30, "{:?}", t.elapsed());
+    // Every cell is within 1000 m of the one obstacle.
+    let a = MapArgs {
+        inflate: Some(1000.0),
+        ..args(&yaml)
+    };
+    assert!(blocked(&load(&a)).iter().all(|r| r == &"#".repeat(40)));
+    // 0.5 m = 10 cells: the columns 10..=30 of the obstacle's row, fewer above and below.
+    let a = MapArgs {
+        inflate: Some(0.5),
+        ..args(&yaml)
+    };
+    let rows = blocked(&load(&a));
+    assert_eq!(
+        rows[2],
+        format!("{}{}{}", ".".repeat(10), "#".repeat(21), ".".repeat(9))
+    );
+    // Row 0 is 2 cells away: |dx| <= sqrt(100 - 4) = 9.8.
+    assert_eq!(
+        rows[0],
+        format!("{}{}{}", ".".repeat(11), "#".repeat(19), ".".repeat(10))
+    );
+}
