@@ -252,9 +252,19 @@ pub fn read_image(path: &Path) -> Result<RgbaImage, InputError> {
         problem,
     };
     let bytes = std::fs::read(path).map_err(|e| err(format!("cannot read the image: {e}")))?;
-    let format = image::guess_format(&bytes)
+    decode_image(&bytes, &name)
+}
+
+/// Decode the bytes of a PNG or PGM image as RGBA, as [`read_image`] does for a file; `name`
+/// stands for the file in errors.
+pub fn decode_image(bytes: &[u8], name: &str) -> Result<RgbaImage, InputError> {
+    let err = |problem: String| InputError::File {
+        path: name.to_string(),
+        problem,
+    };
+    let format = image::guess_format(bytes)
         .map_err(|_| err("not a PNG or PGM image (unknown file signature)".to_string()))?;
-    let img = image::load_from_memory_with_format(&bytes, format)
+    let img = image::load_from_memory_with_format(bytes, format)
         .map_err(|e| err(format!("cannot decode the image: {e}")))?;
     let (w, h) = (img.width(), img.height());
     if w == 0 || h == 0 {
@@ -270,7 +280,7 @@ pub fn read_image(path: &Path) -> Result<RgbaImage, InputError> {
     Ok(img.to_rgba8())
 }
 
-/// Image sides as `u16` (checked by [`read_image`]).
+/// Image sides as `u16` (checked by [`decode_image`]; larger sides clamp to `u16::MAX`).
 fn sides(img: &RgbaImage) -> (u16, u16) {
     (
         u16::try_from(img.width()).unwrap_or(u16::MAX),
@@ -296,7 +306,13 @@ pub fn load_ros(yaml: &Path, unknown: Unknown) -> Result<(Map, Frame), InputErro
         )));
     }
     let img = read_image(&meta.image)?;
-    let (w, h) = sides(&img);
+    Ok(ros_map(&meta, &img, unknown))
+}
+
+/// The map and frame of a ROS `map_server` map from its parsed YAML and its decoded image (what
+/// [`load_ros`] does once the files are read). Unknown cells follow `unknown`.
+pub fn ros_map(meta: &RosMeta, img: &RgbaImage, unknown: Unknown) -> (Map, Frame) {
+    let (w, h) = sides(img);
     let map = Map::from_fn(w, h, |x, y| {
         let px = img.get_pixel(u32::from(x), u32::from(y));
         match meta.classify(grey(px), px.0[3]) {
@@ -312,20 +328,24 @@ pub fn load_ros(yaml: &Path, unknown: Unknown) -> Result<(Map, Frame), InputErro
         width: w,
         height: h,
     };
-    Ok((map, frame))
+    (map, frame)
 }
 
 /// Load a plain image as a map: darker than 50 % is blocked (transparent counts as white).
 pub fn load_image(path: &Path) -> Result<Map, InputError> {
-    let img = read_image(path)?;
-    let (w, h) = sides(&img);
-    Ok(Map::from_fn(w, h, |x, y| {
+    read_image(path).map(|img| image_map(&img))
+}
+
+/// A decoded plain image as a map: darker than 50 % is blocked (transparent counts as white).
+pub fn image_map(img: &RgbaImage) -> Map {
+    let (w, h) = sides(img);
+    Map::from_fn(w, h, |x, y| {
         let px = img.get_pixel(u32::from(x), u32::from(y));
         // Composite over white: value * a + 255 * (1 - a).
         let a = f64::from(px.0[3]) / 255.0;
         let v = grey(px) * a + 255.0 * (1.0 - a);
         v < 127.5
-    }))
+    })
 }
 
 #[cfg(test)]
@@ -418,6 +438,21 @@ mod tests {
             let e = meta(text).unwrap_err();
             assert!(e.starts_with(want), "{text:?}: {e}");
         }
+    }
+
+    #[test]
+    fn from_memory_matches_the_files() {
+        // The in-memory steps (used by fuzz/src/maps.rs) give what the file loaders give.
+        let yaml = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/ros/lab.yaml");
+        let (map, frame) = load_ros(&yaml, Unknown::Free).unwrap();
+        let meta = RosMeta::parse(&std::fs::read_to_string(&yaml).unwrap(), &yaml).unwrap();
+        let img = decode_image(&std::fs::read(&meta.image).unwrap(), "lab.pgm").unwrap();
+        assert_eq!(ros_map(&meta, &img, Unknown::Free), (map, frame));
+        assert_eq!(image_map(&img), load_image(&meta.image).unwrap());
+        let e = decode_image(b"P5\n2 2\n255\n", "short.pgm").unwrap_err();
+        assert!(e.to_string().starts_with("short.pgm: cannot decode"), "{e}");
+        let e = decode_image(b"no image", "x.png").unwrap_err();
+        assert!(e.to_string().contains("unknown file signature"), "{e}");
     }
 
     #[test]

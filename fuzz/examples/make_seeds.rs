@@ -1,0 +1,353 @@
+//! Writes the seed inputs of the `frame` and `map_parsers` targets into `fuzz/seeds/<target>/`
+//! (small, committed) from the protocol's own encoders and the repository's maps.
+//!
+//! ```text
+//! cd fuzz && cargo run --example make_seeds --target x86_64-unknown-linux-gnu
+//! ```
+
+use std::fs;
+use std::io::Cursor;
+use std::path::{Path, PathBuf};
+
+use image::{GrayImage, ImageFormat, Luma, Rgba, RgbaImage};
+use ohaca::protocol::{
+    encode_reply, encode_request, Capacity, ErrorCode, ErrorReply, HelloReply, PathReply, Reply,
+    Request, StatsReply, Waypoints, MAX_CHUNK, MAX_DIRECTIONS, MAX_REPLY_WIRE, MAX_REQUEST,
+    MAX_REQUEST_WIRE, MAX_WAYPOINTS, VERSION,
+};
+use ohaca::{Algorithm, DeadEnd, Params, Point, SmoothingKind};
+use ohaca_host::map::Map;
+
+type Result<T> = std::result::Result<T, Box<dyn std::error::Error>>;
+
+fn req(id: u32, r: &Request<'_>) -> Vec<u8> {
+    let mut buf = vec![0u8; MAX_REQUEST_WIRE];
+    let n = encode_request(id, r, &mut buf).expect("seed request encodes");
+    buf.truncate(n);
+    buf
+}
+
+fn rep(id: u32, r: &Reply<'_>) -> Vec<u8> {
+    let mut buf = vec![0u8; MAX_REPLY_WIRE];
+    let n = encode_reply(id, r, &mut buf).expect("seed reply encodes");
+    buf.truncate(n);
+    buf
+}
+
+/// Every `SetMap` chunk of `map`, `chunk` bytes each, ids from `id`.
+fn set_map(map: &Map, chunk: usize, id: u32) -> Vec<Vec<u8>> {
+    let total = map.bits.len() as u32;
+    map.bits
+        .chunks(chunk)
+        .enumerate()
+        .map(|(i, c)| {
+            req(
+                id + i as u32,
+                &Request::SetMap {
+                    width: map.width,
+                    height: map.height,
+                    offset: (i * chunk) as u32,
+                    total_len: total,
+                    chunk: c,
+                },
+            )
+        })
+        .collect()
+}
+
+fn frame_seeds(root: &Path) -> Result<Vec<(String, Vec<u8>)>> {
+    let mut out: Vec<(String, Vec<u8>)> = Vec::new();
+    let complex = Map::load(root.join("maps/complex-26.map"))?;
+    let random = Map::load(root.join("maps/movingai/random-32-32-20.map"))?;
+    let params = Params {
+        algorithm: Algorithm::Haca,
+        ants: 50,
+        iterations: 100,
+        seed: 0xDEAD_BEEF,
+        dead_end: DeadEnd::Die,
+        smoothing: SmoothingKind::Greedy,
+        tighten: false,
+        ..Params::default()
+    };
+    let plan = Request::Plan {
+        start: Point::new(0, 0),
+        goal: Point::new(25, 25),
+        seed: Some(42),
+    };
+
+    // Single requests, one frame a file.
+    out.push(("req-hello".into(), req(1, &Request::Hello)));
+    out.push((
+        "req-set-params-default".into(),
+        req(2, &Request::SetParams(Params::default())),
+    ));
+    out.push((
+        "req-set-params-haca".into(),
+        req(3, &Request::SetParams(params)),
+    ));
+    for (i, f) in set_map(&complex, MAX_CHUNK, 4).into_iter().enumerate() {
+        out.push((format!("req-set-map-complex26-{i}"), f));
+    }
+    out.push(("req-plan-seed".into(), req(5, &plan)));
+    out.push((
+        "req-plan-noseed".into(),
+        req(
+            u32::MAX,
+            &Request::Plan {
+                start: Point::new(65535, 0),
+                goal: Point::new(31, 31),
+                seed: None,
+            },
+        ),
+    ));
+    out.push(("req-cancel".into(), req(6, &Request::Cancel)));
+    out.push(("req-stats".into(), req(300, &Request::Stats)));
+
+    // A whole session as the host sends it: 32-byte chunks of complex-26, 128-byte chunks of a
+    // 32x32 map.
+    let mut session = req(1, &Request::Hello);
+    session.extend(req(2, &Request::SetParams(params)));
+    for f in set_map(&complex, 32, 3) {
+        session.extend(f);
+    }
+    session.extend(req(10, &plan));
+    session.extend(req(11, &Request::Stats));
+    session.extend(req(12, &Request::Cancel));
+    out.push(("session-complex26".into(), session));
+    let mut session = Vec::new();
+    for f in set_map(&random, MAX_CHUNK, 100) {
+        session.extend(f);
+    }
+    session.extend(req(
+        200,
+        &Request::Plan {
+            start: Point::new(0, 0),
+            goal: Point::new(31, 31),
+            seed: None,
+        },
+    ));
+    out.push(("session-random32".into(), session));
+
+    // Replies, as the host reads them.
+    let hello = HelloReply {
+        protocol_version: VERSION,
+        firmware_version: "0.1.0",
+        board: "qemu-mps2-an386",
+        capacity: Capacity {
+            cells: 4096,
+            max_width: 4096,
+            max_height: 4096,
+            max_chunk: MAX_CHUNK as u16,
+            max_request: MAX_REQUEST as u16,
+            plan_queue: 4,
+            tick_hz: 1_000_000,
+        },
+        defaults: Params::default(),
+    };
+    out.push(("rep-hello".into(), rep(1, &Reply::Hello(hello))));
+    out.push(("rep-ack".into(), rep(2, &Reply::Ack)));
+    let points = [
+        Point::new(0, 0),
+        Point::new(3, 2),
+        Point::new(10, 10),
+        Point::new(25, 25),
+    ];
+    let directions: Vec<u8> = (0..40).map(|i| (i % 3) as u8).collect();
+    let path = PathReply {
+        raw_length: 41.8,
+        length: 39.15,
+        turns: 2,
+        iterations: 21,
+        best_iteration: 7,
+        moves: 4200,
+        ticks: 1689,
+        raw_cells: 41,
+        waypoints: Waypoints::Points(&points),
+        directions: &directions,
+    };
+    out.push(("rep-path".into(), rep(10, &Reply::Path(path))));
+    // The largest path the protocol allows, and a reply frame one byte over the host's buffer.
+    let many: Vec<Point> = (0..MAX_WAYPOINTS as u16)
+        .map(|i| Point::new(i, i / 3))
+        .collect();
+    let steps: Vec<u8> = (0..MAX_DIRECTIONS).map(|i| (i % 8) as u8).collect();
+    let max_path = PathReply {
+        waypoints: Waypoints::Points(&many),
+        directions: &steps,
+        ..path
+    };
+    out.push(("rep-path-max".into(), rep(14, &Reply::Path(max_path))));
+    let mut over = vec![0x17u8; MAX_REPLY_WIRE];
+    over.push(0);
+    out.push(("rep-too-large".into(), over));
+    out.push((
+        "rep-error-busy".into(),
+        rep(11, &Reply::Error(ErrorReply::with(ErrorCode::Busy, 4, 4))),
+    ));
+    out.push((
+        "rep-error-badparam".into(),
+        rep(
+            12,
+            &Reply::Error(ErrorReply::with(ErrorCode::BadParam, 3, 0)),
+        ),
+    ));
+    out.push((
+        "rep-error-unknown-id".into(),
+        rep(0, &Reply::Error(ErrorReply::new(ErrorCode::BadCrc))),
+    ));
+    let stats = StatsReply {
+        uptime: 123_456_789,
+        boots: 1,
+        frames_ok: 10,
+        frames_bad: 1,
+        rx_bytes: 999,
+        tx_frames: 11,
+        plans: 3,
+        map_width: 26,
+        map_height: 26,
+        queued: 1,
+        planning: true,
+        stack_peak: 9000,
+        ..StatsReply::default()
+    };
+    out.push(("rep-stats".into(), rep(13, &Reply::Stats(stats))));
+
+    // Damaged frames: a flipped CRC byte, no delimiter, an overlong frame, lone delimiters.
+    let mut bad = req(7, &Request::Stats);
+    let n = bad.len();
+    bad[n - 2] ^= 0x55;
+    out.push(("bad-crc".into(), bad));
+    let mut cut = req(8, &plan);
+    cut.pop();
+    out.push(("no-delimiter".into(), cut));
+    let mut long = vec![0x42u8; MAX_REQUEST_WIRE + 5];
+    long.push(0);
+    long.extend(req(9, &Request::Hello));
+    out.push(("too-large-then-hello".into(), long));
+    out.push(("zeros".into(), vec![0, 0, 0]));
+    Ok(out)
+}
+
+fn png(img: &RgbaImage) -> Vec<u8> {
+    let mut v = Cursor::new(Vec::new());
+    img.write_to(&mut v, ImageFormat::Png).expect("png encodes");
+    v.into_inner()
+}
+
+fn pgm(img: &GrayImage) -> Vec<u8> {
+    let mut v = Cursor::new(Vec::new());
+    img.write_to(&mut v, ImageFormat::Pnm).expect("pgm encodes");
+    v.into_inner()
+}
+
+fn with(sel: u8, body: &[u8]) -> Vec<u8> {
+    let mut v = vec![sel];
+    v.extend_from_slice(body);
+    v
+}
+
+fn map_seeds(root: &Path) -> Result<Vec<(String, Vec<u8>)>> {
+    let mut out = Vec::new();
+    for f in [
+        "maps/simple-18.map",
+        "maps/complex-26.map",
+        "maps/classic-20.map",
+        "maps/movingai/random-32-32-10.map",
+        "maps/movingai/random-32-32-20.map",
+    ] {
+        let name = Path::new(f)
+            .file_stem()
+            .and_then(|s| s.to_str())
+            .unwrap_or("map");
+        out.push((
+            format!("movingai-{name}"),
+            with(b'M', &fs::read(root.join(f))?),
+        ));
+    }
+    let simple = Map::load(root.join("maps/simple-18.map"))?;
+    out.push((
+        "text-simple18".into(),
+        with(b'T', simple.to_text().as_bytes()),
+    ));
+    out.push((
+        "text-crlf-digits".into(),
+        with(b'T', b"\xef\xbb\xbf0101\r\n1..#\r\n####\r\n\r\n"),
+    ));
+    out.push((
+        "auto-movingai".into(),
+        with(b'A', b"type octile\nwidth 4\nheight 2\nmap\nS.@T\nWG..\n"),
+    ));
+    out.push((
+        "auto-named-map".into(),
+        with(
+            b'a',
+            b"\xef\xbb\xbftype octile\r\nheight 2\r\nwidth 3\r\nmap\r\n..@\r\nO.S\r\n",
+        ),
+    ));
+
+    // ROS: the shipped lab map, and small ones in each mode.
+    let mut lab = fs::read(root.join("host/assets/ros/lab.yaml"))?;
+    lab.push(0);
+    lab.extend(fs::read(root.join("host/assets/ros/lab.pgm"))?);
+    out.push(("ros-lab".into(), with(b'R', &lab)));
+    let small = GrayImage::from_fn(12, 9, |x, y| {
+        Luma([match (x + 2 * y) % 5 {
+            0 => 0,
+            1 => 205,
+            2 => 100,
+            _ => 254,
+        }])
+    });
+    let yamls = [
+        "image: small.pgm\nresolution: 0.1\norigin: [-1.0, 2.5, 0.3]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n",
+        "image: /abs/small.pgm\nresolution: 1\norigin: [0, 0]\nnegate: 1\nmode: scale\n",
+        "image: small.png\nresolution: 0.05\norigin: [0.0, 0.0, 0.0]\nmode: raw\noccupied_thresh: 0.5\nfree_thresh: 0.5\n",
+    ];
+    for (i, y) in yamls.iter().enumerate() {
+        let mut v = y.as_bytes().to_vec();
+        v.push(0);
+        v.extend(pgm(&small));
+        out.push((
+            format!("ros-small-{i}"),
+            with(if i == 1 { b'r' } else { b'R' }, &v),
+        ));
+    }
+    let rgba = RgbaImage::from_fn(10, 7, |x, y| {
+        Rgba([
+            (x * 25) as u8,
+            (y * 36) as u8,
+            128,
+            if x == 3 { 100 } else { 255 },
+        ])
+    });
+    let mut v = yamls[2].as_bytes().to_vec();
+    v.push(0);
+    v.extend(png(&rgba));
+    out.push(("ros-small-png".into(), with(b'R', &v)));
+
+    // Plain images.
+    out.push(("image-png".into(), with(b'I', &png(&rgba))));
+    out.push(("image-pgm".into(), with(b'I', &pgm(&small))));
+    out.push((
+        "image-pgm-ascii".into(),
+        with(b'I', b"P2\n3 2\n255\n0 255 128\n12 200 255\n"),
+    ));
+    Ok(out)
+}
+
+fn write(dir: &Path, seeds: &[(String, Vec<u8>)]) -> Result<()> {
+    fs::create_dir_all(dir)?;
+    for (name, bytes) in seeds {
+        fs::write(dir.join(name), bytes)?;
+    }
+    println!("{}: {} seeds", dir.display(), seeds.len());
+    Ok(())
+}
+
+fn main() -> Result<()> {
+    let fuzz = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let root = fuzz.parent().ok_or("no repository root")?.to_path_buf();
+    write(&fuzz.join("seeds/frame"), &frame_seeds(&root)?)?;
+    write(&fuzz.join("seeds/map_parsers"), &map_seeds(&root)?)?;
+    Ok(())
+}

@@ -1,0 +1,81 @@
+//! Replays every saved input through its target's checks: the crash reproducers in
+//! `fuzz/regressions/<target>/` and the seeds in `fuzz/seeds/<target>/`.
+//!
+//! ```text
+//! cd fuzz && cargo test --target x86_64-unknown-linux-gnu
+//! ```
+
+use std::fs;
+use std::path::Path;
+
+fn replay(dir: &str, check: fn(&[u8])) -> usize {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join(dir);
+    let Ok(entries) = fs::read_dir(&dir) else {
+        return 0;
+    };
+    let mut files: Vec<_> = entries.filter_map(|e| e.ok().map(|e| e.path())).collect();
+    files.sort();
+    let mut n = 0;
+    for f in files.iter().filter(|f| f.is_file()) {
+        if f.extension().is_some_and(|e| e == "md") {
+            continue;
+        }
+        let data = fs::read(f).unwrap_or_else(|e| panic!("{}: {e}", f.display()));
+        eprintln!("replaying {}", f.display());
+        check(&data);
+        n += 1;
+    }
+    n
+}
+
+#[test]
+fn frame_inputs() {
+    replay("regressions/frame", ohaca_fuzz::frame::fuzz_frame);
+    assert!(
+        replay("seeds/frame", ohaca_fuzz::frame::fuzz_frame) > 0,
+        "no frame seeds"
+    );
+}
+
+#[test]
+fn map_parser_inputs() {
+    replay(
+        "regressions/map_parsers",
+        ohaca_fuzz::maps::fuzz_map_parsers,
+    );
+    assert!(
+        replay("seeds/map_parsers", ohaca_fuzz::maps::fuzz_map_parsers) > 0,
+        "no map seeds"
+    );
+}
+
+/// The seeds must reach the success paths, not just the error ones.
+#[test]
+fn seeds_are_accepted() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("seeds");
+    for e in fs::read_dir(dir.join("frame")).unwrap() {
+        let f = e.unwrap().path();
+        let name = f.file_name().unwrap().to_string_lossy().into_owned();
+        let (req, rep) = ohaca_fuzz::frame::check_streams(&fs::read(&f).unwrap());
+        if name.starts_with("req-") || name.starts_with("session-") {
+            assert!(req >= 1, "{name}: no request decoded");
+        }
+        if name.starts_with("rep-") && name != "rep-too-large" {
+            assert!(rep >= 1, "{name}: no reply decoded");
+        }
+        if name.starts_with("too-large") {
+            assert_eq!(req, 1, "{name}: the Hello after the long frame");
+        }
+    }
+    for e in fs::read_dir(dir.join("map_parsers")).unwrap() {
+        let f = e.unwrap().path();
+        let name = f.file_name().unwrap().to_string_lossy().into_owned();
+        let ok = ohaca_fuzz::maps::check_map_input(&fs::read(&f).unwrap());
+        assert!(ok, "{name}: no map loaded");
+    }
+}
+
+#[test]
+fn planner_inputs() {
+    replay("regressions/planner", ohaca_fuzz::fuzz_planner);
+}
