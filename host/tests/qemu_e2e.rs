@@ -5,213 +5,33 @@
 //! done ([`Qemu`]'s `Drop`). The firmware is built once per run with `cargo build --release` in
 //! the workspace root (a no-op when it is up to date; set `OHACA_FIRMWARE=path/to/elf` to use
 //! another ELF and skip the build). Without `qemu-system-arm` the tests are skipped with a
-//! message, except under CI (`CI` set), where they fail.
+//! message, except under CI (`CI` set), where they fail. The QEMU helpers are shared with the
+//! soak test (`qemu_soak.rs`) in `common/qemu.rs`.
 //!
 //! Nothing here asserts on time: every wait is bounded by generous timeouts, and latencies are
 //! only printed (`cargo test ... -- --nocapture`).
 
-use std::io::{BufRead, BufReader, Read, Write};
-use std::net::{TcpListener, TcpStream};
-use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Output, Stdio};
-use std::sync::OnceLock;
+#[macro_use]
+#[path = "common/qemu.rs"]
+mod qemu;
+
+use std::io::{Read, Write};
+use std::net::TcpListener;
+use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
 use ohaca::protocol::{
-    crc32, decode_request, encode_request, Capacity, ErrorCode, ErrorReply, Request, RequestReader,
-    MAX_CHUNK, MAX_REQUEST_WIRE, UNKNOWN_ID,
+    crc32, encode_request, Capacity, ErrorCode, ErrorReply, Request, MAX_CHUNK, MAX_REQUEST_WIRE,
+    UNKNOWN_ID,
 };
 use ohaca::{Algorithm, Params, Point};
-use ohaca_host::link::{DevicePath, Link, LinkError, PlanJob, Response, Transport};
+use ohaca_host::link::{DevicePath, Link, LinkError, PlanJob, Response, Stray, Transport};
 use ohaca_host::{plan_map, Map, PlanReport};
+use qemu::{
+    assert_core_path, cobs, core_plan, expected_errors, frame_of, free_port, have_qemu, maps, Qemu,
+    TIMEOUT,
+};
 use serde_json::Value;
-
-/// How long any single reply may take (QEMU on a loaded 2-core CI machine can be slow).
-const TIMEOUT: Duration = Duration::from_secs(120);
-
-// ---- QEMU --------------------------------------------------------------------------------
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
-
-fn maps() -> PathBuf {
-    root().join("maps")
-}
-
-/// True if QEMU can run; false (skip) if it is missing outside CI.
-fn have_qemu() -> bool {
-    let ok = Command::new("qemu-system-arm")
-        .arg("--version")
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .status()
-        .is_ok_and(|s| s.success());
-    if !ok {
-        assert!(
-            std::env::var_os("CI").is_none(),
-            "qemu-system-arm is missing, and CI needs these tests to run \
-             (apt-get install qemu-system-arm, or source scripts/setup.sh)"
-        );
-        eprintln!("SKIPPED: qemu-system-arm is not installed (apt-get install qemu-system-arm)");
-    }
-    ok
-}
-
-/// The firmware ELF, built once per test run.
-fn firmware() -> &'static Path {
-    static ELF: OnceLock<PathBuf> = OnceLock::new();
-    ELF.get_or_init(|| {
-        if let Some(p) = std::env::var_os("OHACA_FIRMWARE") {
-            return PathBuf::from(p);
-        }
-        let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
-        let out = Command::new(cargo)
-            .args(["build", "--release", "-q"])
-            .current_dir(root())
-            .stdout(Stdio::inherit())
-            .output()
-            .expect("run cargo build --release for the firmware");
-        assert!(
-            out.status.success(),
-            "cargo build --release (the firmware) failed:\n{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        let target = std::env::var_os("CARGO_TARGET_DIR")
-            .map(PathBuf::from)
-            .unwrap_or_else(|| root().join("target"));
-        let elf = target.join("thumbv7em-none-eabihf/release/ohaca");
-        assert!(elf.is_file(), "no firmware at {}", elf.display());
-        elf
-    })
-}
-
-/// A running QEMU with the firmware; killed on drop.
-struct Qemu {
-    child: Child,
-    /// `127.0.0.1:PORT` of UART0 (TCP mode).
-    addr: Option<String>,
-    /// `/dev/pts/N` of UART0 (pty mode).
-    pty: Option<String>,
-}
-
-impl Drop for Qemu {
-    fn drop(&mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
-    }
-}
-
-fn qemu_command(serial: &str) -> Command {
-    let mut c = Command::new("qemu-system-arm");
-    c.args(["-M", "mps2-an386", "-display", "none", "-monitor", "none"])
-        .args(["-semihosting-config", "enable=on,target=native"])
-        .args(["-serial", serial])
-        .arg("-kernel")
-        .arg(firmware())
-        .stdin(Stdio::null());
-    c
-}
-
-fn free_port() -> u16 {
-    let l = TcpListener::bind("127.0.0.1:0").expect("bind a free port");
-    l.local_addr().expect("local addr").port()
-}
-
-impl Qemu {
-    /// Boot with UART0 on a free TCP port; returns once the port accepts connections.
-    fn tcp() -> Qemu {
-        for _ in 0..5 {
-            let port = free_port();
-            let child = qemu_command(&format!(
-                "tcp:127.0.0.1:{port},server=on,wait=off,nodelay=on"
-            ))
-            .stdout(Stdio::null())
-            .stderr(Stdio::piped())
-            .spawn()
-            .expect("start qemu-system-arm");
-            let mut q = Qemu {
-                child,
-                addr: Some(format!("127.0.0.1:{port}")),
-                pty: None,
-            };
-            let t0 = Instant::now();
-            while t0.elapsed() < Duration::from_secs(30) {
-                if let Ok(Some(status)) = q.child.try_wait() {
-                    let mut err = String::new();
-                    if let Some(mut e) = q.child.stderr.take() {
-                        let _ = e.read_to_string(&mut err);
-                    }
-                    eprintln!("qemu exited ({status}) on port {port}: {err}; retrying");
-                    break;
-                }
-                if TcpStream::connect(("127.0.0.1", port)).is_ok() {
-                    return q;
-                }
-                std::thread::sleep(Duration::from_millis(20));
-            }
-        }
-        panic!("could not start QEMU with UART0 on a TCP port");
-    }
-
-    /// Boot with UART0 on a pty, as a USB-serial adapter would appear.
-    fn pty() -> Qemu {
-        let mut child = qemu_command("pty")
-            .stdout(Stdio::piped())
-            .stderr(Stdio::inherit())
-            .spawn()
-            .expect("start qemu-system-arm");
-        let stdout = child.stdout.take().expect("qemu stdout");
-        let (tx, rx) = std::sync::mpsc::channel();
-        // QEMU prints `char device redirected to /dev/pts/N (label serial0)` on stdout, then
-        // the firmware's defmt frames (semihosting) follow: keep draining them, or QEMU blocks.
-        std::thread::spawn(move || {
-            let mut r = BufReader::new(stdout);
-            let mut line = Vec::new();
-            let _ = r.read_until(b'\n', &mut line);
-            let _ = tx.send(String::from_utf8_lossy(&line).into_owned());
-            let _ = std::io::copy(&mut r, &mut std::io::sink());
-        });
-        let mut q = Qemu {
-            child,
-            addr: None,
-            pty: None,
-        };
-        let line = rx
-            .recv_timeout(Duration::from_secs(30))
-            .expect("QEMU's `char device redirected to` line");
-        let pty = line
-            .split_whitespace()
-            .find(|w| w.starts_with("/dev/"))
-            .unwrap_or_else(|| panic!("no pty in QEMU's line {line:?}"))
-            .to_string();
-        q.pty = Some(pty);
-        q
-    }
-
-    fn addr(&self) -> &str {
-        self.addr.as_deref().expect("a TCP QEMU")
-    }
-
-    fn link(&self) -> Link<TcpStream> {
-        let t0 = Instant::now();
-        loop {
-            match Link::tcp(self.addr(), TIMEOUT) {
-                Ok(l) => return l,
-                Err(e) if t0.elapsed() > Duration::from_secs(30) => panic!("connect: {e}"),
-                Err(_) => std::thread::sleep(Duration::from_millis(50)),
-            }
-        }
-    }
-}
-
-macro_rules! need_qemu {
-    () => {
-        if !have_qemu() {
-            return;
-        }
-    };
-}
 
 // ---- the host's reference ----------------------------------------------------------------
 
@@ -299,15 +119,19 @@ fn assert_same(what: &str, host: &PlanReport, start: Point, dev: &Result<DeviceP
     assert_eq!(dev.raw_cells as usize, raw.len(), "{what}: raw_cells");
     assert_eq!(wps, host.waypoints, "{what}: waypoints");
     let bits = |v: Option<f32>| v.map(f32::to_bits);
+    // The host's report writes the length of a one-cell path as 0, not the core's -0
+    // (`output.rs`, `unsigned_zero`); the device sends the core's bits (`core_plan` checks
+    // those, in the soak test).
+    let unsigned = |v: f32| if v == 0.0 { 0.0 } else { v };
     assert_eq!(
-        Some(dev.raw_length.to_bits()),
+        Some(unsigned(dev.raw_length).to_bits()),
         bits(host.raw_length),
         "{what}: raw_length {} vs {:?}",
         dev.raw_length,
         host.raw_length
     );
     assert_eq!(
-        Some(dev.length.to_bits()),
+        Some(unsigned(dev.length).to_bits()),
         bits(host.length),
         "{what}: length {} vs {:?}",
         dev.length,
@@ -493,57 +317,6 @@ fn h_code(e: &ohaca_host::PlanError) -> u8 {
         ohaca_host::PlanError::Core(c) => c.code(),
         other => panic!("{other}"),
     }
-}
-
-/// COBS encode (the protocol's own encoder is private): for building broken frames.
-fn cobs(data: &[u8]) -> Vec<u8> {
-    let mut out = vec![0];
-    let (mut code_at, mut code) = (0usize, 1u8);
-    for &b in data {
-        if b == 0 {
-            out[code_at] = code;
-            code_at = out.len();
-            out.push(0);
-            code = 1;
-        } else {
-            out.push(b);
-            code += 1;
-            if code == 0xff {
-                out[code_at] = code;
-                code_at = out.len();
-                out.push(0);
-                code = 1;
-            }
-        }
-    }
-    out[code_at] = code;
-    out
-}
-
-/// A frame of raw postcard bytes with a correct CRC.
-fn frame_of(body: &[u8]) -> Vec<u8> {
-    let mut p = body.to_vec();
-    p.extend_from_slice(&crc32(body).to_le_bytes());
-    let mut f = cobs(&p);
-    f.push(0);
-    f
-}
-
-/// What the firmware must answer to `bytes`, computed with the protocol's own reader and
-/// decoder (exactly what the device runs): one `(id, error)` per broken frame, nothing for
-/// empty ones.
-fn expected_errors(bytes: &[u8]) -> Vec<(u32, ErrorReply)> {
-    let mut r = RequestReader::new();
-    let mut out = Vec::new();
-    for &b in bytes {
-        if let Some(f) = r.push(b).into_frame(MAX_REQUEST_WIRE) {
-            match f.and_then(decode_request) {
-                Ok((id, req)) => panic!("test frame decodes: {id} {req:?}"),
-                Err(e) => out.push((e.id(), e.reply())),
-            }
-        }
-    }
-    out
 }
 
 #[test]
@@ -816,6 +589,213 @@ fn refusals_no_map_map_too_large_busy_and_cancel() {
     assert_eq!(link.stray_count(), 0, "{:?}", link.take_strays());
 }
 
+/// `docs/PROTOCOL.md`, SetMap: "Activating a map cancels every plan received before it: the
+/// running one and the queued ones are answered with `Error Cancelled`; plans received
+/// afterwards use the new map." An upload's first chunk changes nothing (the old map stays in
+/// force and the plan keeps running); a plan received between the first and the last chunk is
+/// for the old map, so it is cancelled too.
+#[test]
+fn a_new_map_cancels_running_and_queued_plans_and_later_plans_use_it() {
+    need_qemu!();
+    let q = Qemu::tcp();
+    let mut link = q.link();
+    link.hello().expect("hello");
+    let old = load("complex-26.map");
+    link.set_map(&old).expect("set map");
+    let slow = Params {
+        iterations: 60_000,
+        patience: 0,
+        ..Params::default()
+    };
+    link.set_params(&slow).expect("set params");
+    let (s, g) = (Point::new(0, 0), Point::new(25, 25));
+    let plan = |link: &mut Link<_>, seed: u64| {
+        link.send(&Request::Plan {
+            start: s,
+            goal: g,
+            seed: Some(seed),
+        })
+        .expect("send")
+    };
+    let running = plan(&mut link, 1);
+    let t0 = Instant::now();
+    loop {
+        let st = link.stats().expect("stats");
+        if st.planning && st.queued == 0 {
+            break;
+        }
+        assert!(t0.elapsed() < TIMEOUT, "the plan never started: {st:?}");
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    let queued = [plan(&mut link, 2), plan(&mut link, 3)];
+
+    // The new map: 20x20 with a wall, sent in two chunks.
+    let new = Map::from_fn(20, 20, |x, y| x == 10 && y < 17);
+    let half = new.bits.len() / 2;
+    fn chunk<'a>(map: &Map, offset: usize, bytes: &'a [u8]) -> Request<'a> {
+        Request::SetMap {
+            width: map.width,
+            height: map.height,
+            offset: offset as u32,
+            total_len: map.bits.len() as u32,
+            chunk: bytes,
+        }
+    }
+    let ack = link
+        .call(&chunk(&new, 0, &new.bits[..half]))
+        .expect("first chunk");
+    assert_eq!(ack, Response::Ack);
+    let st = link.stats().expect("stats");
+    assert_eq!((st.map_width, st.map_height), (26, 26), "{st:?}");
+    assert!(st.planning && st.queued == 2 && st.cancelled == 0, "{st:?}");
+    let between = plan(&mut link, 4);
+    let last = link
+        .send(&chunk(&new, half, &new.bits[half..]))
+        .expect("last chunk");
+    // The map's Ack may come before or after the Cancelled errors: wait for each by id.
+    assert_eq!(link.wait_for(last, "SetMap").expect("ack"), Response::Ack);
+    for id in [running, queued[0], queued[1], between] {
+        let r = link.wait_for(id, "Plan").expect("cancelled");
+        assert_eq!(
+            r,
+            Response::Error(ErrorReply::new(ErrorCode::Cancelled)),
+            "plan {id}"
+        );
+    }
+    let st = link.stats().expect("stats");
+    assert_eq!((st.map_width, st.map_height), (20, 20), "{st:?}");
+    assert!(!st.planning && st.queued == 0, "{st:?}");
+    assert_eq!(
+        (st.cancelled, st.plans, st.plan_errors),
+        (4, 0, 0),
+        "{st:?}"
+    );
+
+    // Later plans use the new map: a path around its wall, bit-identical to the host core's on
+    // the new map (and not the one the old map gives), and the old map's goal is now outside.
+    let params = Params {
+        seed: 5,
+        ..Params::default()
+    };
+    link.set_params(&params).expect("set params");
+    let (s2, g2) = (Point::new(0, 0), Point::new(19, 0));
+    let dev = link.plan(s2, g2, None).expect("plan on the new map");
+    let on_new = core_plan(&new, s2, g2, &params).expect("host plan");
+    assert_core_path("on the new map", &on_new, &dev);
+    assert_ne!(
+        core_plan(&old, s2, g2, &params),
+        Ok(on_new),
+        "the test needs maps with different paths"
+    );
+    let e = error_code(link.plan(s, g, None));
+    assert_eq!(e.code, ErrorCode::GoalOutOfBounds, "{e}");
+    assert_eq!(link.stray_count(), 0, "{:?}", link.take_strays());
+}
+
+/// A host that goes away in the middle of a frame (QEMU's `server=on,wait=off` then accepts the
+/// next client): the partial frame stays in the device's reader until the next client's leading
+/// `00` (which [`Link`] sends on open) ends it. The device answers that one bad frame with an
+/// error reply of id 0, which the link skips as a stray; every request of the new connection is
+/// served, the map is still there, and the device did not reset (`boots` 1, `uptime` grows,
+/// every byte counted).
+#[test]
+fn a_host_that_disconnects_mid_frame_does_not_disturb_the_next_one() {
+    need_qemu!();
+    let mut q = Qemu::tcp();
+    let map = load("simple-18.map");
+    let mut before = {
+        let mut link = q.link();
+        link.hello().expect("hello");
+        link.set_map(&map).expect("set map");
+        let st = link.stats().expect("stats");
+        assert_eq!(link.stray_count(), 0, "{:?}", link.take_strays());
+        st
+    }; // the link is dropped here: disconnected
+    let (s, g) = (Point::new(0, 0), Point::new(17, 17));
+    let mut frame = [0u8; MAX_REQUEST_WIRE];
+    let n = encode_request(
+        77,
+        &Request::Plan {
+            start: s,
+            goal: g,
+            seed: Some(9),
+        },
+        &mut frame,
+    )
+    .expect("encode");
+    // Cut after the first byte, in the middle, and just before the last byte (a whole frame
+    // but its delimiter would be served: the next `00` completes it).
+    for cut in [1, n / 2, n - 2] {
+        let part = &frame[..cut];
+        assert!(!part.contains(&0));
+        {
+            let mut raw = q.connect();
+            raw.write_all(part).expect("write half a frame");
+            raw.flush().expect("flush");
+            // Let QEMU pass the bytes to the UART before the connection goes away (it would
+            // anyway: they come before the end of the stream).
+            std::thread::sleep(Duration::from_millis(200));
+        }
+        let mut flushed = part.to_vec();
+        flushed.push(0);
+        let want = expected_errors(&flushed);
+        assert_eq!(want.len(), 1, "cut {cut}: {want:?}");
+        assert_eq!(want[0].0, UNKNOWN_ID, "cut {cut}");
+
+        let mut link = q.link();
+        let info = link.hello().expect("hello after the reconnection");
+        assert_eq!(info.board, "qemu-mps2-an386");
+        let params = Params {
+            seed: 9,
+            ..Params::default()
+        };
+        let dev = link.plan(s, g, Some(9)).expect("plan");
+        assert_core_path(
+            &format!("cut {cut}"),
+            &core_plan(&map, s, g, &params).expect("host plan"),
+            &dev,
+        );
+        let st = link.stats().expect("stats");
+        assert_eq!(
+            link.take_strays(),
+            vec![Stray::Reply {
+                id: UNKNOWN_ID,
+                response: Response::Error(want[0].1)
+            }],
+            "cut {cut}: the flushed partial frame's error"
+        );
+        assert_eq!(st.boots, 1, "cut {cut}: the device reset: {st:?}");
+        assert!(
+            st.uptime > before.uptime,
+            "cut {cut}: {st:?} after {before:?}"
+        );
+        assert_eq!((st.map_width, st.map_height), (18, 18), "cut {cut}: {st:?}");
+        assert_eq!(st.frames_ok, before.frames_ok + 3, "cut {cut}: {st:?}");
+        assert_eq!(st.frames_bad, before.frames_bad + 1, "cut {cut}: {st:?}");
+        assert_eq!(st.plans, before.plans + 1, "cut {cut}: {st:?}");
+        // Every byte arrived: the partial frame, the link's `00`, Hello, Plan, Stats.
+        let len = |id, r: &Request| {
+            encode_request(id, r, &mut [0u8; MAX_REQUEST_WIRE]).expect("encode") as u32
+        };
+        let sent = cut as u32
+            + 1
+            + len(1, &Request::Hello)
+            + len(
+                2,
+                &Request::Plan {
+                    start: s,
+                    goal: g,
+                    seed: Some(9),
+                },
+            )
+            + len(3, &Request::Stats);
+        assert_eq!(st.rx_bytes, before.rx_bytes + sent, "cut {cut}: {st:?}");
+        assert_eq!(st.rx_overruns, 0, "{st:?}");
+        before = st;
+    }
+    assert!(q.is_running(), "QEMU exited");
+}
+
 #[test]
 fn hello_round_trip_latency() {
     need_qemu!();
@@ -947,7 +927,8 @@ fn send_command_over_tcp() {
     assert!(err.contains("goal is on an obstacle"), "{err}");
     assert!(o.stdout.is_empty());
 
-    // A map larger than the device: refused before the upload, exit 2.
+    // A map larger than the device: resampled to fit (2x2 cells per cell), with a note on
+    // stderr; start, goal and output are cells of the coarse grid.
     let big = maps().join("movingai/random-32-32-10.map");
     let dir = tempfile::tempdir().expect("tempdir");
     let huge = dir.path().join("huge.map");
@@ -957,8 +938,27 @@ fn send_command_over_tcp() {
         text.push('\n');
     }
     std::fs::write(&huge, text).expect("write map");
-    let mut a = base(&["--start", "0,0", "--goal", "39,39"]);
+    let mut a = base(&["--start", "0,0", "--goal", "39,39", "--json"]);
     a[4] = huge.display().to_string();
+    let o = ohaca(&a);
+    assert_eq!(o.status.code(), Some(0), "{o:?}");
+    let err = String::from_utf8_lossy(&o.stderr).into_owned();
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.starts_with("note: ") && err.contains("resampled to 20x20"),
+        "{err}"
+    );
+    let line = json_lines(&o).remove(0);
+    assert_eq!(line["found"], true, "{line}");
+    assert_eq!(line["raw"][0], serde_json::json!([0, 0]), "{line}");
+    assert_eq!(
+        line["waypoints"].as_array().and_then(|w| w.last()),
+        Some(&serde_json::json!([19, 19])),
+        "{line}"
+    );
+    // With --cell the map is taken as given: refused before the upload, exit 2.
+    a.truncate(a.len() - 1);
+    a.extend(strings(&["--cell", "1"]));
     let o = ohaca(&a);
     assert_eq!(o.status.code(), Some(2), "{o:?}");
     let err = String::from_utf8_lossy(&o.stderr).into_owned();

@@ -1,0 +1,350 @@
+//! QEMU helpers shared by the firmware's end-to-end tests (`qemu_e2e.rs`, `qemu_soak.rs`):
+//! build the firmware once, boot it in `qemu-system-arm -M mps2-an386` with UART0 on a free
+//! local TCP port (or a pty), connect a [`Link`], build broken frames, and compute what the
+//! device must answer with the protocol's own reader and decoder, and what its plans must be
+//! with the host's copy of the core.
+//!
+//! Include it with `#[macro_use] #[path = "common/qemu.rs"] mod qemu;` (it is not part of
+//! `common/mod.rs`, so the other tests do not compile it).
+#![allow(dead_code)]
+
+use std::io::{BufRead, BufReader, Read};
+use std::net::{TcpListener, TcpStream};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::sync::OnceLock;
+use std::time::{Duration, Instant};
+
+use ohaca::protocol::{crc32, decode_request, ErrorReply, RequestReader, MAX_REQUEST_WIRE};
+use ohaca::{Params, Point};
+use ohaca_host::link::{DevicePath, Link};
+use ohaca_host::{HeapStorage, Map};
+
+/// How long any single reply may take (QEMU on a loaded 2-core CI machine can be slow).
+pub const TIMEOUT: Duration = Duration::from_secs(120);
+
+pub fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+pub fn maps() -> PathBuf {
+    root().join("maps")
+}
+
+/// True if QEMU can run; false (skip) if it is missing outside CI.
+pub fn have_qemu() -> bool {
+    let ok = Command::new("qemu-system-arm")
+        .arg("--version")
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .status()
+        .is_ok_and(|s| s.success());
+    if !ok {
+        assert!(
+            std::env::var_os("CI").is_none(),
+            "qemu-system-arm is missing, and CI needs these tests to run \
+             (apt-get install qemu-system-arm, or source scripts/setup.sh)"
+        );
+        eprintln!("SKIPPED: qemu-system-arm is not installed (apt-get install qemu-system-arm)");
+    }
+    ok
+}
+
+/// Return early (skip the test) when QEMU is missing outside CI.
+macro_rules! need_qemu {
+    () => {
+        if !have_qemu() {
+            return;
+        }
+    };
+}
+
+/// The firmware ELF, built once per test run.
+pub fn firmware() -> &'static Path {
+    static ELF: OnceLock<PathBuf> = OnceLock::new();
+    ELF.get_or_init(|| {
+        if let Some(p) = std::env::var_os("OHACA_FIRMWARE") {
+            return PathBuf::from(p);
+        }
+        let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
+        let out = Command::new(cargo)
+            .args(["build", "--release", "-q"])
+            .current_dir(root())
+            .stdout(Stdio::inherit())
+            .output()
+            .expect("run cargo build --release for the firmware");
+        assert!(
+            out.status.success(),
+            "cargo build --release (the firmware) failed:\n{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let target = std::env::var_os("CARGO_TARGET_DIR")
+            .map(PathBuf::from)
+            .unwrap_or_else(|| root().join("target"));
+        let elf = target.join("thumbv7em-none-eabihf/release/ohaca");
+        assert!(elf.is_file(), "no firmware at {}", elf.display());
+        elf
+    })
+}
+
+/// A running QEMU with the firmware; killed on drop.
+pub struct Qemu {
+    child: Child,
+    /// `127.0.0.1:PORT` of UART0 (TCP mode).
+    pub addr: Option<String>,
+    /// `/dev/pts/N` of UART0 (pty mode).
+    pub pty: Option<String>,
+}
+
+impl Drop for Qemu {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+fn qemu_command(serial: &str) -> Command {
+    let mut c = Command::new("qemu-system-arm");
+    c.args(["-M", "mps2-an386", "-display", "none", "-monitor", "none"])
+        .args(["-semihosting-config", "enable=on,target=native"])
+        .args(["-serial", serial])
+        .arg("-kernel")
+        .arg(firmware())
+        .stdin(Stdio::null());
+    c
+}
+
+pub fn free_port() -> u16 {
+    let l = TcpListener::bind("127.0.0.1:0").expect("bind a free port");
+    l.local_addr().expect("local addr").port()
+}
+
+impl Qemu {
+    /// Boot with UART0 on a free TCP port (`server=on,wait=off,nodelay=on`: one client at a
+    /// time, a new one accepted after it disconnects); returns once the port accepts
+    /// connections.
+    pub fn tcp() -> Qemu {
+        for _ in 0..5 {
+            let port = free_port();
+            let child = qemu_command(&format!(
+                "tcp:127.0.0.1:{port},server=on,wait=off,nodelay=on"
+            ))
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("start qemu-system-arm");
+            let mut q = Qemu {
+                child,
+                addr: Some(format!("127.0.0.1:{port}")),
+                pty: None,
+            };
+            let t0 = Instant::now();
+            while t0.elapsed() < Duration::from_secs(30) {
+                if let Ok(Some(status)) = q.child.try_wait() {
+                    let mut err = String::new();
+                    if let Some(mut e) = q.child.stderr.take() {
+                        let _ = e.read_to_string(&mut err);
+                    }
+                    eprintln!("qemu exited ({status}) on port {port}: {err}; retrying");
+                    break;
+                }
+                if TcpStream::connect(("127.0.0.1", port)).is_ok() {
+                    return q;
+                }
+                std::thread::sleep(Duration::from_millis(20));
+            }
+        }
+        panic!("could not start QEMU with UART0 on a TCP port");
+    }
+
+    /// Boot with UART0 on a pty, as a USB-serial adapter would appear.
+    pub fn pty() -> Qemu {
+        let mut child = qemu_command("pty")
+            .stdout(Stdio::piped())
+            .stderr(Stdio::inherit())
+            .spawn()
+            .expect("start qemu-system-arm");
+        let stdout = child.stdout.take().expect("qemu stdout");
+        let (tx, rx) = std::sync::mpsc::channel();
+        // QEMU prints `char device redirected to /dev/pts/N (label serial0)` on stdout, then
+        // the firmware's defmt frames (semihosting) follow: keep draining them, or QEMU blocks.
+        std::thread::spawn(move || {
+            let mut r = BufReader::new(stdout);
+            let mut line = Vec::new();
+            let _ = r.read_until(b'\n', &mut line);
+            let _ = tx.send(String::from_utf8_lossy(&line).into_owned());
+            let _ = std::io::copy(&mut r, &mut std::io::sink());
+        });
+        let mut q = Qemu {
+            child,
+            addr: None,
+            pty: None,
+        };
+        let line = rx
+            .recv_timeout(Duration::from_secs(30))
+            .expect("QEMU's `char device redirected to` line");
+        let pty = line
+            .split_whitespace()
+            .find(|w| w.starts_with("/dev/"))
+            .unwrap_or_else(|| panic!("no pty in QEMU's line {line:?}"))
+            .to_string();
+        q.pty = Some(pty);
+        q
+    }
+
+    pub fn addr(&self) -> &str {
+        self.addr.as_deref().expect("a TCP QEMU")
+    }
+
+    /// True while QEMU runs (the firmware leaves it through semihosting on a panic or a hard
+    /// fault, so a dead QEMU means a crashed device).
+    pub fn is_running(&mut self) -> bool {
+        matches!(self.child.try_wait(), Ok(None))
+    }
+
+    /// A plain TCP connection to UART0 (`TCP_NODELAY`), retried while QEMU has not yet taken
+    /// the previous client's disconnection.
+    pub fn connect(&self) -> TcpStream {
+        let t0 = Instant::now();
+        loop {
+            match TcpStream::connect(self.addr()) {
+                Ok(s) => {
+                    s.set_nodelay(true).expect("nodelay");
+                    return s;
+                }
+                Err(e) if t0.elapsed() > Duration::from_secs(30) => panic!("connect: {e}"),
+                Err(_) => std::thread::sleep(Duration::from_millis(50)),
+            }
+        }
+    }
+
+    /// A [`Link`] over TCP (it sends a leading `00` to flush a partial frame).
+    pub fn link(&self) -> Link<TcpStream> {
+        let t0 = Instant::now();
+        loop {
+            match Link::tcp(self.addr(), TIMEOUT) {
+                Ok(l) => return l,
+                Err(e) if t0.elapsed() > Duration::from_secs(30) => panic!("connect: {e}"),
+                Err(_) => std::thread::sleep(Duration::from_millis(50)),
+            }
+        }
+    }
+}
+
+// ---- frames --------------------------------------------------------------------------------
+
+/// COBS encode (the protocol's own encoder is private): for building broken frames.
+pub fn cobs(data: &[u8]) -> Vec<u8> {
+    let mut out = vec![0];
+    let (mut code_at, mut code) = (0usize, 1u8);
+    for &b in data {
+        if b == 0 {
+            out[code_at] = code;
+            code_at = out.len();
+            out.push(0);
+            code = 1;
+        } else {
+            out.push(b);
+            code += 1;
+            if code == 0xff {
+                out[code_at] = code;
+                code_at = out.len();
+                out.push(0);
+                code = 1;
+            }
+        }
+    }
+    out[code_at] = code;
+    out
+}
+
+/// A frame of raw postcard bytes with a correct CRC.
+pub fn frame_of(body: &[u8]) -> Vec<u8> {
+    let mut p = body.to_vec();
+    p.extend_from_slice(&crc32(body).to_le_bytes());
+    let mut f = cobs(&p);
+    f.push(0);
+    f
+}
+
+/// What the firmware must answer to `bytes` (starting at a frame boundary), computed with the
+/// protocol's own reader and decoder (exactly what the device runs): one `(id, error)` per
+/// broken frame, nothing for empty ones. `None` if a frame in `bytes` decodes as a request.
+pub fn try_expected_errors(bytes: &[u8]) -> Option<Vec<(u32, ErrorReply)>> {
+    let mut r = RequestReader::new();
+    let mut out = Vec::new();
+    for &b in bytes {
+        if let Some(f) = r.push(b).into_frame(MAX_REQUEST_WIRE) {
+            match f.and_then(decode_request) {
+                Ok(_) => return None,
+                Err(e) => out.push((e.id(), e.reply())),
+            }
+        }
+    }
+    Some(out)
+}
+
+/// [`try_expected_errors`] for bytes known to hold no valid request.
+pub fn expected_errors(bytes: &[u8]) -> Vec<(u32, ErrorReply)> {
+    try_expected_errors(bytes).unwrap_or_else(|| panic!("test frame decodes: {bytes:02x?}"))
+}
+
+// ---- the host's reference ------------------------------------------------------------------
+
+/// A plan as the host's copy of the core computes it: every field of a `Path` reply but
+/// `ticks`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CorePath {
+    pub raw_length: f32,
+    pub length: f32,
+    pub turns: u32,
+    pub iterations: u16,
+    pub best_iteration: u16,
+    pub moves: u64,
+    pub raw_cells: u32,
+    pub waypoints: Vec<Point>,
+    pub directions: Vec<u8>,
+}
+
+/// Plan as the firmware does (`ohaca::plan` on the map's grid), on the host: the path, or the
+/// error reply the device must send.
+pub fn core_plan(
+    map: &Map,
+    start: Point,
+    goal: Point,
+    params: &Params,
+) -> Result<CorePath, ErrorReply> {
+    let grid = map.grid().map_err(ErrorReply::from)?;
+    params.validate().map_err(ErrorReply::from)?;
+    let mut storage = HeapStorage::for_run(map.cells(), params).expect("host storage");
+    let plan = ohaca::plan(&grid, start, goal, params, storage.workspace())?;
+    Ok(CorePath {
+        raw_length: plan.raw_length,
+        length: plan.length,
+        turns: plan.turns,
+        iterations: plan.iterations,
+        best_iteration: plan.best_iteration,
+        moves: plan.moves,
+        raw_cells: u32::try_from(plan.raw_len()).expect("raw cells"),
+        waypoints: plan.waypoints().to_vec(),
+        directions: plan.directions().to_vec(),
+    })
+}
+
+/// The device's path must be the host core's, bit for bit (floats compared by their bits).
+pub fn assert_core_path(what: &str, core: &CorePath, dev: &DevicePath) {
+    let bits = |p: &CorePath| (p.raw_length.to_bits(), p.length.to_bits());
+    let dev_core = CorePath {
+        raw_length: dev.raw_length,
+        length: dev.length,
+        turns: dev.turns,
+        iterations: dev.iterations,
+        best_iteration: dev.best_iteration,
+        moves: dev.moves,
+        raw_cells: dev.raw_cells,
+        waypoints: dev.waypoints.clone(),
+        directions: dev.directions.clone(),
+    };
+    assert_eq!(dev_core, *core, "{what}: device path vs host core");
+    assert_eq!(bits(&dev_core), bits(core), "{what}: length bits");
+}
