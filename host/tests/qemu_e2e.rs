@@ -919,6 +919,20 @@ fn send_command_over_tcp() {
     assert!(text.contains("qemu-mps2-an386"), "{text}");
     assert!(text.contains("ticks"), "{text}");
 
+    // CSV: the same waypoint lines as `plan --format csv`.
+    let o = ohaca(&base(&[
+        "--start", "0,0", "--goal", "25,25", "--format", "csv",
+    ]));
+    assert_eq!(o.status.code(), Some(0), "{o:?}");
+    let p = ohaca(&strings(&[
+        "plan", "--map", &complex, "--start", "0,0", "--goal", "25,25", "--format", "csv",
+    ]));
+    assert_eq!(
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&p.stdout)
+    );
+    assert!(String::from_utf8_lossy(&o.stdout).starts_with("x,y\n"));
+
     // A goal on an obstacle: bad input, exit 2, one line on stderr.
     let o = ohaca(&base(&["--start", "0,0", "--goal", "3,1"]));
     assert_eq!(o.status.code(), Some(2), "{o:?}");
@@ -1138,6 +1152,26 @@ fn send_fails_cleanly_without_a_device() {
         format!("error: {addr}: no reply to Hello (request 1) within 0.5 s")
     );
     let _ = keep.join();
+
+    // A serial device that does not exist.
+    let o = ohaca(&strings(&[
+        "send",
+        "--serial",
+        "/dev/ttyOHACA-missing",
+        "--map",
+        &complex,
+        "--start",
+        "0,0",
+        "--goal",
+        "25,25",
+    ]));
+    assert_eq!(o.status.code(), Some(2), "{o:?}");
+    let err = String::from_utf8_lossy(&o.stderr).into_owned();
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.starts_with("error: cannot open /dev/ttyOHACA-missing"),
+        "{err}"
+    );
 
     // Bad arguments: neither --tcp nor --serial.
     let o = ohaca(&strings(&[
