@@ -69,7 +69,7 @@ async fn plan(
     loop {
         let t = Instant::now();
         let more = run.step();
-        in_steps += t.elapsed().as_ticks();
+        in_steps += Instant::now().saturating_duration_since(t).as_ticks();
         yield_now().await;
         if state::cancelled(job.generation) {
             defmt::info!(
@@ -86,7 +86,7 @@ async fn plan(
     let t_finish = Instant::now();
     let plan = run.finish()?;
     let t_end = Instant::now();
-    let ticks = (t_end - t0).as_ticks();
+    let ticks = t_end.saturating_duration_since(t0).as_ticks();
     defmt::info!(
         "plan {}: {} iterations, length {}, {} waypoints, {} ticks (new {}, steps {}, finish {})",
         job.id,
@@ -94,9 +94,9 @@ async fn plan(
         plan.length,
         plan.waypoints().len(),
         ticks,
-        (t_new - t0).as_ticks(),
+        t_new.saturating_duration_since(t0).as_ticks(),
         in_steps,
-        (t_end - t_finish).as_ticks()
+        t_end.saturating_duration_since(t_finish).as_ticks()
     );
     let reply = PathReply {
         raw_length: plan.raw_length,

@@ -103,6 +103,14 @@ impl Drop for Qemu {
     }
 }
 
+/// Where the firmware's defmt log (QEMU's stdout) goes: discarded, unless `OHACA_QEMU_LOG` names
+/// a file (decode it with `defmt-print -e target/thumbv7em-none-eabihf/release/ohaca < FILE`).
+fn defmt_log() -> Stdio {
+    std::env::var_os("OHACA_QEMU_LOG")
+        .and_then(|p| std::fs::File::create(p).ok())
+        .map_or_else(Stdio::null, Stdio::from)
+}
+
 fn qemu_command(serial: &str) -> Command {
     let mut c = Command::new("qemu-system-arm");
     c.args(["-M", "mps2-an386", "-display", "none", "-monitor", "none"])
@@ -129,7 +137,7 @@ impl Qemu {
             let child = qemu_command(&format!(
                 "tcp:127.0.0.1:{port},server=on,wait=off,nodelay=on"
             ))
-            .stdout(Stdio::null())
+            .stdout(defmt_log())
             .stderr(Stdio::piped())
             .spawn()
             .expect("start qemu-system-arm");

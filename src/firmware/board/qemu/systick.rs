@@ -8,7 +8,7 @@
 //! Under `qemu-system-arm -icount shift=0` the guest's clocks are virtual and advance exactly
 //! 1 ns per executed instruction while the CPU runs, so 1 tick = 1 µs = 1000 instructions.
 
-use core::cell::RefCell;
+use core::cell::{Cell, RefCell};
 
 use cortex_m::peripheral::syst::SystClkSource;
 use cortex_m::peripheral::{SCB, SYST};
@@ -28,6 +28,8 @@ struct State {
     periods: u64,
     next_alarm: u64,
     queue: Queue,
+    /// The last time `now` returned: time never goes backwards (see `State::now`).
+    last: Cell<u64>,
 }
 
 struct SysTickDriver {
@@ -39,6 +41,7 @@ embassy_time_driver::time_driver_impl!(static DRIVER: SysTickDriver = SysTickDri
         periods: 0,
         next_alarm: u64::MAX,
         queue: Queue::new(),
+        last: Cell::new(0),
     })),
 });
 
@@ -51,8 +54,23 @@ pub fn init(mut syst: SYST) {
 }
 
 impl State {
-    /// Ticks now; call with interrupts masked.
+    /// Ticks now; call with interrupts masked. Never less than a value it returned before.
+    ///
+    /// QEMU's SysTick is not cycle-exact: without `-icount`, and with the host busy, the counter
+    /// can already have wrapped (it reads near the reload value again) while the wrap's pending
+    /// bit is not set yet, because QEMU raises it from a host timer that runs later. The sum
+    /// below then reads up to one period (1 ms) early, and an `Instant` subtraction in
+    /// embassy-time panics on the negative difference (the soak test found it:
+    /// `unwrap failed: self.ticks.checked_sub(earlier.ticks)`). Clamping to the last value keeps
+    /// time monotonic; it stands still for that moment and catches up at the next interrupt.
     fn now(&self) -> u64 {
+        let t = self.raw_now().max(self.last.get());
+        self.last.set(t);
+        t
+    }
+
+    /// Periods counted plus the counter's elapsed part, as the hardware reads.
+    fn raw_now(&self) -> u64 {
         let mut periods = self.periods;
         let mut cvr = SYST::get_current();
         if SCB::is_pendst_pending() {
