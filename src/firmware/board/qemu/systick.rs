@@ -85,8 +85,7 @@ impl State {
         periods * TICKS_PER_PERIOD + u64::from(elapsed)
     }
 
-    fn wake_expired(&mut self) {
-        let now = self.now();
+    fn wake_expired(&mut self, now: u64) {
         self.next_alarm = self.queue.next_expiration(now);
     }
 }
@@ -100,7 +99,8 @@ impl Driver for SysTickDriver {
         self.state.lock(|s| {
             let mut s = s.borrow_mut();
             if s.queue.schedule_wake(at, waker) {
-                s.wake_expired();
+                let now = s.now();
+                s.wake_expired(now);
             }
         });
     }
@@ -111,8 +111,12 @@ fn SysTick() {
     DRIVER.state.lock(|s| {
         let mut s = s.borrow_mut();
         s.periods += 1;
-        if s.now() >= s.next_alarm {
-            s.wake_expired();
+        // This interrupt marks the wrap itself: the time is exactly `periods` periods. (Reading
+        // the counter here could give a whole period more, since QEMU may not have reloaded it
+        // yet when the handler starts; `now` must not remember such a reading.)
+        let now = (s.periods * TICKS_PER_PERIOD).max(s.last.get());
+        if now >= s.next_alarm {
+            s.wake_expired(now);
         }
     });
 }
