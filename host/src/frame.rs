@@ -33,6 +33,18 @@ pub struct Frame {
 }
 
 impl Frame {
+    /// The centres of cells given as `[x, y]`, in metres rounded to a micrometre (what the
+    /// reports print as `waypoints_m`).
+    pub fn points_m(&self, points: &[[u16; 2]]) -> Vec<[f64; 2]> {
+        points
+            .iter()
+            .map(|&[x, y]| {
+                let [mx, my] = self.to_metres(Point::new(x, y));
+                [round_um(mx), round_um(my)]
+            })
+            .collect()
+    }
+
     /// The centre of cell `p` in metres (`p` may lie outside the grid; it is extrapolated).
     pub fn to_metres(&self, p: Point) -> [f64; 2] {
         let lx = (f64::from(p.x) + 0.5) * self.resolution;

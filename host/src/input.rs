@@ -70,7 +70,8 @@ pub fn parse_length(s: &str) -> Result<f64, String> {
 }
 
 /// The map and the start and goal, as command-line flags. Flatten it into a subcommand
-/// (`#[command(flatten)]`) and call [`MapArgs::load`].
+/// (`#[command(flatten)]`) and call [`MapArgs::load`]. The start and the goal are each required,
+/// in cells or in metres (`send` relaxes that for `--goals` with `mut_arg`).
 #[derive(clap::Args, Clone, Debug, PartialEq)]
 pub struct MapArgs {
     /// Map file: Moving AI `.map`, a text grid (`.`/`0` free, `#`/`1` blocked), a ROS
@@ -122,16 +123,7 @@ pub struct Scenario {
 impl Scenario {
     /// Metres of each point (rounded to a micrometre), if the map has a resolution.
     pub fn metres(&self, points: &[[u16; 2]]) -> Option<Vec<[f64; 2]>> {
-        let f = self.frame?;
-        Some(
-            points
-                .iter()
-                .map(|&[x, y]| {
-                    let m = f.to_metres(Point::new(x, y));
-                    [crate::frame::round_um(m[0]), crate::frame::round_um(m[1])]
-                })
-                .collect(),
-        )
+        self.frame.map(|f| f.points_m(points))
     }
 }
 

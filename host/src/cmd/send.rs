@@ -23,16 +23,15 @@ use std::time::{Duration, Instant};
 
 use ohaca::protocol::{ErrorCode, ErrorReply};
 use ohaca::{Error, Params, Point};
-use ohaca_host::frame::{round_um, Frame};
+use ohaca_host::frame::Frame;
 use ohaca_host::gridops::{resample, resample_frame};
-use ohaca_host::input::{parse_length, parse_metres, prepare_map, resolve_point};
+use ohaca_host::input::{prepare_map, resolve_point, MapArgs};
 use ohaca_host::link::{
     core_error, DeviceInfo, DevicePath, Link, LinkError, PlanJob, Transport, DEFAULT_BAUD,
 };
 use ohaca_host::output::{
     format_us, micros, render, waypoints_csv, xy, LocatedReport, ParamsReport, PlanReport,
 };
-use ohaca_host::rosmap::Unknown;
 use ohaca_host::{exit, parse_point, Map, ParamArgs};
 use serde::Serialize;
 
@@ -42,6 +41,10 @@ use super::{bad_input, print};
 /// Arguments of `ohaca send`.
 #[derive(clap::Args, Debug)]
 #[command(group(clap::ArgGroup::new("device").required(true).args(["tcp", "serial"])))]
+// `--goals FILE` takes the place of `--goal`, and its lines may carry their own starts.
+#[command(mut_arg("start", |a| a.required_unless_present("goals")))]
+#[command(mut_arg("goal", |a| a.required_unless_present("goals").conflicts_with("goals")))]
+#[command(mut_arg("goal_m", |a| a.conflicts_with("goals")))]
 pub struct Args {
     /// Device on a TCP port, e.g. QEMU's UART (scripts/qemu-serve.sh): HOST:PORT
     #[arg(long, value_name = "HOST:PORT")]
@@ -55,37 +58,8 @@ pub struct Args {
     /// Seconds to wait for each reply (and for the connection)
     #[arg(long, value_name = "SECONDS", default_value = "10", value_parser = parse_timeout)]
     pub timeout: Duration,
-    /// Map file: Moving AI `.map`, a text grid (`.`/`0` free, `#`/`1` blocked), a ROS
-    /// map_server `.yaml` (with its PGM/PNG image) or a PNG/PGM image (dark = blocked), as
-    /// `plan` reads
-    #[arg(long, value_name = "FILE")]
-    pub map: PathBuf,
-    /// Start cell: column,row with 0,0 the top-left cell (of the grid after --cell)
-    #[arg(long, value_name = "X,Y", value_parser = parse_point, allow_hyphen_values = true,
-          conflicts_with = "start_m")]
-    pub start: Option<Point>,
-    /// Goal cell: column,row
-    #[arg(long, value_name = "X,Y", value_parser = parse_point, allow_hyphen_values = true,
-          conflicts_with_all = ["goals", "goal_m"])]
-    pub goal: Option<Point>,
-    /// Start in metres, in the ROS map frame (maps with a resolution only)
-    #[arg(long, value_name = "X,Y", value_parser = parse_metres, allow_hyphen_values = true)]
-    pub start_m: Option<[f64; 2]>,
-    /// Goal in metres, in the ROS map frame
-    #[arg(long, value_name = "X,Y", value_parser = parse_metres, allow_hyphen_values = true,
-          conflicts_with = "goals")]
-    pub goal_m: Option<[f64; 2]>,
-    /// ROS maps: cells between free_thresh and occupied_thresh (unexplored) are blocked or free
-    #[arg(long, value_name = "AS", value_enum, default_value_t = Unknown::Blocked)]
-    pub unknown: Unknown,
-    /// Block every cell whose centre is within this radius of an obstacle's centre: metres
-    /// (cells for maps without a resolution)
-    #[arg(long, value_name = "RADIUS", value_parser = parse_length)]
-    pub inflate: Option<f64>,
-    /// Resample to coarser cells of this size: metres (cells for maps without a resolution).
-    /// Without it, a map too large for the device is resampled to fit, with a note on stderr
-    #[arg(long, value_name = "SIZE", value_parser = parse_length)]
-    pub cell: Option<f64>,
+    #[command(flatten)]
+    pub input: MapArgs,
     /// Plan every line of FILE (`SX,SY GX,GY`, or `GX,GY` from --start; `#` comments) over one
     /// connection; prints one JSON line per request, in order
     #[arg(long, value_name = "FILE")]
@@ -256,12 +230,13 @@ impl Session {
             }
             (false, f, false) => f.unwrap_or(Format::Text),
         };
-        let name = args.map.display().to_string();
-        let (map, frame) = prepare_map(&args.map, args.unknown, args.inflate, args.cell)
-            .map_err(|e| e.to_string())?;
+        let a = &args.input;
+        let name = a.map.display().to_string();
+        let (map, frame) =
+            prepare_map(&a.map, a.unknown, a.inflate, a.cell).map_err(|e| e.to_string())?;
         let params = args.params.params();
         params.validate().map_err(|e| e.to_string())?;
-        let start = match (args.start, args.start_m) {
+        let start = match (a.start, a.start_m) {
             (None, None) => None,
             (s, m) => Some(resolve_point(&name, frame, "start", s, m).map_err(|e| e.to_string())?),
         };
@@ -269,7 +244,7 @@ impl Session {
             (Some(file), start) => load_goals(file, start)?,
             (None, Some(start)) => vec![PlanJob {
                 start,
-                goal: resolve_point(&name, frame, "goal", args.goal, args.goal_m)
+                goal: resolve_point(&name, frame, "goal", a.goal, a.goal_m)
                     .map_err(|e| e.to_string())?,
                 seed: None,
             }],
@@ -282,7 +257,7 @@ impl Session {
         let target = args.tcp.as_deref().or(args.serial.as_deref()).unwrap_or("");
         Ok(Session {
             target: target.to_string(),
-            name: args.map.display().to_string(),
+            name,
             map,
             frame,
             params,
@@ -301,11 +276,11 @@ impl Session {
         {
             return Ok(());
         }
-        if args.cell.is_some() {
-            return Err(too_large(&args.map, &self.map, info));
+        if args.input.cell.is_some() {
+            return Err(too_large(&args.input.map, &self.map, info));
         }
         let Some((k, coarse)) = fit_factor(&self.map, self.frame, info) else {
-            return Err(too_large(&args.map, &self.map, info));
+            return Err(too_large(&args.input.map, &self.map, info));
         };
         let frame = self
             .frame
@@ -337,16 +312,24 @@ impl Session {
 
     /// The waypoints in metres (rounded to a micrometre), for maps with a resolution.
     fn metres(&self, waypoints: &[[u16; 2]]) -> Option<Vec<[f64; 2]>> {
-        let f = self.frame?;
-        Some(
-            waypoints
-                .iter()
-                .map(|&[x, y]| {
-                    let [mx, my] = f.to_metres(Point::new(x, y));
-                    [round_um(mx), round_um(my)]
-                })
-                .collect(),
-        )
+        self.frame.map(|f| f.points_m(waypoints))
+    }
+
+    /// One `send --json` line: the report with `waypoints_m` (maps with a resolution), `ticks`
+    /// and `device`.
+    fn json_line(&self, report: &PlanReport, ticks: Option<u64>, info: &DeviceInfo) -> String {
+        let metres = self.metres(&report.waypoints);
+        let mut s = SendReport {
+            report: LocatedReport {
+                report,
+                waypoints_m: metres.as_deref(),
+            },
+            ticks,
+            device: &info.board,
+        }
+        .to_json();
+        s.push('\n');
+        s
     }
 
     /// `error: <target>: <what>`.
@@ -379,7 +362,7 @@ impl Session {
         link.set_params(&self.params).map_err(fail)?;
         link.set_map(&self.map).map_err(|e| match e {
             LinkError::Device { error, .. } if error.code == ErrorCode::MapTooLarge => {
-                too_large(&args.map, &self.map, &info)
+                too_large(&args.input.map, &self.map, &info)
             }
             e => fail(e),
         })?;
@@ -428,23 +411,12 @@ impl Session {
             let metres = self.metres(&report.waypoints);
             print(&waypoints_csv(&report.waypoints, metres.as_deref()));
         } else if self.format == Format::Json {
-            let metres = self.metres(&report.waypoints);
-            let mut s = SendReport {
-                report: LocatedReport {
-                    report: &report,
-                    waypoints_m: metres.as_deref(),
-                },
-                ticks,
-                device: &info.board,
-            }
-            .to_json();
-            s.push('\n');
-            print(&s);
+            print(&self.json_line(&report, ticks, info));
         } else {
             let p = &report.params;
             let mut s = format!(
                 "{}, ({},{}) -> ({},{}), {} seed {}, planned on {} (firmware {})\n",
-                args.map.display(),
+                args.input.map.display(),
                 job.start.x,
                 job.start.y,
                 job.goal.x,
@@ -496,18 +468,7 @@ impl Session {
                     )
                 }
             };
-            let metres = self.metres(&report.waypoints);
-            let mut s = SendReport {
-                report: LocatedReport {
-                    report: &report,
-                    waypoints_m: metres.as_deref(),
-                },
-                ticks,
-                device: &info.board,
-            }
-            .to_json();
-            s.push('\n');
-            print(&s);
+            print(&self.json_line(&report, ticks, info));
         })?;
         Ok(code)
     }
