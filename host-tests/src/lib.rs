@@ -17,6 +17,7 @@
 pub mod check;
 pub mod gen;
 pub mod heap;
+pub mod large;
 pub mod maps;
 pub mod quality;
 pub mod reference;
