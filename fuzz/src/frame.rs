@@ -24,7 +24,7 @@ use ohaca::protocol::{
     MAX_REQUEST, MAX_REQUEST_WIRE, UNKNOWN_ID,
 };
 use ohaca::Point;
-use ohaca_host::link::{core_error, request_name, LinkError, Response};
+use ohaca_host::link::{request_name, LinkError, Response};
 
 /// What a reader should report for one delimiter, per the reference splitter.
 #[derive(Debug, PartialEq, Eq)]
@@ -228,7 +228,7 @@ fn check_reply_frame(frame: &mut [u8], piece: usize) -> bool {
                 }
                 (Reply::Error(e), _) => {
                     let _ = format!("{e}");
-                    if let Some(core) = core_error(e) {
+                    if let Ok(core) = ohaca::Error::try_from(*e) {
                         assert_eq!(ErrorReply::from(core).code, e.code);
                     }
                 }

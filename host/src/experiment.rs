@@ -28,13 +28,12 @@ use std::path::Path;
 use ohaca::{Algorithm, Params};
 use rayon::prelude::*;
 
-use crate::args::{dead_end_name, smoothing_name};
 use crate::draw::{self, Convergence, Layer, Scene, Series};
 use crate::input::Scenario;
 use crate::output::PlanReport;
-use crate::planning::PlanError;
-use crate::storage::HeapStorage;
+use crate::plan_map::PlanError;
 use crate::trace::plan_traced;
+use ohaca::heap::HeapStorage;
 
 /// What to run.
 #[derive(Clone, Debug, PartialEq)]
@@ -492,8 +491,8 @@ pub fn params_brief(p: &Params) -> String {
         p.ants,
         p.iterations,
         p.patience,
-        dead_end_name(p.dead_end),
-        smoothing_name(p.smoothing),
+        p.dead_end.name(),
+        p.smoothing.name(),
         if p.tighten { "" } else { ", no tightening" }
     )
 }
@@ -515,8 +514,8 @@ pub fn params_line(p: &Params) -> String {
         p.tau_min,
         p.tau_max,
         p.patience,
-        dead_end_name(p.dead_end),
-        smoothing_name(p.smoothing),
+        p.dead_end.name(),
+        p.smoothing.name(),
         p.tighten
     )
 }

@@ -26,12 +26,8 @@ use ohaca::{Error, Params, Point};
 use ohaca_host::frame::Frame;
 use ohaca_host::gridops::{resample, resample_frame};
 use ohaca_host::input::{prepare_map, resolve_point, MapArgs};
-use ohaca_host::link::{
-    core_error, DeviceInfo, DevicePath, Link, LinkError, PlanJob, Transport, DEFAULT_BAUD,
-};
-use ohaca_host::output::{
-    format_us, micros, render, waypoints_csv, xy, LocatedReport, ParamsReport, PlanReport,
-};
+use ohaca_host::link::{DeviceInfo, DevicePath, Link, LinkError, PlanJob, Transport, DEFAULT_BAUD};
+use ohaca_host::output::{format_us, micros, render, waypoints_csv, xy, LocatedReport, PlanReport};
 use ohaca_host::{exit, parse_point, Map, ParamArgs};
 use serde::Serialize;
 
@@ -111,14 +107,14 @@ impl SendReport<'_> {
 
 /// Run `ohaca send`; returns the exit code.
 pub fn run(args: &Args) -> u8 {
-    match Session::prepare(args).and_then(|mut s| s.run(args)) {
+    match Sender::prepare(args).and_then(|mut s| s.run(args)) {
         Ok(code) => code,
         Err(msg) => bad_input(msg),
     }
 }
 
 /// The connected state of one `send`.
-struct Session {
+struct Sender {
     /// `--tcp` or `--serial`, for messages.
     target: String,
     /// The map file as given, for messages.
@@ -213,9 +209,9 @@ fn coarse_cell(p: Point, k: u16, fine: Option<Frame>, coarse: Option<Frame>) -> 
     }
 }
 
-impl Session {
+impl Sender {
     /// Everything that can be checked before connecting.
-    fn prepare(args: &Args) -> Result<Session, String> {
+    fn prepare(args: &Args) -> Result<Sender, String> {
         let format = match (args.json, args.format, args.goals.is_some()) {
             (true, None | Some(Format::Json), _) => Format::Json,
             (true, Some(f), _) => {
@@ -255,7 +251,7 @@ impl Session {
             }
         };
         let target = args.tcp.as_deref().or(args.serial.as_deref()).unwrap_or("");
-        Ok(Session {
+        Ok(Sender {
             target: target.to_string(),
             name,
             map,
@@ -487,7 +483,7 @@ impl Session {
         let path = match result {
             Ok(p) => p,
             Err(e) => {
-                return match core_error(&e) {
+                return match Error::try_from(e).ok() {
                     Some(err @ Error::NoPath) => Outcome::found(
                         PlanReport::not_found(&params, err, Some(0), round_trip),
                         None,
@@ -536,7 +532,7 @@ impl Session {
             best_iteration: Some(path.best_iteration),
             moves: Some(path.moves),
             elapsed_us: micros(round_trip),
-            params: ParamsReport::from(&params),
+            params,
             error: None,
         };
         Outcome::found(report, Some(path.ticks))
