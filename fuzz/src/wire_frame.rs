@@ -328,7 +328,7 @@ pub fn check_streams(data: &[u8]) -> (usize, usize) {
 }
 
 /// The `frame` fuzz target.
-pub fn fuzz_frame(data: &[u8]) {
+pub fn fuzz_wire_frame(data: &[u8]) {
     check_streams(data);
 }
 
@@ -341,7 +341,7 @@ mod tests {
         let mut buf = [0u8; MAX_REQUEST_WIRE];
         let n = encode_request(9, &Request::Stats, &mut buf).unwrap();
         assert!(reference_unframe(&buf[..n - 1]).is_ok());
-        fuzz_frame(&buf[..n]);
+        fuzz_wire_frame(&buf[..n]);
     }
 
     #[test]
