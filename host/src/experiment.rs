@@ -333,7 +333,7 @@ impl Outcome {
         let sc = &self.scenario;
         let (layer, which) = match self.best_run(a) {
             Some(r) => (
-                Layer::from_report(a, &r.report, sc.frame.map(|f| f.resolution)),
+                Layer::from_report(a, &r.report, sc.metric.map(|f| f.resolution)),
                 format!("best of {} runs (seed {})", self.config.runs, r.seed),
             ),
             None => {
@@ -367,7 +367,7 @@ impl Outcome {
             layers: vec![layer],
             pheromone: None,
             pheromone_label: String::new(),
-            frame: sc.frame,
+            metric: sc.metric,
         }
     }
 
@@ -393,7 +393,7 @@ impl Outcome {
             last,
             sc.map.width,
             sc.map.height,
-            sc.frame
+            sc.metric
                 .map_or_else(String::new, |f| format!(", 1 cell = {} m", f.resolution))
         );
         let _ = writeln!(s, "Parameters: {}.\n", params_line(&c.params));
@@ -535,7 +535,7 @@ mod tests {
                 Format::Text,
             )
             .unwrap(),
-            frame: None,
+            metric: None,
             start: Point::new(0, 0),
             goal: Point::new(7, 3),
         }

@@ -1,10 +1,13 @@
 //! The planner parameters are declared once, in `ohaca::Params` (its serde derive serves the
-//! protocol and the JSON report). The places that still spell them out by hand must follow it:
-//! the parameter table of docs/PROTOCOL.md (names in wire order, defaults) and the Python client
-//! `scripts/ohaca_client.py` (field order and encoding, enum values in variant order).
+//! protocol and the JSON report), and the error codes once, in `ohaca::protocol::ErrorCode`. The
+//! places that still spell them out by hand must follow: the tables of docs/PROTOCOL.md (parameter
+//! names in wire order with their defaults; error codes and names) and the Python client
+//! `scripts/ohaca_client.py` (field order and encoding, enum values in variant order, error
+//! names).
 
 use std::path::Path;
 
+use ohaca::protocol::ErrorCode;
 use ohaca::{Algorithm, DeadEnd, Params, SmoothingKind};
 use serde_json::Value;
 
@@ -123,4 +126,56 @@ fn the_python_client_encodes_every_parameter_in_wire_order() {
     assert_eq!(python_list(&py, "ALGORITHMS"), algorithms);
     assert_eq!(python_list(&py, "DEAD_ENDS"), dead_ends);
     assert_eq!(python_list(&py, "SMOOTHING"), smoothing);
+}
+
+/// Every error code with its name (`1 BadMap`, ...), in numeric order.
+fn error_codes() -> Vec<(u8, String)> {
+    ErrorCode::ALL
+        .into_iter()
+        .map(|c| (c.code(), format!("{c:?}")))
+        .collect()
+}
+
+#[test]
+fn the_protocol_doc_and_the_python_client_name_every_error_code() {
+    let doc = read("docs/PROTOCOL.md");
+    let table = doc
+        .split("\n## Error codes\n")
+        .nth(1)
+        .expect("a `## Error codes` section");
+    let documented: Vec<(u8, String)> = table
+        .lines()
+        .skip_while(|l| !l.starts_with("| code"))
+        .skip(2)
+        .take_while(|l| l.starts_with('|'))
+        .map(|l| {
+            let cols: Vec<&str> = l.split('|').map(str::trim).collect();
+            (
+                cols[1].parse().unwrap(),
+                cols[2].trim_matches('`').to_string(),
+            )
+        })
+        .collect();
+    assert_eq!(
+        documented,
+        error_codes(),
+        "docs/PROTOCOL.md, ## Error codes"
+    );
+
+    let py = read("scripts/ohaca_client.py");
+    let start = py.find("\nERRORS = {").expect("ERRORS");
+    let body = &py[start..];
+    let body = &body[body.find('{').unwrap() + 1..body.find('}').unwrap()];
+    let listed: Vec<(u8, String)> = body
+        .split(',')
+        .filter(|kv| !kv.trim().is_empty())
+        .map(|kv| {
+            let (k, v) = kv.split_once(':').unwrap();
+            (
+                k.trim().parse().unwrap(),
+                v.trim().trim_matches('"').to_string(),
+            )
+        })
+        .collect();
+    assert_eq!(listed, error_codes(), "scripts/ohaca_client.py ERRORS");
 }
