@@ -64,7 +64,8 @@ fn the_protocol_doc_lists_every_parameter_in_wire_order_with_its_default() {
                 default.parse::<f64>().ok().map(|d| d as f32) == n.as_f64().map(|v| v as f32)
             }
             Value::String(s) => s == default,
-            other => other.to_string() == *default,
+            Value::Bool(b) => default.parse::<bool>() == Ok(*b),
+            other => panic!("{name}: unexpected {other}"),
         };
         assert!(
             same,
