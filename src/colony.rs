@@ -25,6 +25,11 @@ use crate::rng::Xoshiro128pp;
 /// What an ant does when every neighbour is blocked or already visited.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(rename_all = "lowercase")
+)]
 pub enum DeadEnd {
     /// Step back along its path and continue (never loses an ant while the goal is reachable).
     #[default]

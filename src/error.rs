@@ -1,6 +1,6 @@
 //! The planner's error enum: small, `Copy`, with `Display` and (behind the `defmt` feature)
-//! `defmt::Format`. Every value has a stable numeric [`Error::code`] so the wire protocol can
-//! carry it.
+//! `defmt::Format`. The wire protocol maps every value to an error code and back, in one place
+//! (`ohaca::protocol::ErrorReply`); [`Param::index`] is the number it carries for a bad parameter.
 
 use core::fmt;
 
@@ -66,21 +66,29 @@ pub enum Error {
     Cancelled,
 }
 
-impl Error {
-    /// A stable one-byte code for the wire protocol.
-    pub const fn code(&self) -> u8 {
-        match self {
-            Error::BadMap => 1,
-            Error::MapTooLarge { .. } => 2,
-            Error::OutOfBounds(Endpoint::Start) => 3,
-            Error::OutOfBounds(Endpoint::Goal) => 4,
-            Error::Blocked(Endpoint::Start) => 5,
-            Error::Blocked(Endpoint::Goal) => 6,
-            Error::BadParam(_) => 7,
-            Error::NoPath => 8,
-            Error::Cancelled => 9,
-            Error::NoAntArrived => 10,
-        }
+impl Param {
+    /// Every parameter, in index order ([`Param::index`]).
+    pub const ALL: [Param; 9] = [
+        Param::Ants,
+        Param::Iterations,
+        Param::Alpha,
+        Param::Beta,
+        Param::Rho,
+        Param::Q,
+        Param::A,
+        Param::Xi,
+        Param::Tau,
+    ];
+
+    /// A stable number (ants 0, iterations 1, ... tau 8: the declaration order), which the wire
+    /// protocol carries.
+    pub const fn index(self) -> u32 {
+        self as u32
+    }
+
+    /// The parameter with this [`Param::index`].
+    pub fn from_index(i: u32) -> Option<Param> {
+        Param::ALL.into_iter().find(|p| p.index() == i)
     }
 }
 
@@ -125,5 +133,19 @@ impl fmt::Display for Error {
                 f.write_str("no ant reached the goal (every ant died at a dead end)")
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn param_indices_are_the_declaration_order() {
+        for (i, p) in Param::ALL.into_iter().enumerate() {
+            assert_eq!(p.index() as usize, i, "{p:?}");
+            assert_eq!(Param::from_index(p.index()), Some(p));
+        }
+        assert_eq!(Param::from_index(9), None);
     }
 }

@@ -19,8 +19,17 @@
 //! | [`update`] | the per-iteration pheromone update: classic deposit and the wolves rule |
 //! | [`smoothing`] | line-of-sight smoothing of the raw ant path |
 //! | [`planner`] | parameters, caller-provided storage, the iteration loop and the result |
+//! | `heap` | (feature `alloc`) the planner's storage on the heap, sized at run time |
+//! | `protocol` | (feature `protocol`) the wire protocol between a host and the firmware |
 //! | [`rng`] | the small seedable generator every platform shares |
 //! | [`error`] | the error enum |
+//!
+//! ## Features
+//! None is needed to plan. `serde` derives `Serialize`/`Deserialize` for [`Params`] and its
+//! enums (values by their lower-case names, `"ohaca"`, `"backtrack"`, `"shortest"`): the one
+//! parameter table the protocol and the host tool's JSON both use. `protocol` adds the wire
+//! protocol (and `serde`); both firmware boards turn it on. `alloc` adds `heap::HeapStorage`.
+//! `defmt` adds `defmt::Format` impls.
 //!
 //! ## Panic freedom
 //! Nothing reachable from a map, a start/goal pair or a parameter set panics: indexing goes
@@ -74,15 +83,21 @@
     )
 )]
 
+#[cfg(any(feature = "alloc", test))]
+extern crate alloc;
+
 pub(crate) mod fmt;
 
 pub mod colony;
 pub mod error;
 pub mod geometry;
 pub mod grid;
+#[cfg(any(feature = "alloc", test))]
+pub mod heap;
 pub mod heuristic;
 pub mod pheromone;
 pub mod planner;
+#[cfg(feature = "protocol")]
 pub mod protocol;
 pub mod rng;
 pub mod smoothing;

@@ -35,6 +35,11 @@ use crate::update::{deposit, wolves};
 /// The four variants the paper compares.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(rename_all = "lowercase")
+)]
 pub enum Algorithm {
     /// Plain ant colony: `eta = 1 / d_ij`, classic ant-system update.
     Aca,
@@ -93,6 +98,7 @@ impl Algorithm {
 /// Every tunable of the planner. [`Params::default`] is the paper's setting.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Params {
     /// Which variant to run.
     pub algorithm: Algorithm,

@@ -26,6 +26,11 @@ use crate::grid::{Grid, Point};
 /// How to post-process the raw path.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(rename_all = "lowercase")
+)]
 pub enum SmoothingKind {
     /// Keep the raw path; waypoints are its corners.
     None,

@@ -1,4 +1,4 @@
-//! Writes the seed inputs of the `frame` and `map_parsers` targets into `fuzz/seeds/<target>/`
+//! Writes the seed inputs of the `wire_frame` and `map_parsers` targets into `fuzz/seeds/<target>/`
 //! (small, committed) from the protocol's own encoders and the repository's maps.
 //!
 //! ```text
@@ -55,7 +55,7 @@ fn set_map(map: &Map, chunk: usize, id: u32) -> Vec<Vec<u8>> {
         .collect()
 }
 
-fn frame_seeds(root: &Path) -> Result<Vec<(String, Vec<u8>)>> {
+fn wire_frame_seeds(root: &Path) -> Result<Vec<(String, Vec<u8>)>> {
     let mut out: Vec<(String, Vec<u8>)> = Vec::new();
     let complex = Map::load(root.join("maps/complex-26.map"))?;
     let random = Map::load(root.join("maps/movingai/random-32-32-20.map"))?;
@@ -347,7 +347,7 @@ fn write(dir: &Path, seeds: &[(String, Vec<u8>)]) -> Result<()> {
 fn main() -> Result<()> {
     let fuzz = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
     let root = fuzz.parent().ok_or("no repository root")?.to_path_buf();
-    write(&fuzz.join("seeds/frame"), &frame_seeds(&root)?)?;
+    write(&fuzz.join("seeds/wire_frame"), &wire_frame_seeds(&root)?)?;
     write(&fuzz.join("seeds/map_parsers"), &map_seeds(&root)?)?;
     Ok(())
 }

@@ -2,10 +2,11 @@
 //! from tests (`cargo test` in this crate runs the saved regression inputs).
 //!
 //! * [`fuzz_planner`] — the `planner` target (below).
-//! * [`frame::fuzz_frame`] — the `frame` target: the protocol's frame readers and decoders.
+//! * [`wire_frame::fuzz_wire_frame`] — the `wire_frame` target: the protocol's frame readers and
+//!   decoders.
 //! * [`maps::fuzz_map_parsers`] — the `map_parsers` target: the host tool's map readers.
 
-pub mod frame;
+pub mod wire_frame;
 pub mod maps;
 
 use arbitrary::{Arbitrary, Unstructured};

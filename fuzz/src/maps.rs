@@ -1,5 +1,5 @@
-//! The `map_parsers` target: the host tool's map readers (`host/src/map.rs`,
-//! `host/src/rosmap.rs`), fed from memory.
+//! The `map_parsers` target: the host tool's map readers (`host/src/map/`: text formats, ROS,
+//! images), fed from memory.
 //!
 //! Input layout: the first byte picks the reader, the rest is the file. The seeds use the
 //! letters; any other byte picks by `byte % 5` (0 to 4 in the table's order).
@@ -23,7 +23,7 @@ use std::path::Path;
 
 use ohaca::Point;
 use ohaca_host::map::{Format, Map};
-use ohaca_host::rosmap::{decode_image, image_map, ros_map, Mode, RosMeta, Unknown};
+use ohaca_host::map::{decode_image, image_map, ros_map, Mode, RosMeta, Unknown};
 
 /// The lines a map file consists of: byte-order mark skipped, `\n` or `\r\n` endings, blank lines
 /// at the end ignored (the documented rules, read independently of the parser).
@@ -214,7 +214,7 @@ fn ros(yaml: &[u8], image: &[u8], unknown: Unknown) -> bool {
         // Raw values above 100 % are unknown whatever the thresholds.
         assert_eq!(
             meta.classify(if meta.negate { 0.0 } else { 255.0 }, 255),
-            ohaca_host::rosmap::Occupancy::Unknown
+            ohaca_host::map::Occupancy::Unknown
         );
     }
     true

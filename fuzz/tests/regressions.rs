@@ -30,10 +30,10 @@ fn replay(dir: &str, check: fn(&[u8])) -> usize {
 
 #[test]
 fn frame_inputs() {
-    replay("regressions/frame", ohaca_fuzz::frame::fuzz_frame);
+    replay("regressions/wire_frame", ohaca_fuzz::wire_frame::fuzz_wire_frame);
     assert!(
-        replay("seeds/frame", ohaca_fuzz::frame::fuzz_frame) > 0,
-        "no frame seeds"
+        replay("seeds/wire_frame", ohaca_fuzz::wire_frame::fuzz_wire_frame) > 0,
+        "no wire_frame seeds"
     );
 }
 
@@ -53,10 +53,10 @@ fn map_parser_inputs() {
 #[test]
 fn seeds_are_accepted() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("seeds");
-    for e in fs::read_dir(dir.join("frame")).unwrap() {
+    for e in fs::read_dir(dir.join("wire_frame")).unwrap() {
         let f = e.unwrap().path();
         let name = f.file_name().unwrap().to_string_lossy().into_owned();
-        let (req, rep) = ohaca_fuzz::frame::check_streams(&fs::read(&f).unwrap());
+        let (req, rep) = ohaca_fuzz::wire_frame::check_streams(&fs::read(&f).unwrap());
         if name.starts_with("req-") || name.starts_with("session-") {
             assert!(req >= 1, "{name}: no request decoded");
         }

@@ -15,14 +15,14 @@ use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use ohaca::{plan, Params, Point};
-use ohaca_host_tests::heap::HeapStorage;
+use ohaca_host_tests::heap;
 use ohaca_host_tests::maps::{maps_dir, Map};
 
 fn bench_plan(c: &mut Criterion) {
     let map = Map::load(maps_dir().join("complex-26.map")).expect("complex-26.map");
     let grid = map.grid();
     let (start, goal) = (Point::new(0, 0), Point::new(25, 25));
-    let mut storage = HeapStorage::new(map.cells());
+    let mut storage = heap::storage(map.cells());
     let configs = [
         (
             "full_50x100",

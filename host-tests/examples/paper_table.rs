@@ -24,7 +24,7 @@ use ohaca::heuristic::Heuristic;
 use ohaca::pheromone::Table;
 use ohaca::rng::Xoshiro128pp;
 use ohaca::{Algorithm, DeadEnd, Params};
-use ohaca_host_tests::heap::HeapStorage;
+use ohaca_host_tests::heap;
 use ohaca_host_tests::maps::scenarios;
 use ohaca_host_tests::quality::{prepare, run_one, summarize, Prepared, Run};
 
@@ -116,7 +116,7 @@ fn main() {
                     dead_end,
                     ..Params::default()
                 };
-                let mut storage = HeapStorage::new(prep.map.cells());
+                let mut storage = heap::storage(prep.map.cells());
                 let runs: Vec<Run> = seeds
                     .iter()
                     .map(|&seed| {

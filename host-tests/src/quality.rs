@@ -13,7 +13,7 @@ use std::time::{Duration, Instant};
 use ohaca::{plan, Error, Params, Point};
 
 use crate::check::check_plan;
-use crate::heap::HeapStorage;
+use crate::heap::{self, HeapStorage};
 use crate::maps::{Case, Map, MapScenarios};
 use crate::reference::{self, Optima};
 
@@ -164,7 +164,7 @@ pub fn run_one(
     let time = t0.elapsed();
     let outcome = match result {
         Err(e) => Outcome::Failed(e),
-        Ok(p) => match check_plan(map, case.start, case.goal, &p, crate::heap::DEFAULT_CURVE) {
+        Ok(p) => match check_plan(map, case.start, case.goal, &p, heap::DEFAULT_CURVE) {
             Err(e) => Outcome::Invalid(e),
             Ok(c) => {
                 let o = case.optima;
@@ -209,7 +209,7 @@ pub fn run_map(prep: &Prepared, params: &Params, seeds: &[u64]) -> Vec<Run> {
             .lock()
             .expect("no thread panicked")
             .pop()
-            .unwrap_or_else(|| HeapStorage::new(cells));
+            .unwrap_or_else(|| heap::storage(cells));
         let p = Params { seed, ..*params };
         let (outcome, time) = run_one(&prep.map, &prep.cases[case], &p, &mut st);
         storage.lock().expect("no thread panicked").push(st);

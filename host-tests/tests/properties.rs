@@ -13,7 +13,7 @@ use ohaca::error::{Endpoint, Param};
 use ohaca::{plan, Algorithm, DeadEnd, Error, Params, Point, Run, SmoothingKind};
 use ohaca_host_tests::check::{check_plan, is_subsequence};
 use ohaca_host_tests::gen;
-use ohaca_host_tests::heap::HeapStorage;
+use ohaca_host_tests::heap::{self, HeapStorage};
 use ohaca_host_tests::maps::Map;
 use ohaca_host_tests::reference::{any_angle, euclid, opt8, Segments};
 use proptest::prelude::*;
@@ -204,14 +204,14 @@ proptest! {
         salt in any::<u32>(),
     ) {
         let cells = m.cells();
-        let mut st = HeapStorage::with_curve(cells, curve_cap);
+        let mut st = heap::with_curve(cells, curve_cap);
         let first = run(&m, s, g, &p, &mut st, curve_cap);
         check_against_references(&m, s, g, &p, &first)?;
         if p.dead_end == DeadEnd::Backtrack && opt8(&m, s, g).is_some() {
             prop_assert!(first.is_ok());
         }
-        let mut dirty = HeapStorage::dirty(cells + 3, salt);
-        let again = run(&m, s, g, &p, &mut dirty, ohaca_host_tests::heap::DEFAULT_CURVE);
+        let mut dirty = heap::dirty(cells + 3, salt);
+        let again = run(&m, s, g, &p, &mut dirty, heap::DEFAULT_CURVE);
         match (&first, &again) {
             (Ok(a), Ok(b)) => {
                 // The curves differ only in how much of it the workspace could hold.
@@ -235,8 +235,8 @@ proptest! {
         seed in 0u64..1000,
     ) {
         let p = Params { algorithm, dead_end, seed, ants: 20, iterations: 15, ..Params::default() };
-        let mut st = HeapStorage::new(m.cells());
-        let r = run(&m, s, g, &p, &mut st, ohaca_host_tests::heap::DEFAULT_CURVE);
+        let mut st = heap::storage(m.cells());
+        let r = run(&m, s, g, &p, &mut st, heap::DEFAULT_CURVE);
         check_against_references(&m, s, g, &p, &r)?;
     }
 
@@ -244,8 +244,8 @@ proptest! {
     #[test]
     fn extreme_parameters_are_safe((m, s, g) in gen::case(12), p in extreme_params()) {
         prop_assert_eq!(p.validate(), Ok(()));
-        let mut st = HeapStorage::new(m.cells());
-        let r = run(&m, s, g, &p, &mut st, ohaca_host_tests::heap::DEFAULT_CURVE);
+        let mut st = heap::storage(m.cells());
+        let r = run(&m, s, g, &p, &mut st, heap::DEFAULT_CURVE);
         check_against_references(&m, s, g, &p, &r)?;
         if p.dead_end == DeadEnd::Backtrack && opt8(&m, s, g).is_some() {
             prop_assert!(r.is_ok());
@@ -256,8 +256,8 @@ proptest! {
     /// kinds order as promised (shortest <= greedy <= raw, all through raw path cells).
     #[test]
     fn smoothing_only_changes_the_output((m, s, g) in gen::case(16), p in small_params()) {
-        let mut st = HeapStorage::new(m.cells());
-        let cap = ohaca_host_tests::heap::DEFAULT_CURVE;
+        let mut st = heap::storage(m.cells());
+        let cap = heap::DEFAULT_CURVE;
         let haca = run(&m, s, g, &Params { algorithm: Algorithm::Haca, ..p }, &mut st, cap);
         let mut lens = Vec::new();
         for smoothing in [SmoothingKind::None, SmoothingKind::Greedy, SmoothingKind::Shortest] {
@@ -289,10 +289,10 @@ proptest! {
     #[test]
     fn run_steps_and_early_finish((m, s, g) in gen::case(12), p in small_params(), stop in 0u16..10) {
         let grid = m.grid();
-        let cap = ohaca_host_tests::heap::DEFAULT_CURVE;
-        let mut st = HeapStorage::new(m.cells());
+        let cap = heap::DEFAULT_CURVE;
+        let mut st = heap::storage(m.cells());
         let whole = run(&m, s, g, &p, &mut st, cap);
-        let mut st2 = HeapStorage::new(m.cells());
+        let mut st2 = heap::storage(m.cells());
         match Run::new(&grid, s, g, &p, st2.workspace()) {
             Err(e) => prop_assert_eq!(whole.err(), Some(e)),
             Ok(mut r) => {
@@ -331,7 +331,7 @@ proptest! {
     #[test]
     fn endpoint_errors((m, s, g) in gen::raw_case(10), p in small_params()) {
         let grid = m.grid();
-        let mut st = HeapStorage::new(m.cells());
+        let mut st = heap::storage(m.cells());
         let r = plan(&grid, s, g, &p, st.workspace()).map(|_| ());
         let start_bad = if !m.contains(s) {
             Some(Error::OutOfBounds(Endpoint::Start))
@@ -374,7 +374,7 @@ const ROWS: [&str; 6] = [
 #[test]
 fn every_algorithm_and_dead_end_on_a_fixed_map() {
     let m = Map::from_rows(&ROWS);
-    let cap = ohaca_host_tests::heap::DEFAULT_CURVE;
+    let cap = heap::DEFAULT_CURVE;
     for algorithm in Algorithm::ALL {
         for dead_end in DeadEnd::ALL {
             for seed in 0..20 {
@@ -385,7 +385,7 @@ fn every_algorithm_and_dead_end_on_a_fixed_map() {
                         seed,
                         ..Params::default()
                     };
-                    let mut st = HeapStorage::new(m.cells());
+                    let mut st = heap::storage(m.cells());
                     let r = run(&m, s, g, &prm, &mut st, cap);
                     check_against_references(&m, s, g, &prm, &r).unwrap();
                     if dead_end == DeadEnd::Backtrack {
@@ -446,7 +446,7 @@ fn each_extreme_parameter_alone_on_complex_26() {
                     dead_end,
                     ..base
                 };
-                let mut st = HeapStorage::new(m.cells());
+                let mut st = heap::storage(m.cells());
                 let r = run(m, c.start, c.goal, &prm, &mut st, 1024);
                 check_against_references(m, c.start, c.goal, &prm, &r).unwrap();
                 if dead_end == DeadEnd::Backtrack {
@@ -480,7 +480,7 @@ fn large_and_thin_maps() {
                 iterations: 3,
                 ..Params::default()
             };
-            let mut st = HeapStorage::new(m.cells());
+            let mut st = heap::storage(m.cells());
             let snap = run(m, *s, *g, &prm, &mut st, 1024).unwrap();
             let raw = f64::from(f32::from_bits(snap.raw_length));
             let len = f64::from(f32::from_bits(snap.length));
@@ -499,7 +499,7 @@ fn start_equals_goal_is_a_one_point_plan() {
             algorithm,
             ..Params::default()
         };
-        let mut st = HeapStorage::new(m.cells());
+        let mut st = heap::storage(m.cells());
         let snap = run(&m, p(3, 2), p(3, 2), &prm, &mut st, 1024).unwrap();
         assert_eq!(snap.raw, vec![p(3, 2)]);
         assert_eq!(snap.waypoints, vec![p(3, 2)]);
@@ -517,7 +517,7 @@ fn endpoint_and_storage_errors() {
             .map(|_| ())
             .unwrap_err()
     };
-    let mut st = HeapStorage::new(m.cells());
+    let mut st = heap::storage(m.cells());
     use Endpoint::{Goal, Start};
     assert_eq!(err(p(8, 0), p(0, 0), &mut st), Error::OutOfBounds(Start));
     assert_eq!(err(p(0, 6), p(0, 0), &mut st), Error::OutOfBounds(Start));
@@ -532,7 +532,7 @@ fn endpoint_and_storage_errors() {
     // Both bad: the start is reported.
     assert_eq!(err(p(1, 1), p(9, 9), &mut st), Error::Blocked(Start));
     // Storage one cell short.
-    let mut small = HeapStorage::new(m.cells() - 1);
+    let mut small = heap::storage(m.cells() - 1);
     assert_eq!(
         err(p(0, 0), p(7, 5), &mut small),
         Error::MapTooLarge {
@@ -542,7 +542,7 @@ fn endpoint_and_storage_errors() {
     );
     // Walled-in goal.
     let walled = Map::from_rows(&["..#.", ".##.", "#...", "...."]);
-    let mut st = HeapStorage::new(walled.cells());
+    let mut st = heap::storage(walled.cells());
     let r = plan(&walled.grid(), p(0, 0), p(3, 3), &prm, st.workspace()).map(|_| ());
     assert_eq!(r, Err(Error::NoPath));
     // A diagonal gap is no gap.
@@ -592,7 +592,7 @@ fn bad_parameters_are_rejected() {
         (Params { tau_min: nan, ..d }, Param::Tau),
     ];
     for (prm, want) in cases {
-        let mut st = HeapStorage::new(m.cells());
+        let mut st = heap::storage(m.cells());
         // Bad parameters are reported before anything else is looked at.
         let r = plan(&grid, p(99, 99), p(1, 1), &prm, st.workspace()).map(|_| ());
         assert_eq!(r, Err(Error::BadParam(want)), "{prm:?}");
@@ -634,7 +634,7 @@ fn tightened_paths_have_no_shortcut() {
         ..Params::default()
     };
     assert!(prm.tighten);
-    let mut st = HeapStorage::new(m.cells());
+    let mut st = heap::storage(m.cells());
     let snap = run(&m, p(0, 0), p(1, 0), &prm, &mut st, 1024).unwrap();
     assert_eq!(
         shortcut(&m, &snap.raw),
@@ -656,7 +656,7 @@ fn tightened_paths_have_no_shortcut() {
                     ..Params::default()
                 };
                 for (s, g) in [(p(0, 0), p(1, 0)), (p(0, 0), p(2, 2))] {
-                    let mut st = HeapStorage::new(m.cells());
+                    let mut st = heap::storage(m.cells());
                     let snap = run(&m, s, g, &prm, &mut st, 1024).unwrap();
                     if let Some(sc) = shortcut(&m, &snap.raw) {
                         bad.push(format!("{algorithm} seed {seed} {s:?}->{g:?}: {sc:?}"));

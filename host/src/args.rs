@@ -54,47 +54,12 @@ pub fn parse_point(s: &str) -> Result<Point, PointError> {
     Ok(Point::new(coord('x', x)?, coord('y', y)?))
 }
 
-/// Lower-case name of a dead-end rule: `backtrack` or `die`.
-pub const fn dead_end_name(d: DeadEnd) -> &'static str {
-    match d {
-        DeadEnd::Backtrack => "backtrack",
-        DeadEnd::Die => "die",
-    }
-}
-
-/// Lower-case name of a smoothing kind: `shortest`, `greedy` or `none`.
-pub const fn smoothing_name(s: SmoothingKind) -> &'static str {
-    match s {
-        SmoothingKind::Shortest => "shortest",
-        SmoothingKind::Greedy => "greedy",
-        SmoothingKind::None => "none",
-    }
-}
-
-/// Parse an algorithm name (`ohaca`, `haca`, `paca`, `aca`; any case).
-pub fn parse_algorithm(s: &str) -> Result<Algorithm, String> {
-    Algorithm::from_name(s.trim())
-        .ok_or_else(|| format!("unknown algorithm `{s}`; expected ohaca, haca, paca or aca"))
-}
-
-/// Parse a dead-end rule (`backtrack` or `die`; any case).
-pub fn parse_dead_end(s: &str) -> Result<DeadEnd, String> {
-    [DeadEnd::Backtrack, DeadEnd::Die]
-        .into_iter()
-        .find(|d| dead_end_name(*d).eq_ignore_ascii_case(s.trim()))
-        .ok_or_else(|| format!("unknown dead-end rule `{s}`; expected backtrack or die"))
-}
-
-/// Parse a smoothing kind (`shortest`, `greedy` or `none`; any case).
-pub fn parse_smoothing(s: &str) -> Result<SmoothingKind, String> {
-    [
-        SmoothingKind::Shortest,
-        SmoothingKind::Greedy,
-        SmoothingKind::None,
-    ]
-    .into_iter()
-    .find(|k| smoothing_name(*k).eq_ignore_ascii_case(s.trim()))
-    .ok_or_else(|| format!("unknown smoothing `{s}`; expected shortest, greedy or none"))
+/// Parse a planner enum ([`Algorithm`], [`DeadEnd`], [`SmoothingKind`]) by its lower-case name,
+/// in any case: the names of the core's serde derive, which the JSON report prints too.
+pub fn parse_name<T: serde::de::DeserializeOwned>(s: &str) -> Result<T, String> {
+    use serde::de::value::{Error, StrDeserializer};
+    let lower = s.trim().to_ascii_lowercase();
+    T::deserialize(StrDeserializer::<Error>::new(&lower)).map_err(|e| e.to_string())
 }
 
 /// Parse a boolean flag value (`true`/`false`, `on`/`off`, `yes`/`no`, `1`/`0`).
@@ -112,8 +77,8 @@ pub fn parse_bool(s: &str) -> Result<bool, String> {
 #[command(next_help_heading = "Planner parameters (defaults: the paper's setting)")]
 pub struct ParamArgs {
     /// Planner variant: ohaca, haca, paca or aca
-    #[arg(long, value_name = "NAME", value_parser = parse_algorithm,
-          default_value = Params::default().algorithm.name())]
+    #[arg(long, value_name = "NAME", value_parser = parse_name::<Algorithm>,
+          default_value_t = Params::default().algorithm)]
     pub algorithm: Algorithm,
     /// Seed of the random generator
     #[arg(long, value_name = "N", allow_negative_numbers = true,
@@ -168,12 +133,12 @@ pub struct ParamArgs {
           default_value_t = Params::default().patience)]
     pub patience: u16,
     /// What an ant does at a dead end: backtrack or die (the paper)
-    #[arg(long, value_name = "RULE", value_parser = parse_dead_end,
-          default_value = dead_end_name(Params::default().dead_end))]
+    #[arg(long, value_name = "RULE", value_parser = parse_name::<DeadEnd>,
+          default_value_t = Params::default().dead_end)]
     pub dead_end: DeadEnd,
     /// How OHACA smooths its path: shortest, greedy (the paper) or none
-    #[arg(long, value_name = "KIND", value_parser = parse_smoothing,
-          default_value = smoothing_name(Params::default().smoothing))]
+    #[arg(long, value_name = "KIND", value_parser = parse_name::<SmoothingKind>,
+          default_value_t = Params::default().smoothing)]
     pub smoothing: SmoothingKind,
     /// Straighten each ant's path before the pheromone update (not in the paper)
     #[arg(long, value_name = "BOOL", value_parser = parse_bool, action = clap::ArgAction::Set,
@@ -321,18 +286,18 @@ mod tests {
     #[test]
     fn names_round_trip() {
         for a in Algorithm::ALL {
-            assert_eq!(parse_algorithm(a.name()), Ok(a));
+            assert_eq!(parse_name(a.name()), Ok(a));
+            assert_eq!(parse_name(&a.name().to_uppercase()), Ok(a));
         }
-        for d in [DeadEnd::Backtrack, DeadEnd::Die] {
-            assert_eq!(parse_dead_end(dead_end_name(d)), Ok(d));
+        for d in DeadEnd::ALL {
+            assert_eq!(parse_name(d.name()), Ok(d));
         }
-        for k in [
-            SmoothingKind::Shortest,
-            SmoothingKind::Greedy,
-            SmoothingKind::None,
-        ] {
-            assert_eq!(parse_smoothing(smoothing_name(k)), Ok(k));
+        for k in SmoothingKind::ALL {
+            assert_eq!(parse_name(k.name()), Ok(k));
         }
+        assert!(parse_name::<Algorithm>("bee")
+            .unwrap_err()
+            .contains("`ohaca`"));
     }
 
     #[test]

@@ -336,7 +336,7 @@ pub struct Scene {
     /// Legend text for the heat map (e.g. which algorithm's pheromone).
     pub pheromone_label: String,
     /// The map's metric frame, if any: the legend gives the start and goal in metres too.
-    pub frame: Option<crate::frame::Frame>,
+    pub metric: Option<crate::map::MapFrame>,
 }
 
 /// Where a [`Scene`]'s parts go, in pixels. Public so tests can find a cell's pixels.
@@ -455,7 +455,7 @@ impl Scene {
 
     /// The legend text of the start or the goal: the cell, and metres for maps with a frame.
     fn endpoint_label(&self, label: &str, p: Point) -> String {
-        let metres = self.frame.map_or_else(String::new, |f| {
+        let metres = self.metric.map_or_else(String::new, |f| {
             let [mx, my] = f.to_metres(p);
             format!(" = ({mx:.2}, {my:.2}) m")
         });
@@ -894,7 +894,7 @@ mod tests {
             }],
             pheromone: pheromone.then(|| (0..18).map(|i| 0.01 + i as f32).collect()),
             pheromone_label: "of OHACA".into(),
-            frame: None,
+            metric: None,
             map,
         }
     }

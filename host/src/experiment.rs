@@ -28,13 +28,12 @@ use std::path::Path;
 use ohaca::{Algorithm, Params};
 use rayon::prelude::*;
 
-use crate::args::{dead_end_name, smoothing_name};
 use crate::draw::{self, Convergence, Layer, Scene, Series};
 use crate::input::Scenario;
 use crate::output::PlanReport;
-use crate::planning::PlanError;
-use crate::storage::HeapStorage;
+use crate::plan_map::PlanError;
 use crate::trace::plan_traced;
+use ohaca::heap::HeapStorage;
 
 /// What to run.
 #[derive(Clone, Debug, PartialEq)]
@@ -334,7 +333,7 @@ impl Outcome {
         let sc = &self.scenario;
         let (layer, which) = match self.best_run(a) {
             Some(r) => (
-                Layer::from_report(a, &r.report, sc.frame.map(|f| f.resolution)),
+                Layer::from_report(a, &r.report, sc.metric.map(|f| f.resolution)),
                 format!("best of {} runs (seed {})", self.config.runs, r.seed),
             ),
             None => {
@@ -368,7 +367,7 @@ impl Outcome {
             layers: vec![layer],
             pheromone: None,
             pheromone_label: String::new(),
-            frame: sc.frame,
+            metric: sc.metric,
         }
     }
 
@@ -394,7 +393,7 @@ impl Outcome {
             last,
             sc.map.width,
             sc.map.height,
-            sc.frame
+            sc.metric
                 .map_or_else(String::new, |f| format!(", 1 cell = {} m", f.resolution))
         );
         let _ = writeln!(s, "Parameters: {}.\n", params_line(&c.params));
@@ -492,8 +491,8 @@ pub fn params_brief(p: &Params) -> String {
         p.ants,
         p.iterations,
         p.patience,
-        dead_end_name(p.dead_end),
-        smoothing_name(p.smoothing),
+        p.dead_end.name(),
+        p.smoothing.name(),
         if p.tighten { "" } else { ", no tightening" }
     )
 }
@@ -515,8 +514,8 @@ pub fn params_line(p: &Params) -> String {
         p.tau_min,
         p.tau_max,
         p.patience,
-        dead_end_name(p.dead_end),
-        smoothing_name(p.smoothing),
+        p.dead_end.name(),
+        p.smoothing.name(),
         p.tighten
     )
 }
@@ -536,7 +535,7 @@ mod tests {
                 Format::Text,
             )
             .unwrap(),
-            frame: None,
+            metric: None,
             start: Point::new(0, 0),
             goal: Point::new(7, 3),
         }

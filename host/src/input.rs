@@ -1,46 +1,17 @@
-//! What the path-producing subcommands (`plan`, `render`, `experiment`) read from the command
-//! line and the disk: the map in any supported format, prepared for the robot (`--unknown`,
-//! `--inflate`, `--cell`), and the start and goal in cells or metres. [`MapArgs::load`] turns
-//! the flags into a [`Scenario`].
-//!
-//! Map formats, chosen by the file name's extension:
-//!
-//! | extension | format | positions |
-//! | --- | --- | --- |
-//! | `.yaml`, `.yml` | ROS `map_server` YAML + its PGM/PNG image ([`crate::rosmap`]) | cells, or metres with `--start-m`/`--goal-m` |
-//! | `.png`, `.pgm`, `.pnm`, `.ppm` (or a PNG signature) | plain image, dark = blocked | cells |
-//! | anything else | Moving AI `.map` or text grid ([`crate::map`]) | cells |
-//!
-//! Order of preparation: unknown cells are resolved while loading, then `--inflate` on the
-//! image's own cells, then `--cell` resampling; `--start`/`--goal` are cells of the final grid.
+//! The map flags of the path-producing subcommands (`plan`, `render`, `experiment`, `send`): the
+//! map file in any format [`crate::map`] reads, prepared for the robot (`--unknown`, `--inflate`,
+//! `--cell`; [`crate::map::prepare`]), and the start and goal in cells or, for maps with a
+//! resolution, metres (`--start-m`/`--goal-m`). [`MapArgs::load`] turns the flags into a
+//! [`Scenario`]; `--start`/`--goal` are cells of the prepared grid.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use clap::parser::ValueSource;
 use clap::{ArgAction, ArgMatches, Args, Command, FromArgMatches};
 use ohaca::{Algorithm, Point};
 
 use crate::args::{parse_point, ParamArgs};
-use crate::frame::Frame;
-use crate::gridops::{inflate, resample, resample_frame};
-use crate::map::{Map, MapError};
-use crate::rosmap::{load_image, load_ros, Unknown};
-
-/// Why a map or a start/goal could not be loaded. `Display` is one line naming the file.
-#[derive(Debug, thiserror::Error)]
-pub enum InputError {
-    /// A Moving AI or text map could not be loaded.
-    #[error(transparent)]
-    Map(#[from] MapError),
-    /// A problem with a file (YAML, image) or with a value that refers to it.
-    #[error("{path}: {problem}")]
-    File {
-        /// The file as given.
-        path: String,
-        /// What is wrong.
-        problem: String,
-    },
-}
+use crate::map::{prepare, Map, MapError, MapFrame, Unknown};
 
 /// Parse `"X,Y"` in metres (any finite numbers, e.g. `-1.5,2`).
 pub fn parse_metres(s: &str) -> Result<[f64; 2], String> {
@@ -113,7 +84,7 @@ pub struct Scenario {
     /// The grid the planner sees.
     pub map: Map,
     /// Where the grid's cells are in metres (maps with a resolution).
-    pub frame: Option<Frame>,
+    pub metric: Option<MapFrame>,
     /// Start cell.
     pub start: Point,
     /// Goal cell.
@@ -123,97 +94,24 @@ pub struct Scenario {
 impl Scenario {
     /// Metres of each point (rounded to a micrometre), if the map has a resolution.
     pub fn metres(&self, points: &[[u16; 2]]) -> Option<Vec<[f64; 2]>> {
-        self.frame.map(|f| f.points_m(points))
+        self.metric.map(|f| f.points_m(points))
     }
-}
-
-/// Which loader a file name asks for.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Kind {
-    Ros,
-    Image,
-    Grid,
-}
-
-fn kind(path: &Path) -> Kind {
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase);
-    match ext.as_deref() {
-        Some("yaml" | "yml") => Kind::Ros,
-        Some("png" | "pgm" | "pnm" | "ppm") => Kind::Image,
-        _ => {
-            // A PNG under another name.
-            let mut head = [0u8; 8];
-            let png = std::fs::File::open(path)
-                .and_then(|mut f| std::io::Read::read_exact(&mut f, &mut head))
-                .is_ok()
-                && head == *b"\x89PNG\r\n\x1a\n";
-            if png {
-                Kind::Image
-            } else {
-                Kind::Grid
-            }
-        }
-    }
-}
-
-/// Load a map file of any supported format (see the module docs), with its frame if it has one.
-pub fn load_map(path: &Path, unknown: Unknown) -> Result<(Map, Option<Frame>), InputError> {
-    match kind(path) {
-        Kind::Ros => load_ros(path, unknown).map(|(m, f)| (m, Some(f))),
-        Kind::Image => load_image(path).map(|m| (m, None)),
-        Kind::Grid => Ok((Map::load(path)?, None)),
-    }
-}
-
-/// Load a map file and prepare it for the robot: unknown cells resolved while loading, then
-/// `inflate` (a radius) on the file's own cells, then `cell` resampling (a cell size); both in
-/// metres for maps with a resolution, in cells otherwise. The frame follows the resampling.
-pub fn prepare_map(
-    path: &Path,
-    unknown: Unknown,
-    inflate_by: Option<f64>,
-    cell: Option<f64>,
-) -> Result<(Map, Option<Frame>), InputError> {
-    let (mut map, mut frame) = load_map(path, unknown)?;
-    let unit = frame.map_or(1.0, |f| f.resolution);
-    if let Some(r) = inflate_by {
-        map = inflate(&map, r / unit);
-    }
-    if let Some(size) = cell {
-        let factor = size / unit;
-        let coarse = resample(&map, factor, frame.is_some()).map_err(|e| InputError::File {
-            path: path.display().to_string(),
-            problem: format!(
-                "--cell {size}: {e}{}",
-                frame.map_or_else(String::new, |f| format!(
-                    "; the map's resolution is {} m",
-                    f.resolution
-                ))
-            ),
-        })?;
-        frame = frame.map(|f| resample_frame(&f, &coarse, factor));
-        map = coarse;
-    }
-    Ok((map, frame))
 }
 
 /// A start or goal (`what`) given in cells or in metres, as a cell of the prepared grid.
 /// `name` is the map file, for messages.
 pub fn resolve_point(
     name: &str,
-    frame: Option<Frame>,
+    metric: Option<MapFrame>,
     what: &str,
     cells: Option<Point>,
     metres: Option<[f64; 2]>,
-) -> Result<Point, InputError> {
-    let err = |problem: String| InputError::File {
+) -> Result<Point, MapError> {
+    let err = |problem: String| MapError::File {
         path: name.to_string(),
         problem,
     };
-    match (cells, metres, frame) {
+    match (cells, metres, metric) {
         (Some(p), _, _) => Ok(p),
         (None, Some(m), Some(f)) => f.cell(m).ok_or_else(|| {
             let [x0, x1, y0, y1] = f.extent();
@@ -236,16 +134,16 @@ pub fn resolve_point(
 }
 
 impl MapArgs {
-    /// Load and prepare the map ([`prepare_map`]), and resolve the start and goal.
-    pub fn load(&self) -> Result<Scenario, InputError> {
+    /// Load and prepare the map ([`prepare`]), and resolve the start and goal.
+    pub fn load(&self) -> Result<Scenario, MapError> {
         let name = self.map.display().to_string();
-        let (map, frame) = prepare_map(&self.map, self.unknown, self.inflate, self.cell)?;
-        let start = resolve_point(&name, frame, "start", self.start, self.start_m)?;
-        let goal = resolve_point(&name, frame, "goal", self.goal, self.goal_m)?;
+        let (map, metric) = prepare(&self.map, self.unknown, self.inflate, self.cell)?;
+        let start = resolve_point(&name, metric, "start", self.start, self.start_m)?;
+        let goal = resolve_point(&name, metric, "goal", self.goal, self.goal_m)?;
         Ok(Scenario {
             name,
             map,
-            frame,
+            metric,
             start,
             goal,
         })

@@ -3,22 +3,19 @@
 //! The library behind the `ohaca` command-line tool, reusable by the tests and by every
 //! subcommand (`plan`, `render`, `experiment`, `send`; `bench` later). It runs the `no_std`
 //! core ([`ohaca`]) under std: it loads maps from files, lends the planner heap buffers instead of
-//! a fixed-size `Storage`, and turns results into a stable JSON report or an ASCII picture.
+//! a fixed-size `Storage` (the core's [`HeapStorage`], feature `alloc`), and turns results into a
+//! stable JSON report or an ASCII picture.
 //!
 //! Modules, one concept each:
 //!
 //! | module | owns |
 //! | --- | --- |
-//! | [`map`] | loading Moving AI `.map` files and plain text grids into an owned [`map::Map`] |
-//! | [`storage`] | [`storage::HeapStorage`]: planner buffers on the heap, sized per map |
+//! | [`map`] | every map format (Moving AI, text grid, ROS YAML, image), one `load`, the metric frame, inflation, resampling and fitting a device |
 //! | [`args`] | command-line values shared by subcommands: `X,Y` points and the planner flags |
-//! | [`planning`] | one planning run on a loaded map, timed, as a [`output::PlanReport`] |
+//! | [`plan_map`](mod@plan_map) | one planning run on a loaded map, timed, as a [`output::PlanReport`] |
 //! | [`output`] | the JSON report (a stable contract) and the ASCII renderer |
 //! | [`exit`] | the tool's exit codes |
-//! | [`input`] | the map flags of `plan`/`render`/`experiment`: any map format, prepared, start/goal in cells or metres |
-//! | [`rosmap`] | ROS `map_server` maps (YAML + PGM/PNG) and plain images as maps |
-//! | [`frame`] | a map's metric frame: cell <-> metres (ROS map frame) |
-//! | [`gridops`] | obstacle inflation and resampling to coarser cells |
+//! | [`input`] | the map flags of `plan`/`render`/`experiment`/`send`: the map prepared, start/goal in cells or metres |
 //! | [`trace`] | a planning run that keeps its convergence curve and final pheromone |
 //! | [`draw`] | pictures: the map with paths (and pheromone), the convergence chart; SVG or PNG |
 //! | [`experiment`] | the paper's experiments: many seeds per algorithm, CSV, summary, pictures |
@@ -52,19 +49,15 @@ pub mod args;
 pub mod draw;
 pub mod exit;
 pub mod experiment;
-pub mod frame;
-pub mod gridops;
 pub mod input;
 pub mod link;
 pub mod map;
 pub mod output;
-pub mod planning;
-pub mod rosmap;
-pub mod storage;
+pub mod plan_map;
 pub mod trace;
 
 pub use args::{parse_point, ParamArgs};
 pub use map::{Map, MapError};
-pub use output::{ParamsReport, PlanReport};
-pub use planning::{plan_map, plan_map_in, PlanError};
-pub use storage::HeapStorage;
+pub use ohaca::heap::HeapStorage;
+pub use output::PlanReport;
+pub use plan_map::{plan_map, plan_map_in, PlanError};

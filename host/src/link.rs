@@ -34,7 +34,6 @@ use std::io::{self, Read, Write};
 use std::net::{TcpStream, ToSocketAddrs};
 use std::time::{Duration, Instant};
 
-use ohaca::error::{Endpoint, Param};
 use ohaca::grid::{DX, DY};
 use ohaca::protocol::{
     decode_reply, encode_request, Capacity, DecodeError, EncodeError, ErrorCode, ErrorReply,
@@ -253,40 +252,6 @@ pub fn request_name(r: &Request<'_>) -> &'static str {
         Request::Cancel => "Cancel",
         Request::Stats => "Stats",
     }
-}
-
-/// The planner error an [`ErrorReply`] stands for, if it is one of the core's (codes 1 to 10),
-/// so it can be shown with the core's own message.
-pub fn core_error(e: &ErrorReply) -> Option<ohaca::Error> {
-    const PARAMS: [Param; 9] = [
-        Param::Ants,
-        Param::Iterations,
-        Param::Alpha,
-        Param::Beta,
-        Param::Rho,
-        Param::Q,
-        Param::A,
-        Param::Xi,
-        Param::Tau,
-    ];
-    Some(match e.code {
-        ErrorCode::BadMap => ohaca::Error::BadMap,
-        ErrorCode::MapTooLarge => ohaca::Error::MapTooLarge {
-            cells: e.detail,
-            capacity: e.limit,
-        },
-        ErrorCode::StartOutOfBounds => ohaca::Error::OutOfBounds(Endpoint::Start),
-        ErrorCode::GoalOutOfBounds => ohaca::Error::OutOfBounds(Endpoint::Goal),
-        ErrorCode::StartBlocked => ohaca::Error::Blocked(Endpoint::Start),
-        ErrorCode::GoalBlocked => ohaca::Error::Blocked(Endpoint::Goal),
-        ErrorCode::BadParam => {
-            ohaca::Error::BadParam(*PARAMS.get(usize::try_from(e.detail).ok()?)?)
-        }
-        ErrorCode::NoPath => ohaca::Error::NoPath,
-        ErrorCode::Cancelled => ohaca::Error::Cancelled,
-        ErrorCode::NoAntArrived => ohaca::Error::NoAntArrived,
-        _ => return None,
-    })
 }
 
 /// A reply nobody was waiting for.
@@ -1226,23 +1191,5 @@ mod tests {
         );
         assert!(raw_path(Point::new(0, 0), &[8]).is_err());
         assert!(raw_path(Point::new(0, 0), &[4]).is_err());
-    }
-
-    #[test]
-    fn core_errors_round_trip() {
-        for e in [
-            ohaca::Error::NoPath,
-            ohaca::Error::Blocked(Endpoint::Goal),
-            ohaca::Error::OutOfBounds(Endpoint::Start),
-            ohaca::Error::BadParam(Param::Tau),
-            ohaca::Error::MapTooLarge {
-                cells: 5,
-                capacity: 4,
-            },
-            ohaca::Error::NoAntArrived,
-        ] {
-            assert_eq!(core_error(&ErrorReply::from(e)), Some(e));
-        }
-        assert_eq!(core_error(&ErrorReply::new(ErrorCode::BadCrc)), None);
     }
 }

@@ -17,7 +17,7 @@
 //! | `best_iteration` | integer or null | 0-based iteration in which the best path was first found |
 //! | `moves` | integer or null | ant moves made, forward and backtracking, over the run |
 //! | `elapsed_us` | integer | planning time in microseconds (map loading excluded) |
-//! | `params` | object | every parameter ([`ParamsReport`]) |
+//! | `params` | object | every field of [`ohaca::Params`], in order; enum values by their lower-case names (`"ohaca"`, `"backtrack"`, `"shortest"`) |
 //! | `error` | string | only when `found` is false: why |
 //!
 //! | `waypoints_m` | `[[x, y], ...]` | only for maps with a resolution (ROS YAML): `waypoints` in metres, ROS map frame ([`LocatedReport`]) |
@@ -34,101 +34,10 @@
 use std::fmt::Write as _;
 use std::time::Duration;
 
-use ohaca::{Algorithm, Params, Plan, Point};
+use ohaca::{Params, Plan, Point};
 use serde::{Deserialize, Serialize};
 
-use crate::args::{dead_end_name, parse_dead_end, parse_smoothing, smoothing_name};
 use crate::map::Map;
-
-/// Every planner parameter, as printed in a report. Enum-valued parameters are lower-case names
-/// (`"ohaca"`, `"backtrack"`, `"shortest"`), the same words the command-line flags take.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct ParamsReport {
-    /// `ohaca`, `haca`, `paca` or `aca`.
-    pub algorithm: String,
-    /// Ants per iteration.
-    pub ants: u16,
-    /// Maximum iterations.
-    pub iterations: u16,
-    /// Pheromone exponent.
-    pub alpha: f32,
-    /// Heuristic exponent.
-    pub beta: f32,
-    /// Evaporation rate.
-    pub rho: f32,
-    /// Pheromone deposit constant.
-    pub q: f32,
-    /// Goal-attraction base.
-    pub a: f32,
-    /// Potential-field gain.
-    pub xi: f32,
-    /// Initial pheromone.
-    pub tau0: f32,
-    /// Lower pheromone bound.
-    pub tau_min: f32,
-    /// Upper pheromone bound.
-    pub tau_max: f32,
-    /// Early-stop patience (0 = never).
-    pub patience: u16,
-    /// Random seed.
-    pub seed: u64,
-    /// `backtrack` or `die`.
-    pub dead_end: String,
-    /// `shortest`, `greedy` or `none`.
-    pub smoothing: String,
-    /// Ant paths straightened before the pheromone update.
-    pub tighten: bool,
-}
-
-impl From<&Params> for ParamsReport {
-    fn from(p: &Params) -> Self {
-        ParamsReport {
-            algorithm: p.algorithm.name().to_string(),
-            ants: p.ants,
-            iterations: p.iterations,
-            alpha: p.alpha,
-            beta: p.beta,
-            rho: p.rho,
-            q: p.q,
-            a: p.a,
-            xi: p.xi,
-            tau0: p.tau0,
-            tau_min: p.tau_min,
-            tau_max: p.tau_max,
-            patience: p.patience,
-            seed: p.seed,
-            dead_end: dead_end_name(p.dead_end).to_string(),
-            smoothing: smoothing_name(p.smoothing).to_string(),
-            tighten: p.tighten,
-        }
-    }
-}
-
-impl ParamsReport {
-    /// Back to core parameters; fails with a message if a name is unknown.
-    pub fn to_params(&self) -> Result<Params, String> {
-        Ok(Params {
-            algorithm: Algorithm::from_name(&self.algorithm)
-                .ok_or_else(|| format!("unknown algorithm `{}`", self.algorithm))?,
-            ants: self.ants,
-            iterations: self.iterations,
-            alpha: self.alpha,
-            beta: self.beta,
-            rho: self.rho,
-            q: self.q,
-            a: self.a,
-            xi: self.xi,
-            tau0: self.tau0,
-            tau_min: self.tau_min,
-            tau_max: self.tau_max,
-            patience: self.patience,
-            seed: self.seed,
-            dead_end: parse_dead_end(&self.dead_end)?,
-            smoothing: parse_smoothing(&self.smoothing)?,
-            tighten: self.tighten,
-        })
-    }
-}
 
 /// The result of one planning request. See the module docs for the JSON contract.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -155,8 +64,8 @@ pub struct PlanReport {
     pub moves: Option<u64>,
     /// Planning time in microseconds.
     pub elapsed_us: u64,
-    /// Parameters used.
-    pub params: ParamsReport,
+    /// Parameters used (enum values by their lower-case names, as the flags take them).
+    pub params: Params,
     /// Why no path was found (absent when `found`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub error: Option<String>,
@@ -202,7 +111,7 @@ impl PlanReport {
             best_iteration: Some(plan.best_iteration),
             moves: Some(plan.moves),
             elapsed_us: micros(elapsed),
-            params: ParamsReport::from(&plan.params),
+            params: plan.params,
             error: None,
         }
     }
@@ -226,7 +135,7 @@ impl PlanReport {
             best_iteration: None,
             moves: None,
             elapsed_us: micros(elapsed),
-            params: ParamsReport::from(params),
+            params: *params,
             error: Some(error.to_string()),
         }
     }
@@ -416,6 +325,7 @@ pub fn render(map: &Map, start: Point, goal: Point, report: &PlanReport) -> Stri
 mod tests {
     use super::*;
     use crate::map::Format;
+    use ohaca::{Algorithm, DeadEnd, SmoothingKind};
 
     fn report() -> PlanReport {
         PlanReport {
@@ -429,7 +339,7 @@ mod tests {
             best_iteration: Some(0),
             moves: Some(42),
             elapsed_us: 1500,
-            params: ParamsReport::from(&Params::default()),
+            params: Params::default(),
             error: None,
         }
     }
@@ -498,14 +408,26 @@ mod tests {
     }
 
     #[test]
-    fn params_round_trip() {
+    fn params_by_name_and_back() {
         let p = Params::default();
-        assert_eq!(ParamsReport::from(&p).to_params(), Ok(p));
-        let j = serde_json::to_value(ParamsReport::from(&p)).unwrap();
+        let j = serde_json::to_value(p).unwrap();
         assert_eq!(j["algorithm"], "ohaca");
         assert_eq!(j["dead_end"], "backtrack");
         assert_eq!(j["smoothing"], "shortest");
         assert_eq!(j["rho"].as_f64().unwrap() as f32, 0.1);
+        assert_eq!(serde_json::from_value::<Params>(j).unwrap(), p);
+        // The derive's names are the core's names (which the flags and messages use).
+        let name = |v: serde_json::Value| v.as_str().unwrap().to_string();
+        for a in Algorithm::ALL {
+            assert_eq!(name(serde_json::to_value(a).unwrap()), a.name());
+        }
+        for d in DeadEnd::ALL {
+            assert_eq!(name(serde_json::to_value(d).unwrap()), d.name());
+        }
+        for k in SmoothingKind::ALL {
+            assert_eq!(name(serde_json::to_value(k).unwrap()), k.name());
+        }
+        assert!(serde_json::from_str::<Algorithm>("\"bee\"").is_err());
     }
 
     #[test]

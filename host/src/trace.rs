@@ -1,5 +1,5 @@
 //! One planning run that keeps more than the report: the convergence curve and, on request, the
-//! final pheromone table. `render` and `experiment` use it; [`crate::planning::plan_map_in`]
+//! final pheromone table. `render` and `experiment` use it; [`crate::plan_map::plan_map_in`]
 //! stays the lean path for `plan`.
 //!
 //! The pheromone is read from the [`HeapStorage`] after the plan is turned into an owned report:
@@ -12,8 +12,8 @@ use ohaca::{Error, Params, Point, Run};
 
 use crate::map::Map;
 use crate::output::PlanReport;
-use crate::planning::PlanError;
-use crate::storage::HeapStorage;
+use crate::plan_map::PlanError;
+use ohaca::heap::HeapStorage;
 
 /// A run's report with its convergence curve and, if asked for, its pheromone.
 #[derive(Clone, Debug, PartialEq)]
@@ -32,7 +32,7 @@ pub struct Traced {
     pub ants_arrived: u64,
 }
 
-/// Plan like [`crate::planning::plan_map_in`], keeping the curve and (with `pheromone`) a copy of
+/// Plan like [`crate::plan_map::plan_map_in`], keeping the curve and (with `pheromone`) a copy of
 /// the final pheromone table. The time in the report covers the core's work only.
 pub fn plan_traced(
     storage: &mut HeapStorage,
@@ -137,7 +137,7 @@ pub fn cell_pheromone(tau: &[[f32; 4]], width: u16, height: u16) -> Vec<f32> {
 mod tests {
     use super::*;
     use crate::map::Format;
-    use crate::planning::plan_map;
+    use crate::plan_map::plan_map;
     use ohaca::DeadEnd;
 
     fn map() -> Map {

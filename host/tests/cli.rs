@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 use ohaca::{Params, Point};
-use ohaca_host::{Map, ParamsReport};
+use ohaca_host::Map;
 use serde_json::Value;
 
 fn ohaca<S: AsRef<std::ffi::OsStr>>(args: &[S]) -> Output {
@@ -152,8 +152,8 @@ fn json_on_complex_26() {
     assert!(v["elapsed_us"].is_u64());
 
     // The params object is exactly the core's defaults.
-    let params: ParamsReport = serde_json::from_value(v["params"].clone()).unwrap();
-    assert_eq!(params, ParamsReport::from(&Params::default()));
+    let params: Params = serde_json::from_value(v["params"].clone()).unwrap();
+    assert_eq!(params, Params::default());
     assert_eq!(v["params"]["algorithm"], "ohaca");
     assert_eq!(v["params"]["ants"], 50);
     assert_eq!(v["params"]["iterations"], 100);

@@ -298,7 +298,8 @@ fn a_stream_of_200_goals_is_answered_in_order() {
             }
             Err(h) => {
                 let e = o.result.as_ref().expect_err(&what);
-                assert_eq!(e.code.code(), h_code(&h), "{what}: host {h}, device {e}");
+                let device = ohaca::Error::try_from(*e);
+                assert_eq!(device, Ok(core(&h)), "{what}: host {h}, device {e}");
             }
         }
     }
@@ -312,9 +313,9 @@ fn a_stream_of_200_goals_is_answered_in_order() {
     );
 }
 
-fn h_code(e: &ohaca_host::PlanError) -> u8 {
+fn core(e: &ohaca_host::PlanError) -> ohaca::Error {
     match e {
-        ohaca_host::PlanError::Core(c) => c.code(),
+        ohaca_host::PlanError::Core(c) => *c,
         other => panic!("{other}"),
     }
 }

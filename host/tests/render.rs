@@ -251,7 +251,7 @@ fn bad_input() {
                 "--algorithm",
                 "bee",
             ],
-            "unknown algorithm",
+            "unknown variant `bee`",
         ),
     ] {
         let o = ohaca(&args);

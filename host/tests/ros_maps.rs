@@ -7,8 +7,8 @@ use std::path::Path;
 
 use common::*;
 use ohaca::Point;
-use ohaca_host::input::{InputError, MapArgs, Scenario};
-use ohaca_host::rosmap::Unknown;
+use ohaca_host::input::{MapArgs, Scenario};
+use ohaca_host::map::{MapError, Unknown};
 use serde_json::Value;
 
 fn args(map: &Path) -> MapArgs {
@@ -47,7 +47,7 @@ fn image_row_zero_is_the_top_and_origin_is_lower_left() {
     let sc = load(&args(&yaml));
     assert_eq!((sc.map.width, sc.map.height), (4, 3));
     assert_eq!(blocked(&sc), ["...#", "....", "...."]);
-    let f = sc.frame.unwrap();
+    let f = sc.metric.unwrap();
     // The lower-left cell (0, 2) is centred half a cell from the origin.
     assert_eq!(f.to_metres(Point::new(0, 2)), [10.25, -1.75]);
     // The obstacle (3, 0) is top right: x = 10 + 3.5 * 0.5, y = -2 + 2.5 * 0.5.
@@ -103,7 +103,7 @@ fn png_maps_with_and_without_yaml() {
     img.save(&png).unwrap();
     let sc = load(&args(&png));
     assert_eq!(blocked(&sc), [".#...", "....."]);
-    assert!(sc.frame.is_none());
+    assert!(sc.metric.is_none());
     // The same PNG through a YAML: 140 is p = 0.45, unknown, so blocked by default.
     std::fs::write(
         dir.path().join("p.yaml"),
@@ -112,7 +112,7 @@ fn png_maps_with_and_without_yaml() {
     .unwrap();
     let sc = load(&args(&dir.path().join("p.yaml")));
     assert_eq!(blocked(&sc), [".##..", "....."]);
-    assert_eq!(sc.frame.unwrap().resolution, 0.1);
+    assert_eq!(sc.metric.unwrap().resolution, 0.1);
 }
 
 #[test]
@@ -184,7 +184,7 @@ fn resampling_keeps_the_origin_and_blocks_any_covered_pixel() {
     // 3 x 3: anchored at the bottom, so the top coarse row covers only fine row 0 and the middle
     // one fine rows 1-2.
     assert_eq!(blocked(&coarse), ["...", "..#", "..."]);
-    let (ff, cf) = (fine.frame.unwrap(), coarse.frame.unwrap());
+    let (ff, cf) = (fine.metric.unwrap(), coarse.metric.unwrap());
     assert_eq!(cf.resolution, 0.1);
     assert_eq!(cf.origin, ff.origin);
     // A fine cell's centre lies in the coarse cell that covers it.
@@ -233,7 +233,7 @@ fn start_and_goal_in_metres() {
         ..a.clone()
     };
     match outside.load() {
-        Err(InputError::File { path, problem }) => {
+        Err(MapError::File { path, problem }) => {
             assert!(path.ends_with("m.yaml"));
             assert_eq!(
                 problem,

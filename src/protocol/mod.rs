@@ -31,7 +31,7 @@ use core::fmt;
 
 use serde::{Deserialize, Serialize};
 
-use crate::error::{Endpoint, Error};
+use crate::error::{Endpoint, Error, Param};
 use crate::grid::Point;
 use crate::planner::Params;
 
@@ -41,7 +41,7 @@ mod wire;
 
 pub use frame::{cobs_overhead, crc32, wire_len, Feed, FrameReader};
 pub use stream::PathStream;
-use wire::{ParamsDef, PointDef};
+use wire::PointDef;
 pub use wire::{Waypoints, WAYPOINT_BYTES};
 
 /// Protocol version, reported in [`HelloReply::protocol_version`]. Bumped on any change to the
@@ -106,7 +106,7 @@ pub enum Request<'a> {
     },
     /// `2`: the planner parameters for every later [`Request::Plan`], answered with
     /// [`Reply::Ack`] (or [`ErrorCode::BadParam`], and the old parameters stay).
-    SetParams(#[serde(with = "ParamsDef")] Params),
+    SetParams(Params),
     /// `3`: plan a path on the active map with the active parameters, answered with
     /// [`Reply::Path`] or [`Reply::Error`].
     Plan {
@@ -153,7 +153,6 @@ pub struct HelloReply<'a> {
     /// Limits.
     pub capacity: Capacity,
     /// The parameters in force until a [`Request::SetParams`].
-    #[serde(with = "ParamsDef")]
     pub defaults: Params,
 }
 
@@ -234,15 +233,58 @@ impl ErrorReply {
     }
 }
 
+/// The one mapping between the planner's errors and the wire: each [`Error`] is an [`ErrorCode`]
+/// from 1 to 10 with its numbers (`MapTooLarge`: cells and capacity; `BadParam`: the parameter's
+/// [`Param`] index). [`TryFrom<ErrorReply>`](#impl-TryFrom%3CErrorReply%3E-for-Error) is its
+/// inverse.
 impl From<Error> for ErrorReply {
     fn from(e: Error) -> Self {
         match e {
+            Error::BadMap => ErrorReply::new(ErrorCode::BadMap),
             Error::MapTooLarge { cells, capacity } => {
                 ErrorReply::with(ErrorCode::MapTooLarge, cells, capacity)
             }
-            Error::BadParam(p) => ErrorReply::with(ErrorCode::BadParam, p as u32, 0),
-            e => ErrorReply::new(ErrorCode::from(e)),
+            Error::OutOfBounds(Endpoint::Start) => ErrorReply::new(ErrorCode::StartOutOfBounds),
+            Error::OutOfBounds(Endpoint::Goal) => ErrorReply::new(ErrorCode::GoalOutOfBounds),
+            Error::Blocked(Endpoint::Start) => ErrorReply::new(ErrorCode::StartBlocked),
+            Error::Blocked(Endpoint::Goal) => ErrorReply::new(ErrorCode::GoalBlocked),
+            Error::BadParam(p) => ErrorReply::with(ErrorCode::BadParam, p.index(), 0),
+            Error::NoPath => ErrorReply::new(ErrorCode::NoPath),
+            Error::Cancelled => ErrorReply::new(ErrorCode::Cancelled),
+            Error::NoAntArrived => ErrorReply::new(ErrorCode::NoAntArrived),
         }
+    }
+}
+
+/// The planner error a reply stands for (codes 1 to 10), so a host can show the core's own
+/// message; the reply itself back when it is one of the protocol's own codes, or a `BadParam`
+/// whose `detail` names no parameter.
+impl TryFrom<ErrorReply> for Error {
+    type Error = ErrorReply;
+
+    fn try_from(r: ErrorReply) -> Result<Self, ErrorReply> {
+        Ok(match r.code {
+            ErrorCode::BadMap => Error::BadMap,
+            ErrorCode::MapTooLarge => Error::MapTooLarge {
+                cells: r.detail,
+                capacity: r.limit,
+            },
+            ErrorCode::StartOutOfBounds => Error::OutOfBounds(Endpoint::Start),
+            ErrorCode::GoalOutOfBounds => Error::OutOfBounds(Endpoint::Goal),
+            ErrorCode::StartBlocked => Error::Blocked(Endpoint::Start),
+            ErrorCode::GoalBlocked => Error::Blocked(Endpoint::Goal),
+            ErrorCode::BadParam => Error::BadParam(Param::from_index(r.detail).ok_or(r)?),
+            ErrorCode::NoPath => Error::NoPath,
+            ErrorCode::Cancelled => Error::Cancelled,
+            ErrorCode::NoAntArrived => Error::NoAntArrived,
+            ErrorCode::BadCrc
+            | ErrorCode::Undecodable
+            | ErrorCode::TooLarge
+            | ErrorCode::NoMap
+            | ErrorCode::Busy
+            | ErrorCode::BadChunk
+            | ErrorCode::Internal => return Err(r),
+        })
     }
 }
 
@@ -266,8 +308,9 @@ impl fmt::Display for ErrorReply {
     }
 }
 
-/// Error codes on the wire (one byte). 1 to 10 are the planner's [`Error::code`]; 16 and up are
-/// the protocol's own. `detail` / `limit` of the [`ErrorReply`] are given where they mean
+/// Error codes on the wire (one byte). 1 to 10 are the planner's [`Error`]s (mapped by
+/// `From<Error> for ErrorReply` and back by `TryFrom<ErrorReply> for Error`); 16 and up are the
+/// protocol's own. `detail` / `limit` of the [`ErrorReply`] are given where they mean
 /// something.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(into = "u8", try_from = "u8")]
@@ -365,23 +408,6 @@ impl ErrorCode {
             ErrorCode::Busy => "busy: plan queue full",
             ErrorCode::BadChunk => "map chunk out of sequence",
             ErrorCode::Internal => "internal error",
-        }
-    }
-}
-
-impl From<Error> for ErrorCode {
-    fn from(e: Error) -> Self {
-        match e {
-            Error::BadMap => ErrorCode::BadMap,
-            Error::MapTooLarge { .. } => ErrorCode::MapTooLarge,
-            Error::OutOfBounds(Endpoint::Start) => ErrorCode::StartOutOfBounds,
-            Error::OutOfBounds(Endpoint::Goal) => ErrorCode::GoalOutOfBounds,
-            Error::Blocked(Endpoint::Start) => ErrorCode::StartBlocked,
-            Error::Blocked(Endpoint::Goal) => ErrorCode::GoalBlocked,
-            Error::BadParam(_) => ErrorCode::BadParam,
-            Error::NoPath => ErrorCode::NoPath,
-            Error::NoAntArrived => ErrorCode::NoAntArrived,
-            Error::Cancelled => ErrorCode::Cancelled,
         }
     }
 }

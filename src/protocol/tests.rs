@@ -647,27 +647,42 @@ fn reader_drops_oversize_frames_and_recovers() {
 }
 
 #[test]
-fn error_codes_match_the_planner() {
+fn error_codes_map_the_planner_errors_both_ways() {
     use crate::error::Endpoint::{Goal, Start};
+    // Every planner error with the wire code docs/PROTOCOL.md gives it.
     let all = [
-        Error::BadMap,
-        Error::MapTooLarge {
-            cells: 2000,
-            capacity: 1024,
-        },
-        Error::OutOfBounds(Start),
-        Error::OutOfBounds(Goal),
-        Error::Blocked(Start),
-        Error::Blocked(Goal),
-        Error::BadParam(Param::Tau),
-        Error::NoPath,
-        Error::Cancelled,
-        Error::NoAntArrived,
+        (Error::BadMap, 1),
+        (
+            Error::MapTooLarge {
+                cells: 2000,
+                capacity: 1024,
+            },
+            2,
+        ),
+        (Error::OutOfBounds(Start), 3),
+        (Error::OutOfBounds(Goal), 4),
+        (Error::Blocked(Start), 5),
+        (Error::Blocked(Goal), 6),
+        (Error::BadParam(Param::Tau), 7),
+        (Error::NoPath, 8),
+        (Error::Cancelled, 9),
+        (Error::NoAntArrived, 10),
     ];
-    for e in all {
-        assert_eq!(ErrorCode::from(e).code(), e.code(), "{e:?}");
-        assert_eq!(ErrorReply::from(e).code.code(), e.code());
+    for (e, code) in all {
+        let reply = ErrorReply::from(e);
+        assert_eq!(reply.code.code(), code, "{e:?}");
+        assert_eq!(Error::try_from(reply), Ok(e), "{e:?}");
     }
+    for p in Param::ALL {
+        let e = Error::BadParam(p);
+        assert_eq!(Error::try_from(ErrorReply::from(e)), Ok(e));
+    }
+    // The protocol's own codes, and a parameter number out of range, are no planner error.
+    for c in ErrorCode::ALL.into_iter().filter(|c| c.code() >= 16) {
+        assert_eq!(Error::try_from(ErrorReply::new(c)), Err(ErrorReply::new(c)));
+    }
+    let bad = ErrorReply::with(ErrorCode::BadParam, 9, 0);
+    assert_eq!(Error::try_from(bad), Err(bad));
     assert_eq!(
         ErrorReply::from(Error::MapTooLarge {
             cells: 2000,

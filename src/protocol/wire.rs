@@ -1,6 +1,6 @@
-//! Serde glue: the core's types as they go on the wire (remote derives, so the core stays free of
-//! serde and a new field in [`Params`] fails to compile here instead of silently not being sent),
-//! and the packed waypoint list.
+//! Serde glue: [`Point`] as it goes on the wire (a remote derive, the grid stays free of serde)
+//! and the packed waypoint list. The parameters need none: [`crate::Params`] and its enums derive
+//! serde themselves (feature `serde`), so a new parameter is sent without a line here.
 
 use core::fmt;
 
@@ -8,10 +8,7 @@ use serde::de::{Deserializer, Error as _};
 use serde::ser::{SerializeSeq, Serializer};
 use serde::{Deserialize, Serialize};
 
-use crate::colony::DeadEnd;
 use crate::grid::Point;
-use crate::planner::{Algorithm, Params};
-use crate::smoothing::SmoothingKind;
 
 /// [`Point`]: `x`, `y` as varints.
 #[derive(Serialize, Deserialize)]
@@ -19,59 +16,6 @@ use crate::smoothing::SmoothingKind;
 pub(crate) struct PointDef {
     x: u16,
     y: u16,
-}
-
-/// [`Algorithm`]: variant index `0 aca, 1 paca, 2 haca, 3 ohaca`.
-#[derive(Serialize, Deserialize)]
-#[serde(remote = "Algorithm")]
-pub(crate) enum AlgorithmDef {
-    Aca,
-    Paca,
-    Haca,
-    Ohaca,
-}
-
-/// [`DeadEnd`]: `0 backtrack, 1 die`.
-#[derive(Serialize, Deserialize)]
-#[serde(remote = "DeadEnd")]
-pub(crate) enum DeadEndDef {
-    Backtrack,
-    Die,
-}
-
-/// [`SmoothingKind`]: `0 none, 1 greedy, 2 shortest`.
-#[derive(Serialize, Deserialize)]
-#[serde(remote = "SmoothingKind")]
-pub(crate) enum SmoothingDef {
-    None,
-    Greedy,
-    Shortest,
-}
-
-/// [`Params`], field by field in declaration order.
-#[derive(Serialize, Deserialize)]
-#[serde(remote = "Params")]
-pub(crate) struct ParamsDef {
-    #[serde(with = "AlgorithmDef")]
-    algorithm: Algorithm,
-    ants: u16,
-    iterations: u16,
-    alpha: f32,
-    beta: f32,
-    rho: f32,
-    q: f32,
-    a: f32,
-    xi: f32,
-    tau0: f32,
-    tau_min: f32,
-    tau_max: f32,
-    patience: u16,
-    seed: u64,
-    #[serde(with = "DeadEndDef")]
-    dead_end: DeadEnd,
-    #[serde(with = "SmoothingDef")]
-    smoothing: SmoothingKind,
-    tighten: bool,
 }
 
 /// Bytes per waypoint on the wire: `x` then `y`, each a little-endian `u16`.

@@ -65,7 +65,7 @@ pub fn run(args: &Args) -> u8 {
         layers.push(Layer::from_report(
             algorithm,
             &t.report,
-            sc.frame.map(|f| f.resolution),
+            sc.metric.map(|f| f.resolution),
         ));
     }
     let scene = scene(&sc, &base, &algorithms, layers, pheromone);
@@ -87,7 +87,7 @@ fn scene(
     pheromone: Option<Vec<f32>>,
 ) -> Scene {
     let names: Vec<String> = algorithms.iter().map(|&a| draw::display_name(a)).collect();
-    let size = match sc.frame {
+    let size = match sc.metric {
         Some(f) => format!(
             "{}x{} cells of {} m",
             sc.map.width, sc.map.height, f.resolution
@@ -114,6 +114,6 @@ fn scene(
             .first()
             .map(|&a| format!("of {}, after its last iteration", draw::display_name(a)))
             .unwrap_or_default(),
-        frame: sc.frame,
+        metric: sc.metric,
     }
 }

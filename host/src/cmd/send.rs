@@ -5,9 +5,11 @@
 //! name). `elapsed_us` is the round trip of the plan request as the host saw it.
 //!
 //! The map flags are `plan`'s (`--unknown`, `--inflate`, `--cell`, `--start-m`, `--goal-m`). A
-//! map larger than the device holds is resampled to the smallest whole number of cells per
-//! coarse cell that fits (a coarse cell is blocked if any cell it covers is), unless `--cell`
-//! was given; a note on stderr says so, and start, goal and output are cells of the coarse grid.
+//! map goes at full resolution whenever it fits the capacity the device reports in Hello (its
+//! cells, and its widest and tallest map); only a larger one is resampled, to the smallest whole
+//! number of cells per coarse cell that fits (a coarse cell is blocked if any cell it covers is;
+//! [`ohaca_host::map::fit`]), unless `--cell` was given; a note on stderr says so, with the new
+//! cell size for maps with a resolution, and start, goal and output are cells of the coarse grid.
 //!
 //! `--goals FILE` plans many requests over one connection, pipelined, and prints one JSON line
 //! per request, in file order. Each line of the file is `SX,SY GX,GY` (start and goal) or
@@ -23,15 +25,10 @@ use std::time::{Duration, Instant};
 
 use ohaca::protocol::{ErrorCode, ErrorReply};
 use ohaca::{Error, Params, Point};
-use ohaca_host::frame::Frame;
-use ohaca_host::gridops::{resample, resample_frame};
-use ohaca_host::input::{prepare_map, resolve_point, MapArgs};
-use ohaca_host::link::{
-    core_error, DeviceInfo, DevicePath, Link, LinkError, PlanJob, Transport, DEFAULT_BAUD,
-};
-use ohaca_host::output::{
-    format_us, micros, render, waypoints_csv, xy, LocatedReport, ParamsReport, PlanReport,
-};
+use ohaca_host::input::{resolve_point, MapArgs};
+use ohaca_host::link::{DeviceInfo, DevicePath, Link, LinkError, PlanJob, Transport, DEFAULT_BAUD};
+use ohaca_host::map::{fit, fits, prepare, MapFrame};
+use ohaca_host::output::{format_us, micros, render, waypoints_csv, xy, LocatedReport, PlanReport};
 use ohaca_host::{exit, parse_point, Map, ParamArgs};
 use serde::Serialize;
 
@@ -111,21 +108,21 @@ impl SendReport<'_> {
 
 /// Run `ohaca send`; returns the exit code.
 pub fn run(args: &Args) -> u8 {
-    match Session::prepare(args).and_then(|mut s| s.run(args)) {
+    match Sender::prepare(args).and_then(|mut s| s.run(args)) {
         Ok(code) => code,
         Err(msg) => bad_input(msg),
     }
 }
 
 /// The connected state of one `send`.
-struct Session {
+struct Sender {
     /// `--tcp` or `--serial`, for messages.
     target: String,
     /// The map file as given, for messages.
     name: String,
     map: Map,
     /// Where the map's cells are in metres (ROS maps).
-    frame: Option<Frame>,
+    metric: Option<MapFrame>,
     params: Params,
     jobs: Vec<PlanJob>,
     /// What to print.
@@ -188,34 +185,9 @@ fn too_large(map_path: &Path, map: &Map, info: &DeviceInfo) -> String {
     )
 }
 
-/// The smallest whole number of cells per coarse cell (side) that makes `map` fit the device,
-/// with the coarse map; `None` if even a single coarse cell would not (a 0-cell device).
-fn fit_factor(map: &Map, frame: Option<Frame>, info: &DeviceInfo) -> Option<(u16, Map)> {
-    let c = &info.capacity;
-    let fits = |m: &Map| {
-        m.cells() <= c.cells as usize && m.width <= c.max_width && m.height <= c.max_height
-    };
-    (2..=map.width.max(map.height)).find_map(|k| {
-        let coarse = resample(map, f64::from(k), frame.is_some()).ok()?;
-        fits(&coarse).then_some((k, coarse))
-    })
-}
-
-/// Where cell `p` of a fine grid lies in its resampled grid (factor `k`): through the metric
-/// frames when the map has one (the coarse grid is anchored at the lower-left corner), else by
-/// division (anchored at the top-left).
-fn coarse_cell(p: Point, k: u16, fine: Option<Frame>, coarse: Option<Frame>) -> Point {
-    match (fine, coarse) {
-        (Some(f), Some(c)) => c
-            .cell(f.to_metres(p))
-            .unwrap_or(Point::new(p.x / k, p.y / k)),
-        _ => Point::new(p.x / k, p.y / k),
-    }
-}
-
-impl Session {
+impl Sender {
     /// Everything that can be checked before connecting.
-    fn prepare(args: &Args) -> Result<Session, String> {
+    fn prepare(args: &Args) -> Result<Sender, String> {
         let format = match (args.json, args.format, args.goals.is_some()) {
             (true, None | Some(Format::Json), _) => Format::Json,
             (true, Some(f), _) => {
@@ -232,19 +204,19 @@ impl Session {
         };
         let a = &args.input;
         let name = a.map.display().to_string();
-        let (map, frame) =
-            prepare_map(&a.map, a.unknown, a.inflate, a.cell).map_err(|e| e.to_string())?;
+        let (map, metric) =
+            prepare(&a.map, a.unknown, a.inflate, a.cell).map_err(|e| e.to_string())?;
         let params = args.params.params();
         params.validate().map_err(|e| e.to_string())?;
         let start = match (a.start, a.start_m) {
             (None, None) => None,
-            (s, m) => Some(resolve_point(&name, frame, "start", s, m).map_err(|e| e.to_string())?),
+            (s, m) => Some(resolve_point(&name, metric, "start", s, m).map_err(|e| e.to_string())?),
         };
         let jobs = match (&args.goals, start) {
             (Some(file), start) => load_goals(file, start)?,
             (None, Some(start)) => vec![PlanJob {
                 start,
-                goal: resolve_point(&name, frame, "goal", a.goal, a.goal_m)
+                goal: resolve_point(&name, metric, "goal", a.goal, a.goal_m)
                     .map_err(|e| e.to_string())?,
                 seed: None,
             }],
@@ -255,11 +227,11 @@ impl Session {
             }
         };
         let target = args.tcp.as_deref().or(args.serial.as_deref()).unwrap_or("");
-        Ok(Session {
+        Ok(Sender {
             target: target.to_string(),
             name,
             map,
-            frame,
+            metric,
             params,
             jobs,
             format,
@@ -267,52 +239,35 @@ impl Session {
     }
 
     /// Resample the map to fit the device if it is too large and `--cell` was not given (the
-    /// jobs' cells follow); with `--cell`, a map that does not fit is an error.
+    /// jobs' cells follow); with `--cell`, a map that does not fit is an error. A map that fits
+    /// (cells and sides) goes at full resolution.
     fn fit(&mut self, args: &Args, info: &DeviceInfo) -> Result<(), String> {
         let c = &info.capacity;
-        if self.map.cells() <= c.cells as usize
-            && self.map.width <= c.max_width
-            && self.map.height <= c.max_height
-        {
+        if fits(&self.map, c) {
             return Ok(());
         }
         if args.input.cell.is_some() {
             return Err(too_large(&args.input.map, &self.map, info));
         }
-        let Some((k, coarse)) = fit_factor(&self.map, self.frame, info) else {
+        let Some(fitted) = fit(&self.map, self.metric, c) else {
             return Err(too_large(&args.input.map, &self.map, info));
         };
-        let frame = self
-            .frame
-            .map(|f| resample_frame(&f, &coarse, f64::from(k)));
-        let size = self.frame.map_or_else(String::new, |f| {
-            format!(" ({} m)", f.resolution * f64::from(k))
-        });
         eprintln!(
-            "note: {}: {}x{} cells do not fit {} ({} cells, at most {}x{}); resampled to {}x{}, \
-             {k}x{k} cells per cell{size}; start, goal and output are cells of the coarse grid",
-            self.name,
-            self.map.width,
-            self.map.height,
-            info.board,
-            c.cells,
-            c.max_width,
-            c.max_height,
-            coarse.width,
-            coarse.height
+            "note: {}",
+            fitted.note(&self.name, &self.map, &info.board, c)
         );
         for job in &mut self.jobs {
-            job.start = coarse_cell(job.start, k, self.frame, frame);
-            job.goal = coarse_cell(job.goal, k, self.frame, frame);
+            job.start = fitted.cell(job.start);
+            job.goal = fitted.cell(job.goal);
         }
-        self.map = coarse;
-        self.frame = frame;
+        self.map = fitted.map;
+        self.metric = fitted.metric;
         Ok(())
     }
 
     /// The waypoints in metres (rounded to a micrometre), for maps with a resolution.
     fn metres(&self, waypoints: &[[u16; 2]]) -> Option<Vec<[f64; 2]>> {
-        self.frame.map(|f| f.points_m(waypoints))
+        self.metric.map(|f| f.points_m(waypoints))
     }
 
     /// One `send --json` line: the report with `waypoints_m` (maps with a resolution), `ticks`
@@ -487,7 +442,7 @@ impl Session {
         let path = match result {
             Ok(p) => p,
             Err(e) => {
-                return match core_error(&e) {
+                return match Error::try_from(e).ok() {
                     Some(err @ Error::NoPath) => Outcome::found(
                         PlanReport::not_found(&params, err, Some(0), round_trip),
                         None,
@@ -536,7 +491,7 @@ impl Session {
             best_iteration: Some(path.best_iteration),
             moves: Some(path.moves),
             elapsed_us: micros(round_trip),
-            params: ParamsReport::from(&params),
+            params,
             error: None,
         };
         Outcome::found(report, Some(path.ticks))
@@ -573,76 +528,6 @@ mod tests {
         assert!(parse_goal_line("7,8", None).is_err());
         assert!(parse_goal_line("1,2 3,4 5,6", None).is_err());
         assert!(parse_goal_line("1;2 3,4", None).is_err());
-    }
-
-    fn device(cells: u32) -> DeviceInfo {
-        DeviceInfo {
-            protocol_version: ohaca::protocol::VERSION,
-            firmware_version: "0".into(),
-            board: "test".into(),
-            capacity: ohaca::protocol::Capacity {
-                cells,
-                max_width: cells as u16,
-                max_height: cells as u16,
-                max_chunk: 128,
-                max_request: 256,
-                plan_queue: 4,
-                tick_hz: 1_000_000,
-            },
-            defaults: Params::default(),
-        }
-    }
-
-    #[test]
-    fn large_maps_are_resampled_by_the_smallest_factor_that_fits() {
-        // 100x75 into 1024 cells: 2 gives 50x38 = 1900, 3 gives 34x25 = 850.
-        let map = Map::from_fn(100, 75, |x, y| x == 50 && y == 10);
-        let (k, coarse) = fit_factor(&map, None, &device(1024)).unwrap();
-        assert_eq!((k, coarse.width, coarse.height), (3, 34, 25));
-        // The blocked cell (50,10) is in coarse cell (16,3).
-        assert!(coarse.is_blocked(Point::new(16, 3)));
-        let blocked = (0..coarse.height)
-            .flat_map(|y| (0..coarse.width).map(move |x| Point::new(x, y)))
-            .filter(|&p| coarse.is_blocked(p))
-            .count();
-        assert_eq!(blocked, 1);
-        assert_eq!(
-            coarse_cell(Point::new(50, 10), k, None, None),
-            Point::new(16, 3)
-        );
-        // A device without cells cannot take any map.
-        assert!(fit_factor(&map, None, &device(0)).is_none());
-    }
-
-    #[test]
-    fn resampled_cells_follow_the_metric_frame() {
-        // 10x9 cells of 0.1 m, origin (-1, -2): the coarse grid (factor 2) is anchored at the
-        // lower-left corner, so rows shift when the height is odd.
-        let fine = Frame {
-            resolution: 0.1,
-            origin: [-1.0, -2.0],
-            yaw: 0.0,
-            width: 10,
-            height: 9,
-        };
-        let map = Map::from_fn(10, 9, |_, _| false);
-        let coarse_map = resample(&map, 2.0, true).unwrap();
-        assert_eq!((coarse_map.width, coarse_map.height), (5, 5));
-        let coarse = resample_frame(&fine, &coarse_map, 2.0);
-        // Bottom-left fine cell (0,8) -> bottom-left coarse cell (0,4); top row 0 -> coarse 0.
-        let c = |x, y| coarse_cell(Point::new(x, y), 2, Some(fine), Some(coarse));
-        assert_eq!(c(0, 8), Point::new(0, 4));
-        assert_eq!(c(9, 0), Point::new(4, 0));
-        // Fine row 7 is row 1 from the bottom: coarse row 0 from the bottom, i.e. row 4.
-        assert_eq!(c(3, 7), Point::new(1, 4));
-        assert_eq!(c(3, 6), Point::new(1, 3));
-        // Every fine cell's centre lies in the coarse cell it is mapped to.
-        for y in 0..9 {
-            for x in 0..10 {
-                let m = fine.to_metres(Point::new(x, y));
-                assert_eq!(coarse.cell(m), Some(c(x, y)));
-            }
-        }
     }
 
     #[test]

@@ -13,12 +13,12 @@ use core::cell::{Cell, RefCell};
 use cortex_m::peripheral::syst::SystClkSource;
 use cortex_m::peripheral::{SCB, SYST};
 use cortex_m_rt::exception;
+use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex as Raw;
 use embassy_sync::blocking_mutex::Mutex;
 use embassy_time_driver::Driver;
 use embassy_time_queue_utils::Queue;
 
 use super::SYSCLK_HZ;
-use crate::firmware::state::Raw;
 
 const CYCLES_PER_TICK: u32 = SYSCLK_HZ / 1_000_000;
 const TICKS_PER_PERIOD: u64 = 1000;

@@ -14,10 +14,10 @@ use core::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 use cortex_m::interrupt::InterruptNumber;
 use cortex_m::peripheral::NVIC;
 use embassy_futures::yield_now;
+use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex as Raw;
 use embassy_sync::pipe::Pipe;
 
 use super::SYSCLK_HZ;
-use crate::firmware::state::Raw;
 
 const BASE: usize = 0x4000_4000;
 const DATA: usize = 0x00;

@@ -24,7 +24,7 @@ use ohaca::protocol::{
     MAX_REQUEST, MAX_REQUEST_WIRE, UNKNOWN_ID,
 };
 use ohaca::Point;
-use ohaca_host::link::{core_error, request_name, LinkError, Response};
+use ohaca_host::link::{request_name, LinkError, Response};
 
 /// What a reader should report for one delimiter, per the reference splitter.
 #[derive(Debug, PartialEq, Eq)]
@@ -228,7 +228,7 @@ fn check_reply_frame(frame: &mut [u8], piece: usize) -> bool {
                 }
                 (Reply::Error(e), _) => {
                     let _ = format!("{e}");
-                    if let Some(core) = core_error(e) {
+                    if let Ok(core) = ohaca::Error::try_from(*e) {
                         assert_eq!(ErrorReply::from(core).code, e.code);
                     }
                 }
@@ -328,7 +328,7 @@ pub fn check_streams(data: &[u8]) -> (usize, usize) {
 }
 
 /// The `frame` fuzz target.
-pub fn fuzz_frame(data: &[u8]) {
+pub fn fuzz_wire_frame(data: &[u8]) {
     check_streams(data);
 }
 
@@ -341,7 +341,7 @@ mod tests {
         let mut buf = [0u8; MAX_REQUEST_WIRE];
         let n = encode_request(9, &Request::Stats, &mut buf).unwrap();
         assert!(reference_unframe(&buf[..n - 1]).is_ok());
-        fuzz_frame(&buf[..n]);
+        fuzz_wire_frame(&buf[..n]);
     }
 
     #[test]

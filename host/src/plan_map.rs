@@ -11,7 +11,7 @@ use ohaca::{Error, Params, Point, Run};
 
 use crate::map::Map;
 use crate::output::PlanReport;
-use crate::storage::{HeapStorage, StorageError};
+use ohaca::heap::{AllocError, HeapStorage};
 
 /// Why a request could not be planned at all (as opposed to "no path").
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
@@ -21,7 +21,7 @@ pub enum PlanError {
     Core(Error),
     /// The planner's buffers could not be allocated.
     #[error(transparent)]
-    Storage(#[from] StorageError),
+    Storage(#[from] AllocError),
 }
 
 impl From<Error> for PlanError {

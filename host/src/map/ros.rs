@@ -1,5 +1,4 @@
-//! Real robot maps: ROS `map_server` maps (a YAML file and its PGM or PNG image) and plain
-//! black-and-white images.
+//! Real robot maps: ROS `map_server` maps, a YAML file and its PGM or PNG image.
 //!
 //! ## ROS `map_server` YAML
 //! ```yaml
@@ -21,21 +20,17 @@
 //! 0 occupied, 205 unknown) is read as intended.
 //!
 //! Image row 0 is the **top** of the map (the planner's `y = 0`), while ROS's origin is the
-//! **lower-left** pixel: [`crate::frame::Frame`] does that flip.
-//!
-//! ## Plain images
-//! A PNG or PGM given directly as the map (no YAML): a pixel is blocked when it is darker than
-//! 50 % (mean of R, G, B below 127.5; a transparent pixel counts as white). Such a map has no
-//! resolution: positions are cells.
+//! **lower-left** pixel: [`MapFrame`] does that flip.
 
 use std::path::{Path, PathBuf};
 
 use image::RgbaImage;
 use serde_norway::Value;
 
-use crate::frame::Frame;
-use crate::input::InputError;
-use crate::map::{Map, MAX_SIDE};
+use super::bitmap::Map;
+use super::error::MapError;
+use super::image::{grey, read_image, sides};
+use super::metric::MapFrame;
 
 /// What to do with cells whose occupancy is between the thresholds (ROS's "unknown", usually the
 /// unexplored area).
@@ -238,61 +233,11 @@ impl RosMeta {
     }
 }
 
-/// Mean of R, G and B.
-fn grey(px: &image::Rgba<u8>) -> f64 {
-    let [r, g, b, _] = px.0;
-    (f64::from(r) + f64::from(g) + f64::from(b)) / 3.0
-}
-
-/// Read an image file as RGBA (grey images are replicated into R, G, B).
-pub fn read_image(path: &Path) -> Result<RgbaImage, InputError> {
-    let name = path.display().to_string();
-    let err = |problem: String| InputError::File {
-        path: name.clone(),
-        problem,
-    };
-    let bytes = std::fs::read(path).map_err(|e| err(format!("cannot read the image: {e}")))?;
-    decode_image(&bytes, &name)
-}
-
-/// Decode the bytes of a PNG or PGM image as RGBA, as [`read_image`] does for a file; `name`
-/// stands for the file in errors.
-pub fn decode_image(bytes: &[u8], name: &str) -> Result<RgbaImage, InputError> {
-    let err = |problem: String| InputError::File {
-        path: name.to_string(),
-        problem,
-    };
-    let format = image::guess_format(bytes)
-        .map_err(|_| err("not a PNG or PGM image (unknown file signature)".to_string()))?;
-    let img = image::load_from_memory_with_format(bytes, format)
-        .map_err(|e| err(format!("cannot decode the image: {e}")))?;
-    let (w, h) = (img.width(), img.height());
-    if w == 0 || h == 0 {
-        return Err(err("the image is empty".to_string()));
-    }
-    let too_big = |side: &str, v: u32| err(format!("image {side} {v} is more than {MAX_SIDE}"));
-    if usize::try_from(w).map_or(true, |w| w > MAX_SIDE) {
-        return Err(too_big("width", w));
-    }
-    if usize::try_from(h).map_or(true, |h| h > MAX_SIDE) {
-        return Err(too_big("height", h));
-    }
-    Ok(img.to_rgba8())
-}
-
-/// Image sides as `u16` (checked by [`decode_image`]; larger sides clamp to `u16::MAX`).
-fn sides(img: &RgbaImage) -> (u16, u16) {
-    (
-        u16::try_from(img.width()).unwrap_or(u16::MAX),
-        u16::try_from(img.height()).unwrap_or(u16::MAX),
-    )
-}
-
 /// Load a ROS `map_server` map: the YAML file at `yaml` and the image it names. Unknown cells
 /// follow `unknown`.
-pub fn load_ros(yaml: &Path, unknown: Unknown) -> Result<(Map, Frame), InputError> {
+pub fn load_ros(yaml: &Path, unknown: Unknown) -> Result<(Map, MapFrame), MapError> {
     let name = yaml.display().to_string();
-    let err = |problem: String| InputError::File {
+    let err = |problem: String| MapError::File {
         path: name.clone(),
         problem,
     };
@@ -309,9 +254,9 @@ pub fn load_ros(yaml: &Path, unknown: Unknown) -> Result<(Map, Frame), InputErro
     Ok(ros_map(&meta, &img, unknown))
 }
 
-/// The map and frame of a ROS `map_server` map from its parsed YAML and its decoded image (what
+/// The map and metric frame of a ROS `map_server` map from its parsed YAML and its decoded image (what
 /// [`load_ros`] does once the files are read). Unknown cells follow `unknown`.
-pub fn ros_map(meta: &RosMeta, img: &RgbaImage, unknown: Unknown) -> (Map, Frame) {
+pub fn ros_map(meta: &RosMeta, img: &RgbaImage, unknown: Unknown) -> (Map, MapFrame) {
     let (w, h) = sides(img);
     let map = Map::from_fn(w, h, |x, y| {
         let px = img.get_pixel(u32::from(x), u32::from(y));
@@ -321,35 +266,19 @@ pub fn ros_map(meta: &RosMeta, img: &RgbaImage, unknown: Unknown) -> (Map, Frame
             Occupancy::Unknown => unknown == Unknown::Blocked,
         }
     });
-    let frame = Frame {
+    let metric = MapFrame {
         resolution: meta.resolution,
         origin: [meta.origin[0], meta.origin[1]],
         yaw: meta.origin[2],
         width: w,
         height: h,
     };
-    (map, frame)
-}
-
-/// Load a plain image as a map: darker than 50 % is blocked (transparent counts as white).
-pub fn load_image(path: &Path) -> Result<Map, InputError> {
-    read_image(path).map(|img| image_map(&img))
-}
-
-/// A decoded plain image as a map: darker than 50 % is blocked (transparent counts as white).
-pub fn image_map(img: &RgbaImage) -> Map {
-    let (w, h) = sides(img);
-    Map::from_fn(w, h, |x, y| {
-        let px = img.get_pixel(u32::from(x), u32::from(y));
-        // Composite over white: value * a + 255 * (1 - a).
-        let a = f64::from(px.0[3]) / 255.0;
-        let v = grey(px) * a + 255.0 * (1.0 - a);
-        v < 127.5
-    })
+    (map, metric)
 }
 
 #[cfg(test)]
 mod tests {
+    use super::super::image::decode_image;
     use super::*;
 
     fn meta(text: &str) -> Result<RosMeta, String> {
@@ -444,15 +373,10 @@ mod tests {
     fn from_memory_matches_the_files() {
         // The in-memory steps (used by fuzz/src/maps.rs) give what the file loaders give.
         let yaml = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/ros/lab.yaml");
-        let (map, frame) = load_ros(&yaml, Unknown::Free).unwrap();
+        let (map, metric) = load_ros(&yaml, Unknown::Free).unwrap();
         let meta = RosMeta::parse(&std::fs::read_to_string(&yaml).unwrap(), &yaml).unwrap();
         let img = decode_image(&std::fs::read(&meta.image).unwrap(), "lab.pgm").unwrap();
-        assert_eq!(ros_map(&meta, &img, Unknown::Free), (map, frame));
-        assert_eq!(image_map(&img), load_image(&meta.image).unwrap());
-        let e = decode_image(b"P5\n2 2\n255\n", "short.pgm").unwrap_err();
-        assert!(e.to_string().starts_with("short.pgm: cannot decode"), "{e}");
-        let e = decode_image(b"no image", "x.png").unwrap_err();
-        assert!(e.to_string().contains("unknown file signature"), "{e}");
+        assert_eq!(ros_map(&meta, &img, Unknown::Free), (map, metric));
     }
 
     #[test]

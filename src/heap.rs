@@ -1,23 +1,21 @@
-//! Planner storage on the heap.
+//! Planner storage on the heap (feature `alloc`), for hosts: the same buffers as
+//! [`crate::Storage`], but as `Vec`s sized at run time instead of a compile-time capacity (a
+//! `Storage` for a 512x512 map would be 14 MiB on the stack).
 //!
-//! The core never allocates: a run borrows every buffer through an [`ohaca::Workspace`]. On the
-//! device those buffers are a fixed-size `static` [`ohaca::Storage`]; on the host a `Storage` for
-//! a 512x512 map would be 14 MiB on the stack. [`HeapStorage`] owns the same buffers as `Vec`s
-//! sized at run time and lends them with [`ohaca::Workspace::from_slices`]. It can be reused for
-//! many runs (and grows on demand with [`HeapStorage::ensure`]), which the experiment and bench
-//! commands rely on.
-//!
-//! Allocation uses `try_reserve`, so a map too large for the machine's memory is an error, not an
-//! abort.
+//! [`HeapStorage`] owns the buffers and lends them to a run with [`Workspace::from_slices`]; it
+//! is only that wrapper, so it follows whatever buffers the workspace takes. It can be reused for
+//! many runs and grows on demand ([`HeapStorage::ensure`], never shrinking). Allocation uses
+//! `try_reserve`, so a map too large for the machine's memory is an [`AllocError`], not an abort.
 
-use std::collections::TryReserveError;
+use alloc::collections::TryReserveError;
+use alloc::vec::Vec;
+use core::fmt;
 
-use ohaca::grid::Dir;
-use ohaca::planner::CurvePoint;
-use ohaca::{Point, Workspace};
+use crate::grid::{Dir, Point};
+use crate::planner::{CurvePoint, Params, Workspace};
 
 /// The planner's buffers, on the heap. See the module docs.
-#[derive(Debug, Default)]
+#[derive(Clone, Debug, Default)]
 pub struct HeapStorage {
     tau: Vec<[f32; 4]>,
     delta: Vec<[f32; 4]>,
@@ -30,11 +28,8 @@ pub struct HeapStorage {
 }
 
 /// The buffers could not be allocated.
-#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[error(
-    "cannot allocate planner storage for {cells} cells and {iterations} iterations ({bytes} bytes)"
-)]
-pub struct StorageError {
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct AllocError {
     /// Cells asked for.
     pub cells: usize,
     /// Curve entries asked for.
@@ -43,10 +38,22 @@ pub struct StorageError {
     pub bytes: usize,
 }
 
+impl fmt::Display for AllocError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "cannot allocate planner storage for {} cells and {} iterations ({} bytes)",
+            self.cells, self.iterations, self.bytes
+        )
+    }
+}
+
+impl core::error::Error for AllocError {}
+
 /// Grow `v` to `n` entries of `fill`, failing instead of aborting when memory is short.
 fn grow<T: Clone>(v: &mut Vec<T>, n: usize, fill: T) -> Result<(), TryReserveError> {
-    if v.len() < n {
-        v.try_reserve_exact(n - v.len())?;
+    if let Some(more) = n.checked_sub(v.len()) {
+        v.try_reserve_exact(more)?;
         v.resize(n, fill);
     }
     Ok(())
@@ -54,7 +61,7 @@ fn grow<T: Clone>(v: &mut Vec<T>, n: usize, fill: T) -> Result<(), TryReserveErr
 
 impl HeapStorage {
     /// Storage for maps of up to `cells` cells and convergence curves of `iterations` entries.
-    pub fn new(cells: usize, iterations: usize) -> Result<Self, StorageError> {
+    pub fn new(cells: usize, iterations: usize) -> Result<Self, AllocError> {
         let mut s = HeapStorage::default();
         s.ensure(cells, iterations)?;
         Ok(s)
@@ -62,7 +69,7 @@ impl HeapStorage {
 
     /// Storage for one run on a map of `cells` cells with `params` (the curve holds every
     /// iteration).
-    pub fn for_run(cells: usize, params: &ohaca::Params) -> Result<Self, StorageError> {
+    pub fn for_run(cells: usize, params: &Params) -> Result<Self, AllocError> {
         HeapStorage::new(cells, usize::from(params.iterations))
     }
 
@@ -75,8 +82,8 @@ impl HeapStorage {
 
     /// Grow the buffers (never shrink) to hold at least `cells` cells and `iterations` curve
     /// entries.
-    pub fn ensure(&mut self, cells: usize, iterations: usize) -> Result<(), StorageError> {
-        let err = |_| StorageError {
+    pub fn ensure(&mut self, cells: usize, iterations: usize) -> Result<(), AllocError> {
+        let err = |_| AllocError {
             cells,
             iterations,
             bytes: HeapStorage::bytes_for(cells, iterations),
@@ -99,9 +106,39 @@ impl HeapStorage {
         self.tau.len()
     }
 
-    /// Curve entries (iterations recorded by [`ohaca::Plan::curve`]).
+    /// Curve entries (iterations recorded by [`crate::Plan::curve`]).
     pub fn curve_len(&self) -> usize {
         self.curve.len()
+    }
+
+    /// Fill every buffer with arbitrary values derived from `salt` (xorshift32), so a test can
+    /// check that a plan does not depend on what the storage held before.
+    pub fn scramble(&mut self, salt: u32) {
+        let mut x = salt.wrapping_mul(0x9E37_79B9) | 1;
+        let mut next = move || {
+            x ^= x << 13;
+            x ^= x >> 17;
+            x ^= x << 5;
+            x
+        };
+        // Pheromone-like values in [0, 143): whole numbers / 7.
+        for t in self.tau.iter_mut().chain(self.delta.iter_mut()) {
+            *t = core::array::from_fn(|_| (next() % 1000) as f32 / 7.0);
+        }
+        for b in self
+            .visited
+            .iter_mut()
+            .chain(self.moves.iter_mut())
+            .chain(self.tours.iter_mut().flatten())
+        {
+            *b = next() as u8;
+        }
+        for p in &mut self.points {
+            *p = Point::new(next() as u16, next() as u16);
+        }
+        for p in &mut self.prev {
+            *p = next();
+        }
     }
 
     /// Borrow the buffers as a workspace for one run.
@@ -134,11 +171,14 @@ mod tests {
         assert_eq!((s.cells(), s.curve_len()), (100, 10), "never shrinks");
         s.ensure(512 * 512, 100).unwrap();
         assert_eq!(s.workspace().capacity(), 512 * 512);
+        s.scramble(3);
+        assert_eq!(s.workspace().capacity(), 512 * 512);
     }
 
     #[test]
     fn impossible_size_is_an_error() {
         let e = HeapStorage::new(usize::MAX / 2, 1).unwrap_err();
         assert_eq!(e.bytes, usize::MAX);
+        assert!(e.to_string().starts_with("cannot allocate planner storage"));
     }
 }

@@ -1,4 +1,4 @@
-//! Map files: Moving AI `.map` files and plain text grids, loaded into an owned [`Map`].
+//! The two text formats: Moving AI `.map` files and plain text grids, parsed into a [`Map`].
 //!
 //! Two formats, detected by content (a first line `type ...` means Moving AI) or else by the
 //! file extension (`.map` means Moving AI, anything else a text grid):
@@ -20,28 +20,10 @@
 //! Nothing is allocated from header values alone: the rows are checked against the header before
 //! the bit buffer is built, so a small file claiming a huge map fails cleanly.
 
-use std::fmt::Write as _;
 use std::path::Path;
 
-use ohaca::{Grid, Point};
-
-/// The largest side a map may have (the core addresses cells with `u16` coordinates).
-pub const MAX_SIDE: usize = u16::MAX as usize;
-
-/// An owned occupancy map in the core's layout: `width x height` cells, row-major, one bit per
-/// cell, least significant bit first, `1` = blocked (see [`ohaca::grid`]).
-///
-/// The fields are public so a map can be built from any source; [`Map::grid`] checks that they
-/// agree.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct Map {
-    /// Columns.
-    pub width: u16,
-    /// Rows.
-    pub height: u16,
-    /// `ceil(width * height / 8)` bytes of cell bits.
-    pub bits: Vec<u8>,
-}
+use super::bitmap::{Map, MAX_SIDE};
+use super::error::{MapError, Problem};
 
 /// The two map file formats. See the module docs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -72,123 +54,9 @@ impl Format {
     }
 }
 
-/// Why a map could not be loaded. `Display` is one line: file, line number, problem.
-#[derive(Debug, thiserror::Error)]
-pub enum MapError {
-    /// The file could not be read (missing, a directory, no permission, ...).
-    #[error("{path}: cannot read the file: {source}")]
-    Unreadable {
-        /// The file as given.
-        path: String,
-        /// What the operating system said.
-        #[source]
-        source: std::io::Error,
-    },
-    /// The file was read but its content is not a valid map.
-    #[error("{path}, line {line}: {problem}")]
-    Parse {
-        /// The file as given (or the name passed to [`Map::parse`]).
-        path: String,
-        /// 1-based line number the problem was found on.
-        line: usize,
-        /// What is wrong.
-        problem: Problem,
-    },
-}
-
-impl MapError {
-    /// The parse problem, if the file was readable.
-    pub fn problem(&self) -> Option<&Problem> {
-        match self {
-            MapError::Parse { problem, .. } => Some(problem),
-            MapError::Unreadable { .. } => None,
-        }
-    }
-
-    /// The 1-based line number of a parse problem.
-    pub fn line(&self) -> Option<usize> {
-        match self {
-            MapError::Parse { line, .. } => Some(*line),
-            MapError::Unreadable { .. } => None,
-        }
-    }
-}
-
-/// What is wrong with a map's content.
-#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
-pub enum Problem {
-    /// A Moving AI header line is not what it should be.
-    #[error("wrong header: expected `{expected}`, found `{found}`")]
-    WrongHeader {
-        /// The line that was expected, e.g. `type octile` or `height <rows>`.
-        expected: &'static str,
-        /// The line found (trimmed).
-        found: String,
-    },
-    /// The file ends inside the Moving AI header.
-    #[error("truncated map: the file ends before the header line `{expected}`")]
-    TruncatedHeader {
-        /// The header line that is missing.
-        expected: &'static str,
-    },
-    /// The file ends before the header's number of rows.
-    #[error("truncated map: expected {expected} rows, found {found}")]
-    TruncatedRows {
-        /// Rows the header announced.
-        expected: usize,
-        /// Rows present.
-        found: usize,
-    },
-    /// A row has a different number of cells than the width (Moving AI) or the first row (text).
-    #[error("row {row} has {found} cells, expected {expected}")]
-    RowLength {
-        /// 1-based row number.
-        row: usize,
-        /// Cells expected.
-        expected: usize,
-        /// Cells found.
-        found: usize,
-    },
-    /// A text grid holds a character other than `.`, `0`, `#`, `1`.
-    #[error("unknown character {ch:?} in column {column} (free: `.` `0`, blocked: `#` `1`)")]
-    UnknownChar {
-        /// The character.
-        ch: char,
-        /// 1-based column.
-        column: usize,
-    },
-    /// A side is longer than 65535 cells.
-    #[error("map too large: {side} {value} is more than {max}", max = MAX_SIDE)]
-    TooLarge {
-        /// `width` or `height`.
-        side: &'static str,
-        /// The value given or counted.
-        value: String,
-    },
-    /// A Moving AI header gives a side of 0.
-    #[error("empty map: {side} is 0")]
-    ZeroSide {
-        /// `width` or `height`.
-        side: &'static str,
-    },
-    /// A text grid file holds no rows.
-    #[error("empty map: no rows")]
-    Empty,
-    /// A text grid has a blank line before its last row.
-    #[error("blank line inside the map")]
-    BlankLine,
-    /// A Moving AI file has more rows than its header's height.
-    #[error("more rows than the header's height {height}")]
-    ExtraRow {
-        /// The header's height.
-        height: usize,
-    },
-}
-
 impl Map {
-    /// Load a map file, detecting its format with [`Format::detect`].
-    pub fn load(path: impl AsRef<Path>) -> Result<Map, MapError> {
-        let path = path.as_ref();
+    /// Read a Moving AI or text-grid file, detecting which with [`Format::detect`].
+    pub fn read_text(path: &Path) -> Result<Map, MapError> {
         let name = path.display().to_string();
         let bytes = std::fs::read(path).map_err(|source| MapError::Unreadable {
             path: name.clone(),
@@ -212,80 +80,6 @@ impl Map {
             Format::MovingAi => parse_moving_ai(&lines).map_err(|(l, p)| err(l, p)),
             Format::Text => parse_text(&lines).map_err(|(l, p)| err(l, p)),
         }
-    }
-
-    /// A `width x height` map whose cell `(x, y)` is blocked iff `blocked(x, y)`. Sides of 0
-    /// give a map that [`Map::grid`] rejects.
-    pub fn from_fn(width: u16, height: u16, mut blocked: impl FnMut(u16, u16) -> bool) -> Map {
-        let cells = usize::from(width) * usize::from(height);
-        let mut bits = vec![0u8; cells.div_ceil(8)];
-        for y in 0..height {
-            for x in 0..width {
-                if blocked(x, y) {
-                    let i = usize::from(y) * usize::from(width) + usize::from(x);
-                    if let Some(b) = bits.get_mut(i / 8) {
-                        *b |= 1 << (i % 8);
-                    }
-                }
-            }
-        }
-        Map {
-            width,
-            height,
-            bits,
-        }
-    }
-
-    /// The core's view of this map. Fails with [`ohaca::Error::BadMap`] if a side is 0 or
-    /// `bits` is too short (possible only for a hand-built `Map`; loaded maps are always valid).
-    pub fn grid(&self) -> Result<Grid<'_>, ohaca::Error> {
-        Grid::new(self.width, self.height, &self.bits)
-    }
-
-    /// `width * height`.
-    pub fn cells(&self) -> usize {
-        usize::from(self.width) * usize::from(self.height)
-    }
-
-    /// True if `p` is outside the map or blocked.
-    pub fn is_blocked(&self, p: Point) -> bool {
-        if p.x >= self.width || p.y >= self.height {
-            return true;
-        }
-        let i = usize::from(p.y) * usize::from(self.width) + usize::from(p.x);
-        self.bits.get(i / 8).is_none_or(|b| (b >> (i % 8)) & 1 == 1)
-    }
-
-    /// The map as a text grid (`.` free, `#` blocked, one row per line), which
-    /// [`Map::parse`] with [`Format::Text`] reads back unchanged.
-    pub fn to_text(&self) -> String {
-        let mut s = String::with_capacity((usize::from(self.width) + 1) * usize::from(self.height));
-        for y in 0..self.height {
-            for x in 0..self.width {
-                s.push(if self.is_blocked(Point::new(x, y)) {
-                    '#'
-                } else {
-                    '.'
-                });
-            }
-            s.push('\n');
-        }
-        s
-    }
-
-    /// The map as a Moving AI `.map` file (`.` free, `@` blocked).
-    pub fn to_moving_ai(&self) -> String {
-        let mut s = String::new();
-        let _ = write!(
-            s,
-            "type octile\nheight {}\nwidth {}\nmap\n",
-            self.height, self.width
-        );
-        for line in self.to_text().lines() {
-            s.extend(line.chars().map(|c| if c == '#' { '@' } else { c }));
-            s.push('\n');
-        }
-        s
     }
 }
 
@@ -492,6 +286,7 @@ fn build(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use ohaca::Point;
 
     fn text(s: &str) -> Result<Map, MapError> {
         Map::parse(s, "t.txt", Format::Text)

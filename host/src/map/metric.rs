@@ -1,4 +1,5 @@
-//! The metric frame of a map: where its cells are in metres.
+//! [`MapFrame`]: the metric frame of a map, where its cells are in metres (ROS's "map frame";
+//! not the wire protocol's COBS frame).
 //!
 //! ROS `map_server` maps say how big a pixel is (`resolution`, metres per cell) and where the
 //! **lower-left** pixel is (`origin`: x, y and a yaw, in the map frame, y pointing up). The
@@ -10,7 +11,7 @@
 //! metres = origin + R(yaw) * local
 //! ```
 //!
-//! and [`Frame::cell`] inverts that: a point in metres belongs to the cell whose square contains
+//! and [`MapFrame::cell`] inverts that: a point in metres belongs to the cell whose square contains
 //! it (a point on a shared edge belongs to the cell to its right and above, in the map's own
 //! axes, up to a billionth of a cell of rounding). Maps without a resolution (Moving AI, text grids, plain images) have no frame: their
 //! positions are cells only.
@@ -19,7 +20,7 @@ use ohaca::Point;
 
 /// A map's placement in metres. See the module docs.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Frame {
+pub struct MapFrame {
     /// Metres per cell (> 0).
     pub resolution: f64,
     /// Position of the lower-left corner of the lower-left cell, in metres.
@@ -32,7 +33,7 @@ pub struct Frame {
     pub height: u16,
 }
 
-impl Frame {
+impl MapFrame {
     /// The centres of cells given as `[x, y]`, in metres rounded to a micrometre (what the
     /// reports print as `waypoints_m`).
     pub fn points_m(&self, points: &[[u16; 2]]) -> Vec<[f64; 2]> {
@@ -79,6 +80,12 @@ impl Frame {
         Some(Point::new(x, y))
     }
 
+    /// Metres per cell rounded to a micrometre, for messages: `0.3`, not the
+    /// `0.30000000000000004` of `0.1 * 3`.
+    pub fn cell_size_m(&self) -> f64 {
+        round_um(self.resolution)
+    }
+
     /// The map's extent in its own axes: `(x_min, x_max, y_min, y_max)` of the rectangle the
     /// cells cover, relative to the origin, before the yaw rotation — i.e. metres when the yaw is
     /// 0.
@@ -107,8 +114,8 @@ pub fn round_um(v: f64) -> f64 {
 mod tests {
     use super::*;
 
-    fn frame(yaw: f64) -> Frame {
-        Frame {
+    fn frame(yaw: f64) -> MapFrame {
+        MapFrame {
             resolution: 0.05,
             origin: [-1.0, 2.0],
             yaw,
