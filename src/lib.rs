@@ -19,6 +19,7 @@
 //! | [`update`] | the per-iteration pheromone update: classic deposit and the wolves rule |
 //! | [`smoothing`] | line-of-sight smoothing of the raw ant path |
 //! | [`planner`] | parameters, caller-provided storage, the iteration loop and the result |
+//! | [`protocol`] | the wire protocol between a host and the device: messages, framing, limits |
 //! | [`rng`] | the small seedable generator every platform shares |
 //! | [`error`] | the error enum |
 //!

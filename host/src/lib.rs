@@ -63,7 +63,7 @@ pub mod rosmap;
 pub mod storage;
 pub mod trace;
 
-pub use args::{parse_point, ParamArgs};
+pub use args::{parse_point, ParamArgs, Preset};
 pub use map::{Map, MapError};
 pub use output::{ParamsReport, PlanReport};
 pub use planning::{plan_map, plan_map_in, PlanError};
