@@ -17,7 +17,7 @@
 //!    every weight the ants can need is one of 15 numbers (30 with the step length), computed
 //!    once per plan ([`Heuristic`]) and looked up through a compile-time class table: no `powf`
 //!    or `expf` in the inner loop, and bit-identical on every platform. The table is scaled by a
-//!    weight some move can have ([`USED`]: 9 of the 30), not by the 15 changes' extremes, which
+//!    weight some move can have (`USED`: 9 of the 30), not by the 15 changes' extremes, which
 //!    no single move reaches, so large `beta` does not push the moves away from the goal to 0.
 //!    The last form of the paper's
 //!    eq. (10), `xi d(P,G) n_PG / d_ij`, is a vector and is not used.
@@ -187,7 +187,15 @@ impl Heuristic {
             *l = if beta == 0.0 {
                 0.0
             } else {
-                (beta * (xi * (change * ln_a) - ln_step)).clamp(-1e30, 1e30)
+                let l = beta * (xi * (change * ln_a) - ln_step);
+                // Comparisons, not `f32::clamp` (which keeps a panic path).
+                if l > 1e30 {
+                    1e30
+                } else if l < -1e30 {
+                    -1e30
+                } else {
+                    l
+                }
             };
         }
         // Scale by a weight some move can have (see [`USED`]): the largest one becomes 1, so a
@@ -355,7 +363,7 @@ mod tests {
 
     #[test]
     fn the_scale_is_a_move_that_exists() {
-        // The paper's setting: the best move any cell can make weighs exactly 1.
+        // The paper's a, xi, beta: the best move any cell can make weighs exactly 1.
         let h = Heuristic::new(Point::new(20, 20), true, 0.05, 1.0, 2.0);
         let max = move_weights(&h).iter().map(|w| w.2).fold(0.0f32, f32::max);
         assert_eq!(max, 1.0);
