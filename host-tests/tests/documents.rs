@@ -1,77 +1,21 @@
 //! Figures in the documents that a test can produce, checked here so they cannot go stale
-//! (the byte-exact example of `docs/PROTOCOL.md` is checked by `src/protocol/tests.rs`; this
-//! file checks what that test takes as given):
+//! (the byte-exact example of `docs/PROTOCOL.md`, and that its plan is the core's, are checked by
+//! `src/protocol/tests.rs`):
 //!
-//! - the example exchange's `Path` reply is the plan the core computes for that request (every
-//!   field but `ticks`, which is the device's clock);
 //! - the request size limits of `docs/PROTOCOL.md`: the reader's 259 COBS bytes (delimiter not
 //!   counted), `TooLarge` reporting the frame's whole length, and the largest request's size;
 //! - the parameter table of `docs/ALGORITHM.md` against `Params::default()` and `Params::paper()`.
 
 use ohaca::protocol::{
-    decode_reply, encode_request, Feed, Reply, ReplyReader, Request, RequestReader, MAX_CHUNK,
-    MAX_REQUEST, MAX_REQUEST_WIRE,
+    encode_request, Feed, Request, RequestReader, MAX_CHUNK, MAX_REQUEST, MAX_REQUEST_WIRE,
 };
-use ohaca::{plan, DeadEnd, Params, Point, SmoothingKind};
-use ohaca_host_tests::heap::HeapStorage;
-use ohaca_host_tests::maps::Map;
+use ohaca::{DeadEnd, Params, SmoothingKind};
 
 fn doc(name: &str) -> String {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../docs")
         .join(name);
     std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
-}
-
-/// The hex bytes after each `marker` line (`;` starts a comment).
-fn doc_bytes(doc: &str, marker: &str) -> Vec<u8> {
-    doc.lines()
-        .filter_map(|l| l.strip_prefix(marker))
-        .flat_map(|l| {
-            l.split(';')
-                .next()
-                .unwrap_or("")
-                .split_whitespace()
-                .map(|t| u8::from_str_radix(t, 16).unwrap_or_else(|_| panic!("bad hex {t:?}")))
-                .collect::<Vec<_>>()
-        })
-        .collect()
-}
-
-#[test]
-fn the_protocol_examples_path_is_the_cores_plan() {
-    let text = doc("PROTOCOL.md");
-    // The example's map: 4x3, one obstacle at (1, 1); the plan (0, 0) -> (3, 2), defaults.
-    let map = Map::from_rows(&["....", ".#..", "...."]);
-    let mut storage = HeapStorage::new(map.cells());
-    let (s, g) = (Point::new(0, 0), Point::new(3, 2));
-    let p = plan(&map.grid(), s, g, &Params::default(), storage.workspace()).expect("plan");
-    let mut wire = doc_bytes(&text, "<< ");
-    let mut reader = ReplyReader::new();
-    let mut found = false;
-    for b in wire.drain(..) {
-        if let Feed::Frame(f) = reader.push(b) {
-            if let Ok((_, Reply::Path(r))) = decode_reply(f) {
-                let hint = "docs/PROTOCOL.md's example plan is not what the core plans: \
-                            regenerate it (see src/protocol/tests.rs, EXAMPLE_*)";
-                assert_eq!(r.raw_length.to_bits(), p.raw_length.to_bits(), "{hint}");
-                assert_eq!(r.length.to_bits(), p.length.to_bits(), "{hint}");
-                assert_eq!(
-                    (r.turns, r.iterations, r.best_iteration, r.moves),
-                    (p.turns, p.iterations, p.best_iteration, p.moves),
-                    "{hint}"
-                );
-                assert_eq!(r.raw_cells as usize, p.raw_len(), "{hint}");
-                let wp: Vec<Point> = (0..r.waypoints.len())
-                    .map(|i| r.waypoints.get(i).unwrap())
-                    .collect();
-                assert_eq!(wp, p.waypoints(), "{hint}");
-                assert_eq!(r.directions, p.directions(), "{hint}");
-                found = true;
-            }
-        }
-    }
-    assert!(found, "no Path reply in the example");
 }
 
 /// The number after `label` in `text` (digits, possibly with a thousands separator).
