@@ -141,6 +141,17 @@ impl Preset {
     }
 }
 
+/// A flag's help line with its value in both presets: `[default: X]` when they agree,
+/// `[default: X, paper: Y]` when they do not.
+fn preset_help(what: &str, value: impl Fn(&Params) -> String) -> String {
+    let (d, p) = (value(&Params::default()), value(&Params::paper()));
+    if d == p {
+        format!("{what} [default: {d}]")
+    } else {
+        format!("{what} [default: {d}, paper: {p}]")
+    }
+}
+
 /// Parse a preset name (`default` or `paper`; any case).
 pub fn parse_preset(s: &str) -> Result<Preset, String> {
     Preset::ALL
@@ -160,55 +171,72 @@ pub struct ParamArgs {
     #[arg(long, value_name = "NAME", value_parser = parse_preset, default_value = "default")]
     pub preset: Preset,
     /// Planner variant: ohaca, haca, paca or aca
-    #[arg(long, value_name = "NAME", value_parser = parse_algorithm)]
+    #[arg(long, value_name = "NAME", value_parser = parse_algorithm,
+          help = preset_help("Planner variant: ohaca, haca, paca or aca", |p| p.algorithm.name().to_string()))]
     pub algorithm: Option<Algorithm>,
     /// Seed of the random generator
-    #[arg(long, value_name = "N", allow_negative_numbers = true)]
+    #[arg(long, value_name = "N", allow_negative_numbers = true,
+          help = preset_help("Seed of the random generator", |p| p.seed.to_string()))]
     pub seed: Option<u64>,
     /// Ants per iteration (M)
-    #[arg(long, value_name = "N", allow_negative_numbers = true)]
+    #[arg(long, value_name = "N", allow_negative_numbers = true,
+          help = preset_help("Ants per iteration (M)", |p| p.ants.to_string()))]
     pub ants: Option<u16>,
     /// Maximum iterations (N)
-    #[arg(long, value_name = "N", allow_negative_numbers = true)]
+    #[arg(long, value_name = "N", allow_negative_numbers = true,
+          help = preset_help("Maximum iterations (N)", |p| p.iterations.to_string()))]
     pub iterations: Option<u16>,
     /// Pheromone exponent
-    #[arg(long, value_name = "A", allow_negative_numbers = true)]
+    #[arg(long, value_name = "A", allow_negative_numbers = true,
+          help = preset_help("Pheromone exponent", |p| p.alpha.to_string()))]
     pub alpha: Option<f32>,
     /// Heuristic exponent
-    #[arg(long, value_name = "B", allow_negative_numbers = true)]
+    #[arg(long, value_name = "B", allow_negative_numbers = true,
+          help = preset_help("Heuristic exponent", |p| p.beta.to_string()))]
     pub beta: Option<f32>,
     /// Evaporation rate, in (0, 1]
-    #[arg(long, value_name = "R", allow_negative_numbers = true)]
+    #[arg(long, value_name = "R", allow_negative_numbers = true,
+          help = preset_help("Evaporation rate, in (0, 1]", |p| p.rho.to_string()))]
     pub rho: Option<f32>,
     /// Pheromone deposit constant
-    #[arg(long, value_name = "Q", allow_negative_numbers = true)]
+    #[arg(long, value_name = "Q", allow_negative_numbers = true,
+          help = preset_help("Pheromone deposit constant", |p| p.q.to_string()))]
     pub q: Option<f32>,
     /// Goal-attraction base, in (0, 1]
-    #[arg(long, value_name = "A", allow_negative_numbers = true)]
+    #[arg(long, value_name = "A", allow_negative_numbers = true,
+          help = preset_help("Goal-attraction base, in (0, 1]", |p| p.a.to_string()))]
     pub a: Option<f32>,
     /// Potential-field gain
-    #[arg(long, value_name = "X", allow_negative_numbers = true)]
+    #[arg(long, value_name = "X", allow_negative_numbers = true,
+          help = preset_help("Potential-field gain", |p| p.xi.to_string()))]
     pub xi: Option<f32>,
     /// Initial pheromone on every edge
-    #[arg(long, value_name = "T", allow_negative_numbers = true)]
+    #[arg(long, value_name = "T", allow_negative_numbers = true,
+          help = preset_help("Initial pheromone on every edge", |p| p.tau0.to_string()))]
     pub tau0: Option<f32>,
     /// Lower pheromone bound
-    #[arg(long, value_name = "T", allow_negative_numbers = true)]
+    #[arg(long, value_name = "T", allow_negative_numbers = true,
+          help = preset_help("Lower pheromone bound", |p| p.tau_min.to_string()))]
     pub tau_min: Option<f32>,
     /// Upper pheromone bound
-    #[arg(long, value_name = "T", allow_negative_numbers = true)]
+    #[arg(long, value_name = "T", allow_negative_numbers = true,
+          help = preset_help("Upper pheromone bound", |p| p.tau_max.to_string()))]
     pub tau_max: Option<f32>,
     /// Stop after this many iterations without improvement; 0 = never stop early
-    #[arg(long, value_name = "N", allow_negative_numbers = true)]
+    #[arg(long, value_name = "N", allow_negative_numbers = true,
+          help = preset_help("Stop after this many iterations without improvement; 0 = never stop early", |p| p.patience.to_string()))]
     pub patience: Option<u16>,
     /// What an ant does at a dead end: backtrack or die (the paper)
-    #[arg(long, value_name = "RULE", value_parser = parse_dead_end)]
+    #[arg(long, value_name = "RULE", value_parser = parse_dead_end,
+          help = preset_help("What an ant does at a dead end: backtrack or die (the paper)", |p| dead_end_name(p.dead_end).to_string()))]
     pub dead_end: Option<DeadEnd>,
     /// How OHACA smooths its path: shortest, greedy (the paper) or none
-    #[arg(long, value_name = "KIND", value_parser = parse_smoothing)]
+    #[arg(long, value_name = "KIND", value_parser = parse_smoothing,
+          help = preset_help("How OHACA smooths its path: shortest, greedy (the paper) or none", |p| smoothing_name(p.smoothing).to_string()))]
     pub smoothing: Option<SmoothingKind>,
     /// Straighten each ant's path before the pheromone update (not in the paper)
-    #[arg(long, value_name = "BOOL", value_parser = parse_bool, action = clap::ArgAction::Set)]
+    #[arg(long, value_name = "BOOL", value_parser = parse_bool, action = clap::ArgAction::Set,
+          help = preset_help("Straighten each ant's path before the pheromone update (not in the paper)", |p| p.tighten.to_string()))]
     pub tighten: Option<bool>,
 }
 
