@@ -188,14 +188,16 @@ impl Heuristic {
                 0.0
             } else {
                 let l = beta * (xi * (change * ln_a) - ln_step);
-                // Comparisons, not `f32::clamp` (which keeps a panic path).
-                if l > 1e30 {
+                // Comparisons, not `f32::clamp` (which keeps a panic path in the firmware).
+                #[allow(clippy::manual_clamp)]
+                let capped = if l > 1e30 {
                     1e30
                 } else if l < -1e30 {
                     -1e30
                 } else {
                     l
-                }
+                };
+                capped
             };
         }
         // Scale by a weight some move can have (see [`USED`]): the largest one becomes 1, so a
