@@ -358,11 +358,23 @@ mod tests {
         dead_end: DeadEnd,
         seed: u64,
     ) -> Option<(Walk, Vec<u8>)> {
+        run_with(rows, start, goal, dead_end, seed, 0.05)
+    }
+
+    /// [`run`] with goal-attraction base `a` (1 = no attraction).
+    fn run_with(
+        rows: &[&str],
+        start: Point,
+        goal: Point,
+        dead_end: DeadEnd,
+        seed: u64,
+        a: f32,
+    ) -> Option<(Walk, Vec<u8>)> {
         let (b, w, h) = setup(rows);
         let g = Grid::new(w, h, &b).unwrap();
         let mut tau_buf = vec![[1.0f32; 4]; g.cells()];
         let tau = Table::new(w, &mut tau_buf);
-        let heur = Heuristic::new(goal, true, 0.05, 1.0, 2.0);
+        let heur = Heuristic::new(goal, true, a, 1.0, 2.0);
         let moves: Vec<u8> = (0..g.cells()).map(|i| g.move_mask(g.point(i))).collect();
         let c = Colony {
             grid: &g,
@@ -414,39 +426,94 @@ mod tests {
 
     #[test]
     fn dying_ants_die_in_dead_ends() {
-        // A corridor with a side pocket the attraction pulls into.
+        // The start sits in a corridor between the goal (west) and a dead end (east). Without
+        // goal attraction (a = 1) both first moves weigh the same, so about half the ants walk
+        // east into the dead end, where a dying ant dies.
         let rows = [
             "#######", //
-            "S.....G", //
-            "###.###", //
-            "###.###", //
+            "G..S...", //
+            "#######", //
         ];
+        let (start, goal) = (Point::new(3, 1), Point::new(0, 1));
         let mut died = 0;
         let mut reached = 0;
         for seed in 0..200 {
-            match run(
-                &rows,
-                Point::new(0, 1),
-                Point::new(6, 1),
-                DeadEnd::Die,
-                seed,
-            ) {
-                Some(_) => reached += 1,
+            match run_with(&rows, start, goal, DeadEnd::Die, seed, 1.0) {
+                Some((w, tour)) => {
+                    reached += 1;
+                    // An ant that arrived never turned back: three steps west.
+                    assert_eq!(tour, [4, 4, 4]);
+                    assert_eq!(w.moves, 3);
+                }
                 None => died += 1,
             }
         }
-        assert!(reached > 0);
-        // Backtracking never loses one.
+        assert_eq!(died + reached, 200);
+        // 200 fair coin flips: 100 +- 3.5 standard deviations.
+        assert!((65..=135).contains(&died), "{died} of 200 died");
+        // Backtracking never loses one: the ants that went east come back.
+        let mut turned_back = 0;
         for seed in 0..200 {
-            assert!(run(
-                &rows,
-                Point::new(0, 1),
-                Point::new(6, 1),
-                DeadEnd::Backtrack,
-                seed
-            )
-            .is_some());
+            let (w, tour) = run_with(&rows, start, goal, DeadEnd::Backtrack, seed, 1.0).unwrap();
+            assert_eq!(tour, [4, 4, 4]);
+            // East and back: 3 forward, 3 back (the dead end counts as a move), then 3 west.
+            if w.moves > 3 {
+                turned_back += 1;
+            }
         }
-        let _ = died;
+        assert_eq!(
+            turned_back, died,
+            "the same seeds walk east with either rule"
+        );
+    }
+
+    #[test]
+    fn roulette_picks_in_proportion_to_the_weights() {
+        // Chi-square goodness of fit of 200 000 draws with a fixed seed, for weight sets with
+        // small, equal and zero entries (a zero weight must never be picked).
+        let sets: [&[f32]; 4] = [
+            &[1.0, 2.0, 3.0, 4.0],
+            &[0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5],
+            &[400.0, 1.0, 0.0, 2395.0, 20.0],
+            &[1e-3, 1.0],
+        ];
+        // 99.9 % quantiles of chi-square with k - 1 degrees of freedom, k = 2..=8.
+        let crit = [0.0, 0.0, 10.83, 13.82, 16.27, 18.47, 20.52, 22.46, 24.32];
+        let draws = 200_000u32;
+        for (seed, w) in sets.iter().enumerate() {
+            let mut rng = Xoshiro128pp::from_u64(seed as u64 + 11);
+            let total: f32 = w.iter().sum();
+            let mut count = [0u32; 8];
+            for _ in 0..draws {
+                count[roulette(&mut rng, w, total)] += 1;
+            }
+            let mut chi2 = 0.0f64;
+            let mut k = 0;
+            for (i, &wi) in w.iter().enumerate() {
+                let want = f64::from(draws) * f64::from(wi) / f64::from(total);
+                if wi == 0.0 {
+                    assert_eq!(count[i], 0, "{w:?}: a zero weight was picked");
+                    continue;
+                }
+                k += 1;
+                chi2 += (f64::from(count[i]) - want).powi(2) / want;
+            }
+            assert!(
+                chi2 < crit[k],
+                "{w:?}: chi2 {chi2:.2} ({:?})",
+                &count[..w.len()]
+            );
+        }
+        // Every weight underflowed: uniform.
+        let mut rng = Xoshiro128pp::from_u64(5);
+        let mut count = [0u32; 3];
+        for _ in 0..30_000 {
+            count[roulette(&mut rng, &[0.0; 3], 0.0)] += 1;
+        }
+        let chi2: f64 = count
+            .iter()
+            .map(|&c| (f64::from(c) - 10_000.0).powi(2) / 10_000.0)
+            .sum();
+        assert!(chi2 < crit[3], "uniform fallback: {count:?}");
     }
 }

@@ -16,7 +16,10 @@
 //!    move is `ds + sqrt(2) dk` with small integers `ds` in `-2..=2` and `dk` in `-1..=1`, so
 //!    every weight the ants can need is one of 15 numbers (30 with the step length), computed
 //!    once per plan ([`Heuristic`]) and looked up through a compile-time class table: no `powf`
-//!    or `expf` in the inner loop, and bit-identical on every platform. The last form of the paper's
+//!    or `expf` in the inner loop, and bit-identical on every platform. The table is scaled by a
+//!    weight some move can have (`USED`: 9 of the 30), not by the 15 changes' extremes, which
+//!    no single move reaches, so large `beta` does not push the moves away from the goal to 0.
+//!    The last form of the paper's
 //!    eq. (10), `xi d(P,G) n_PG / d_ij`, is a vector and is not used.
 //!
 //! Plain ACA uses `eta_ij = 1 / d_ij` alone (eq. 5): 1 for a straight step, `1/sqrt 2` for a
@@ -57,7 +60,11 @@ const WEIGHTS: usize = 32;
 /// occurs for some offset in `-5..=5`.
 // Evaluated at compile time: an index out of range would fail the build, never panic at run time.
 #[allow(clippy::indexing_slicing)]
-static CLASS: [[u8; 8]; KEYS] = {
+static CLASS: [[u8; 8]; KEYS] = CLASS_TABLE;
+
+/// [`CLASS`] as a constant, so [`USED`] can be computed from it at compile time.
+#[allow(clippy::indexing_slicing)]
+const CLASS_TABLE: [[u8; 8]; KEYS] = {
     let mut t = [[(WEIGHTS - 1) as u8; 8]; KEYS];
     let mut dy = -5i32;
     while dy <= 5 {
@@ -78,6 +85,36 @@ static CLASS: [[u8; 8]; KEYS] = {
     }
     t
 };
+
+/// Which of the [`WEIGHTS`] some move of some cell class uses. The others stand for octile
+/// changes that no single move can make (e.g. `-2 - sqrt 2`: one move changes the octile distance
+/// by at most `sqrt 2`), so they must not set the scale of the table. Computed at compile time.
+// Evaluated at compile time: an index out of range would fail the build, never panic at run time.
+#[allow(clippy::indexing_slicing)]
+static USED: [bool; WEIGHTS] = {
+    let mut u = [false; WEIGHTS];
+    let mut k = 0usize;
+    while k < KEYS {
+        let mut d = 0usize;
+        while d < 8 {
+            let i = CLASS_TABLE[k][d] as usize;
+            // The last entry is the zero of impossible classes, never a real move's weight.
+            if i < WEIGHTS - 1 {
+                u[i] = true;
+            }
+            d += 1;
+        }
+        k += 1;
+    }
+    u
+};
+
+/// Natural log of `sqrt 2`.
+const LN_SQRT_2: f32 = 0.5 * core::f32::consts::LN_2;
+
+/// How far below the largest weight the smallest may lie (natural log): `e^-80` is about
+/// `1.8e-35`, above `f32::MIN_POSITIVE` (`1.2e-38`) with room for a pheromone factor of 0.01.
+const LOG_SPAN: f32 = 80.0;
 
 /// Class of a goal offset (see [`CLASS`]). Offsets are differences of `u16` coordinates, so
 /// nothing here can overflow: the `wrapping_` operations never wrap.
@@ -107,7 +144,8 @@ const fn key_of(dx: i32, dy: i32) -> usize {
 pub struct Heuristic {
     goal: Point,
     /// By octile change `(ds + 2) * 3 + (dk + 1)`, straight moves then diagonal moves, then 0;
-    /// normalised so the largest entry is 1.
+    /// scaled so the largest entry a move can use is 1, unless that would push the smallest
+    /// below `e^-LOG_SPAN` (see [`Heuristic::new`]). Entries no move uses are 0.
     weights: [f32; WEIGHTS],
 }
 
@@ -137,26 +175,53 @@ impl Heuristic {
     /// Everything is raised to `beta`. Inputs are assumed validated (`0 < a <= 1`, finite
     /// `xi >= 0`, `0 <= beta <= 16`).
     pub fn new(goal: Point, attract: bool, a: f32, xi: f32, beta: f32) -> Self {
-        let diag_step = libm::powf(SQRT_2, -beta);
-        let mut weights = [0.0f32; WEIGHTS];
-        for (i, w) in weights.iter_mut().enumerate().take(30) {
+        // Every weight as a natural log: beta * (xi * change * ln a - ln step). Computed in logs
+        // so no intermediate over- or underflows before the table is scaled.
+        let ln_a = if attract { libm::logf(a) } else { 0.0 };
+        let mut logs = [0.0f32; WEIGHTS];
+        for (i, l) in logs.iter_mut().enumerate().take(30) {
             let change = ((i % 15) / 3) as f32 - 2.0 + ((i % 3) as f32 - 1.0) * SQRT_2;
-            let att = if attract {
-                libm::powf(a, xi * beta * change)
+            let ln_step = if i >= 15 { LN_SQRT_2 } else { 0.0 };
+            // `beta == 0` means "no heuristic", whatever the product inside would be.
+            // Capped so that differences of logs stay finite (absurd parameters only).
+            *l = if beta == 0.0 {
+                0.0
             } else {
-                1.0
+                let l = beta * (xi * (change * ln_a) - ln_step);
+                // Comparisons, not `f32::clamp` (which keeps a panic path in the firmware).
+                #[allow(clippy::manual_clamp)]
+                let capped = if l > 1e30 {
+                    1e30
+                } else if l < -1e30 {
+                    -1e30
+                } else {
+                    l
+                };
+                capped
             };
-            *w = att * if i >= 15 { diag_step } else { 1.0 };
         }
-        // Normalise so weights never overflow when multiplied by pheromone; an infinite entry
-        // (absurd parameters) becomes 1, the rest shrink accordingly (possibly to 0).
-        let max = weights
-            .iter()
-            .filter(|w| w.is_finite())
-            .fold(0.0f32, |m, &w| m.max(w));
-        if max > 0.0 {
-            for w in weights.iter_mut() {
-                *w = if w.is_finite() { *w / max } else { 1.0 };
+        // Scale by a weight some move can have (see [`USED`]): the largest one becomes 1, so a
+        // weight times pheromone cannot overflow; unless the weights spread over more than
+        // `LOG_SPAN`, then the smallest becomes `e^-LOG_SPAN`, so every move that exists keeps a
+        // weight > 0 (the largest then exceed 1, and are capped at `f32::MAX`).
+        let used = || {
+            logs.iter()
+                .zip(USED.iter())
+                .filter(|(_, u)| **u)
+                .map(|(l, _)| *l)
+        };
+        let hi = used().fold(f32::NEG_INFINITY, f32::max);
+        let lo = used().fold(f32::INFINITY, f32::min);
+        let offset = if hi - lo > LOG_SPAN {
+            lo + LOG_SPAN
+        } else {
+            hi
+        };
+        let mut weights = [0.0f32; WEIGHTS];
+        for ((w, l), u) in weights.iter_mut().zip(logs.iter()).zip(USED.iter()) {
+            if *u {
+                let v = libm::expf(*l - offset);
+                *w = if v.is_finite() { v } else { f32::MAX };
             }
         }
         Heuristic { goal, weights }
@@ -279,7 +344,70 @@ mod tests {
     fn extreme_parameters_stay_finite() {
         let h = Heuristic::new(Point::new(3, 3), true, 1e-30, 1e6, 16.0);
         for w in h.weights.iter() {
-            assert!(w.is_finite() && *w >= 0.0 && *w <= 1.0);
+            assert!(w.is_finite() && *w >= 0.0, "{w}");
+        }
+    }
+
+    /// Every weight a move from some cell can use, over offsets that cover every class.
+    fn move_weights(h: &Heuristic) -> Vec<(Point, u8, f32)> {
+        let g = h.goal();
+        let mut out = Vec::new();
+        for y in g.y - 6..=g.y + 6 {
+            for x in g.x - 6..=g.x + 6 {
+                for d in 0..8u8 {
+                    let p = Point::new(x, y);
+                    out.push((p, d, h.weight(p, d)));
+                }
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn the_scale_is_a_move_that_exists() {
+        // The paper's a, xi, beta: the best move any cell can make weighs exactly 1.
+        let h = Heuristic::new(Point::new(20, 20), true, 0.05, 1.0, 2.0);
+        let max = move_weights(&h).iter().map(|w| w.2).fold(0.0f32, f32::max);
+        assert_eq!(max, 1.0);
+        // Entries no move uses are 0 (they are never read).
+        for (i, w) in h.weights.iter().enumerate() {
+            assert_eq!(USED[i], *w > 0.0, "entry {i}: {w}");
+        }
+        // Of the 15 octile changes x 2 step kinds, a straight step changes the distance by +-1
+        // or +-(sqrt 2 - 1), a diagonal one by 0, +-sqrt 2 or +-(2 - sqrt 2): 9 in all.
+        assert_eq!(USED.iter().filter(|u| **u).count(), 9);
+    }
+
+    #[test]
+    fn large_beta_keeps_every_move_that_exists() {
+        // beta = 16 with the paper's a: a diagonal step towards the goal and one away from it
+        // differ by 0.05^(-16 * 2 sqrt 2), about 1e59, more than f32 can hold between 1 and 0.
+        let goal = Point::new(20, 20);
+        for (a, xi) in [(0.05, 1.0), (0.3, 1.0), (0.05, 0.5)] {
+            let h = Heuristic::new(goal, true, a, xi, 16.0);
+            let ws = move_weights(&h);
+            for &(p, d, w) in &ws {
+                assert!(w > 0.0 && w.is_finite(), "a {a}: {p:?} d{d}: {w}");
+            }
+            // The ratios are still the definition's (in logs: direct() would underflow).
+            let ln = |p: Point, d: u8| {
+                let (ex, ey) = (DX[d as usize], DY[d as usize]);
+                let q = (i32::from(p.x) + ex, i32::from(p.y) + ey);
+                let d0 = f64::from(octile(p, goal));
+                let dq = octile_offset(q.0 - i32::from(goal.x), q.1 - i32::from(goal.y));
+                let d1 = f64::from(dq.0) + f64::from(dq.1) * std::f64::consts::SQRT_2;
+                let step = if d % 2 == 1 { 0.5f64.ln() / 2.0 } else { 0.0 };
+                16.0 * (f64::from(xi) * (d1 - d0) * f64::from(a).ln() + step)
+            };
+            let (p0, d0, w0) = ws[0];
+            for &(p, d, w) in &ws {
+                let want = ln(p, d) - ln(p0, d0);
+                let got = f64::from(w).ln() - f64::from(w0).ln();
+                assert!(
+                    (got - want).abs() < 1e-3 * want.abs().max(1.0),
+                    "{p:?} d{d}"
+                );
+            }
         }
     }
 }

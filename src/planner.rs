@@ -95,7 +95,12 @@ impl Algorithm {
     }
 }
 
-/// Every tunable of the planner. [`Params::default`] is the paper's setting.
+/// Every tunable of the planner.
+///
+/// Two presets: [`Params::default`] is this project's setting (the paper's `alpha`, `beta`, `rho`,
+/// `Q`, `a`, `xi`, `M` and `N`, plus backtracking ants, path tightening, early stopping after 10
+/// stale iterations and shortest smoothing); [`Params::paper`] is the paper's algorithm as
+/// written (ants die at dead ends, no tightening, always all `N` iterations, greedy smoothing).
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
@@ -162,6 +167,34 @@ impl Default for Params {
 }
 
 impl Params {
+    /// The paper's setting as written: `alpha = 1`, `beta = 2`, `rho = 0.1`, `Q = 1`, `a = 0.05`,
+    /// `xi = 1`, `M = 50` ants, always the full `N = 100` iterations (`patience = 0`), ants that
+    /// die at dead ends, no path tightening and the paper's greedy smoothing (section 4.3). The
+    /// pheromone bounds and the seed are [`Params::default`]'s (the paper gives `delta = 0.01`
+    /// and no initial value). Use it for faithful comparisons; `docs/ALGORITHM.md` lists where
+    /// the default differs and why.
+    pub const fn paper() -> Self {
+        Params {
+            algorithm: Algorithm::Ohaca,
+            ants: 50,
+            iterations: 100,
+            alpha: 1.0,
+            beta: 2.0,
+            rho: 0.1,
+            q: 1.0,
+            a: 0.05,
+            xi: 1.0,
+            tau0: 1.0,
+            tau_min: 0.01,
+            tau_max: 100.0,
+            patience: 0,
+            seed: 1,
+            dead_end: DeadEnd::Die,
+            smoothing: SmoothingKind::Greedy,
+            tighten: false,
+        }
+    }
+
     /// Check every field's range.
     pub fn validate(&self) -> Result<(), Error> {
         let bad = |p| Err(Error::BadParam(p));
@@ -496,6 +529,14 @@ impl<'g, 'a> Run<'g, 'a> {
     /// Run one iteration (all ants, then the pheromone update). Returns `true` while there is more
     /// to do.
     pub fn step(&mut self) -> bool {
+        self.step_observed(|_| {})
+    }
+
+    /// [`Run::step`], calling `on_tour` with the path of every ant that arrived, in ant order,
+    /// as directions from the start: exactly the path the ant deposits on (after tightening).
+    /// With these, the iteration's pheromone update (eq. 11-13) can be recomputed by hand; the
+    /// tests do.
+    pub fn step_observed(&mut self, mut on_tour: impl FnMut(&[Dir])) -> bool {
         if self.done {
             return false;
         }
@@ -560,6 +601,7 @@ impl<'g, 'a> Run<'g, 'a> {
                 let Some(path) = tour.get(..walk.steps) else {
                     continue;
                 };
+                on_tour(path);
                 let b = Best::of(&walk);
                 let len = b.length();
                 sum += len;
@@ -958,6 +1000,22 @@ mod tests {
             core::mem::size_of::<Storage<676>>(),
             676 * Workspace::BYTES_PER_CELL + 128 * curve
         );
+    }
+
+    #[test]
+    fn paper_preset_differs_from_default_only_where_documented() {
+        let d = Params::default();
+        assert_eq!(
+            Params::paper(),
+            Params {
+                patience: 0,
+                dead_end: DeadEnd::Die,
+                smoothing: SmoothingKind::Greedy,
+                tighten: false,
+                ..d
+            }
+        );
+        assert_eq!(Params::paper().validate(), Ok(()));
     }
 
     #[test]

@@ -13,6 +13,17 @@
 //!   ants of this iteration whose path has the best (resp. worst) length. So the more ants agree
 //!   on the best path, the stronger it is rewarded. Lengths are compared exactly, as counts of
 //!   straight and diagonal steps.
+//! - **Which path**: the reward goes to the path of the *first* ant (in walking order) with the
+//!   best length, the punishment to the first ant's with the worst length. The ants of one
+//!   iteration are independent draws from the same `tau`, so the first best ant is a uniformly
+//!   random one of the `b`: a best path taken by `b_P` of them gets the whole `b Q / L_best` with
+//!   probability `b_P / b`, i.e. `b_P Q / L_best` in expectation, exactly what "reward each best
+//!   path in proportion to its ants" would give, without storing every best path (the device
+//!   has room for one). Likewise for the worst.
+//! - **`w = 1` cancels**: one worst ant deposited `Q / L_worst` and gets `w Q / L_worst` taken
+//!   back, so its path keeps only evaporation. That is eq. 11-13 as written; in effect the worst
+//!   ants do not reinforce their path and the best ants reinforce theirs twice. We keep it rather
+//!   than invent a stronger punishment constant the paper does not give.
 //! - **No wolves term when every ant has the same length**: then the best and the worst wolf are
 //!   the same and reward and punishment would just cancel (or, for two different paths of equal
 //!   length, arbitrarily punish one of them).

@@ -5,9 +5,10 @@
 //! cargo run --release -p ohaca-host-tests --target host-tuple --example paper_table [-- --seeds N]
 //! ```
 //!
-//! `simple-18` (0,0)->(17,17) and `complex-26` (0,0)->(25,25), seeds `1..=N` (default 30), the
-//! default (paper) parameters otherwise. Two tables: dead ends handled by backtracking (the
-//! default) and by letting the ant die (the paper's behaviour).
+//! `simple-18` (0,0)->(17,17) and `complex-26` (0,0)->(25,25), seeds `1..=N` (default 30).
+//! Three tables: [`Params::default`] (dead ends handled by backtracking), the default with dying
+//! ants (`--dead-end die`), and [`Params::paper`] (`--preset paper`: the paper's algorithm as
+//! written, i.e. dying ants, no tightening, always 100 iterations, greedy smoothing).
 //!
 //! - *success* is the share of runs that returned a path;
 //! - *ants arriving* is the share of first-iteration ants (pheromone still uniform) that reach the
@@ -97,10 +98,19 @@ fn main() {
             .filter(|s| s.name == "simple-18" || s.name == "complex-26")
             .collect(),
     );
-    for dead_end in DeadEnd::ALL {
-        println!(
-            "## Paper comparison, dead end = {dead_end}, seeds 1..={n_seeds}, default parameters\n"
-        );
+    let settings = [
+        ("default parameters", Params::default()),
+        (
+            "default parameters with --dead-end die",
+            Params {
+                dead_end: DeadEnd::Die,
+                ..Params::default()
+            },
+        ),
+        ("the paper preset (--preset paper)", Params::paper()),
+    ];
+    for (setting, base) in settings {
+        println!("## Paper comparison, {setting}, seeds 1..={n_seeds}\n");
         println!(
             "| map | algorithm | success % | ants arriving (1st iteration) % | best | mean | worst | \
              std dev | mean turns | mean convergence iteration | mean iterations | mean time/plan (ms) |"
@@ -111,11 +121,7 @@ fn main() {
         for prep in &prepared {
             let case = &prep.cases[0];
             for algorithm in Algorithm::ALL {
-                let params = Params {
-                    algorithm,
-                    dead_end,
-                    ..Params::default()
-                };
+                let params = Params { algorithm, ..base };
                 let mut storage = heap::storage(prep.map.cells());
                 let runs: Vec<Run> = seeds
                     .iter()

@@ -1,8 +1,10 @@
 //! Command-line values shared by the subcommands: `X,Y` points ([`parse_point`]) and the planner
 //! flags ([`ParamArgs`], which builds an [`ohaca::Params`]).
 //!
-//! Every planner flag defaults to the field of [`ohaca::Params::default`] (the paper's setting),
-//! read at run time, so the defaults can never drift from the core. Flag values are only parsed
+//! Every planner flag takes its value from a preset unless given: `--preset default` (the core's
+//! [`ohaca::Params::default`], this project's setting) or `--preset paper` (the core's
+//! [`ohaca::Params::paper`], the paper's algorithm as written), read at run time, so the presets
+//! can never drift from the core. Explicit flags override the preset. Flag values are only parsed
 //! here; their ranges are checked by the core ([`ohaca::Params::validate`]) so the tool reports
 //! exactly the core's message.
 
@@ -71,102 +73,161 @@ pub fn parse_bool(s: &str) -> Result<bool, String> {
     }
 }
 
+/// A named set of planner parameters that the flags start from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Preset {
+    /// [`Params::default`]: the paper's constants with backtracking ants, path tightening, early
+    /// stopping and shortest smoothing.
+    #[default]
+    Default,
+    /// [`Params::paper`]: the paper's algorithm as written (ants die at dead ends, no tightening,
+    /// always all iterations, greedy smoothing).
+    Paper,
+}
+
+impl Preset {
+    /// Both, default first.
+    pub const ALL: [Preset; 2] = [Preset::Default, Preset::Paper];
+
+    /// Lower-case name (`default`, `paper`).
+    pub const fn name(self) -> &'static str {
+        match self {
+            Preset::Default => "default",
+            Preset::Paper => "paper",
+        }
+    }
+
+    /// The preset's parameters.
+    pub fn params(self) -> Params {
+        match self {
+            Preset::Default => Params::default(),
+            Preset::Paper => Params::paper(),
+        }
+    }
+}
+
+/// A flag's help line with its value in both presets: `[default: X]` when they agree,
+/// `[default: X, paper: Y]` when they do not.
+fn preset_help(what: &str, value: impl Fn(&Params) -> String) -> String {
+    let (d, p) = (value(&Params::default()), value(&Params::paper()));
+    if d == p {
+        format!("{what} [default: {d}]")
+    } else {
+        format!("{what} [default: {d}, paper: {p}]")
+    }
+}
+
+/// Parse a preset name (`default` or `paper`; any case).
+pub fn parse_preset(s: &str) -> Result<Preset, String> {
+    Preset::ALL
+        .into_iter()
+        .find(|p| p.name().eq_ignore_ascii_case(s.trim()))
+        .ok_or_else(|| format!("unknown preset `{s}`; expected default or paper"))
+}
+
 /// Every planner parameter as a command-line flag. Flatten it into a subcommand's arguments
-/// (`#[command(flatten)]`) and call [`ParamArgs::params`].
+/// (`#[command(flatten)]`) and call [`ParamArgs::params`]. A flag that is not given takes the
+/// value of `--preset` (default: `default`).
 #[derive(clap::Args, Clone, Debug, PartialEq)]
-#[command(next_help_heading = "Planner parameters (defaults: the paper's setting)")]
+#[command(next_help_heading = "Planner parameters (unset flags take the preset's value)")]
 pub struct ParamArgs {
+    /// Starting point of every flag below: default (this project's setting) or paper (the
+    /// paper's algorithm as written: ants die, no tightening, all iterations, greedy smoothing)
+    #[arg(long, value_name = "NAME", value_parser = parse_preset, default_value = "default")]
+    pub preset: Preset,
     /// Planner variant: ohaca, haca, paca or aca
     #[arg(long, value_name = "NAME", value_parser = parse_name::<Algorithm>,
-          default_value_t = Params::default().algorithm)]
-    pub algorithm: Algorithm,
+          help = preset_help("Planner variant: ohaca, haca, paca or aca", |p| p.algorithm.name().to_string()))]
+    pub algorithm: Option<Algorithm>,
     /// Seed of the random generator
     #[arg(long, value_name = "N", allow_negative_numbers = true,
-          default_value_t = Params::default().seed)]
-    pub seed: u64,
+          help = preset_help("Seed of the random generator", |p| p.seed.to_string()))]
+    pub seed: Option<u64>,
     /// Ants per iteration (M)
     #[arg(long, value_name = "N", allow_negative_numbers = true,
-          default_value_t = Params::default().ants)]
-    pub ants: u16,
+          help = preset_help("Ants per iteration (M)", |p| p.ants.to_string()))]
+    pub ants: Option<u16>,
     /// Maximum iterations (N)
     #[arg(long, value_name = "N", allow_negative_numbers = true,
-          default_value_t = Params::default().iterations)]
-    pub iterations: u16,
+          help = preset_help("Maximum iterations (N)", |p| p.iterations.to_string()))]
+    pub iterations: Option<u16>,
     /// Pheromone exponent
     #[arg(long, value_name = "A", allow_negative_numbers = true,
-          default_value_t = Params::default().alpha)]
-    pub alpha: f32,
+          help = preset_help("Pheromone exponent", |p| p.alpha.to_string()))]
+    pub alpha: Option<f32>,
     /// Heuristic exponent
     #[arg(long, value_name = "B", allow_negative_numbers = true,
-          default_value_t = Params::default().beta)]
-    pub beta: f32,
+          help = preset_help("Heuristic exponent", |p| p.beta.to_string()))]
+    pub beta: Option<f32>,
     /// Evaporation rate, in (0, 1]
     #[arg(long, value_name = "R", allow_negative_numbers = true,
-          default_value_t = Params::default().rho)]
-    pub rho: f32,
+          help = preset_help("Evaporation rate, in (0, 1]", |p| p.rho.to_string()))]
+    pub rho: Option<f32>,
     /// Pheromone deposit constant
     #[arg(long, value_name = "Q", allow_negative_numbers = true,
-          default_value_t = Params::default().q)]
-    pub q: f32,
+          help = preset_help("Pheromone deposit constant", |p| p.q.to_string()))]
+    pub q: Option<f32>,
     /// Goal-attraction base, in (0, 1]
     #[arg(long, value_name = "A", allow_negative_numbers = true,
-          default_value_t = Params::default().a)]
-    pub a: f32,
+          help = preset_help("Goal-attraction base, in (0, 1]", |p| p.a.to_string()))]
+    pub a: Option<f32>,
     /// Potential-field gain
     #[arg(long, value_name = "X", allow_negative_numbers = true,
-          default_value_t = Params::default().xi)]
-    pub xi: f32,
+          help = preset_help("Potential-field gain", |p| p.xi.to_string()))]
+    pub xi: Option<f32>,
     /// Initial pheromone on every edge
     #[arg(long, value_name = "T", allow_negative_numbers = true,
-          default_value_t = Params::default().tau0)]
-    pub tau0: f32,
+          help = preset_help("Initial pheromone on every edge", |p| p.tau0.to_string()))]
+    pub tau0: Option<f32>,
     /// Lower pheromone bound
     #[arg(long, value_name = "T", allow_negative_numbers = true,
-          default_value_t = Params::default().tau_min)]
-    pub tau_min: f32,
+          help = preset_help("Lower pheromone bound", |p| p.tau_min.to_string()))]
+    pub tau_min: Option<f32>,
     /// Upper pheromone bound
     #[arg(long, value_name = "T", allow_negative_numbers = true,
-          default_value_t = Params::default().tau_max)]
-    pub tau_max: f32,
+          help = preset_help("Upper pheromone bound", |p| p.tau_max.to_string()))]
+    pub tau_max: Option<f32>,
     /// Stop after this many iterations without improvement; 0 = never stop early
     #[arg(long, value_name = "N", allow_negative_numbers = true,
-          default_value_t = Params::default().patience)]
-    pub patience: u16,
+          help = preset_help("Stop after this many iterations without improvement; 0 = never stop early", |p| p.patience.to_string()))]
+    pub patience: Option<u16>,
     /// What an ant does at a dead end: backtrack or die (the paper)
     #[arg(long, value_name = "RULE", value_parser = parse_name::<DeadEnd>,
-          default_value_t = Params::default().dead_end)]
-    pub dead_end: DeadEnd,
+          help = preset_help("What an ant does at a dead end: backtrack or die (the paper)", |p| p.dead_end.name().to_string()))]
+    pub dead_end: Option<DeadEnd>,
     /// How OHACA smooths its path: shortest, greedy (the paper) or none
     #[arg(long, value_name = "KIND", value_parser = parse_name::<SmoothingKind>,
-          default_value_t = Params::default().smoothing)]
-    pub smoothing: SmoothingKind,
+          help = preset_help("How OHACA smooths its path: shortest, greedy (the paper) or none", |p| p.smoothing.name().to_string()))]
+    pub smoothing: Option<SmoothingKind>,
     /// Straighten each ant's path before the pheromone update (not in the paper)
     #[arg(long, value_name = "BOOL", value_parser = parse_bool, action = clap::ArgAction::Set,
-          default_value = if Params::default().tighten { "true" } else { "false" })]
-    pub tighten: bool,
+          help = preset_help("Straighten each ant's path before the pheromone update (not in the paper)", |p| p.tighten.to_string()))]
+    pub tighten: Option<bool>,
 }
 
 impl ParamArgs {
-    /// The flags as core parameters (not yet validated: [`ohaca::plan`] does that).
+    /// The flags over the preset, as core parameters (not yet validated: [`ohaca::plan`] does
+    /// that).
     pub fn params(&self) -> Params {
+        let base = self.preset.params();
         Params {
-            algorithm: self.algorithm,
-            ants: self.ants,
-            iterations: self.iterations,
-            alpha: self.alpha,
-            beta: self.beta,
-            rho: self.rho,
-            q: self.q,
-            a: self.a,
-            xi: self.xi,
-            tau0: self.tau0,
-            tau_min: self.tau_min,
-            tau_max: self.tau_max,
-            patience: self.patience,
-            seed: self.seed,
-            dead_end: self.dead_end,
-            smoothing: self.smoothing,
-            tighten: self.tighten,
+            algorithm: self.algorithm.unwrap_or(base.algorithm),
+            seed: self.seed.unwrap_or(base.seed),
+            ants: self.ants.unwrap_or(base.ants),
+            iterations: self.iterations.unwrap_or(base.iterations),
+            alpha: self.alpha.unwrap_or(base.alpha),
+            beta: self.beta.unwrap_or(base.beta),
+            rho: self.rho.unwrap_or(base.rho),
+            q: self.q.unwrap_or(base.q),
+            a: self.a.unwrap_or(base.a),
+            xi: self.xi.unwrap_or(base.xi),
+            tau0: self.tau0.unwrap_or(base.tau0),
+            tau_min: self.tau_min.unwrap_or(base.tau_min),
+            tau_max: self.tau_max.unwrap_or(base.tau_max),
+            patience: self.patience.unwrap_or(base.patience),
+            dead_end: self.dead_end.unwrap_or(base.dead_end),
+            smoothing: self.smoothing.unwrap_or(base.smoothing),
+            tighten: self.tighten.unwrap_or(base.tighten),
         }
     }
 }
@@ -256,6 +317,59 @@ mod tests {
                 dead_end: DeadEnd::Die,
                 smoothing: SmoothingKind::Greedy,
                 tighten: false,
+            }
+        );
+    }
+
+    #[test]
+    fn the_paper_preset_is_the_cores() {
+        assert_eq!(parse(&["--preset", "paper"]).unwrap(), Params::paper());
+        assert_eq!(parse(&["--preset", "PAPER"]).unwrap(), Params::paper());
+        assert_eq!(parse(&["--preset", "default"]).unwrap(), Params::default());
+        assert!(parse(&["--preset", "book"]).is_err());
+    }
+
+    #[test]
+    fn explicit_flags_override_the_preset() {
+        // Either order: a flag wins over the preset whether it comes before or after it.
+        for args in [
+            &[
+                "--preset",
+                "paper",
+                "--dead-end",
+                "backtrack",
+                "--seed",
+                "9",
+            ][..],
+            &[
+                "--dead-end",
+                "backtrack",
+                "--seed",
+                "9",
+                "--preset",
+                "paper",
+            ],
+        ] {
+            assert_eq!(
+                parse(args).unwrap(),
+                Params {
+                    dead_end: DeadEnd::Backtrack,
+                    seed: 9,
+                    ..Params::paper()
+                },
+                "{args:?}"
+            );
+        }
+        // A flag given with the preset's own value changes nothing.
+        assert_eq!(
+            parse(&["--preset", "paper", "--tighten", "false", "--patience", "0"]).unwrap(),
+            Params::paper()
+        );
+        assert_eq!(
+            parse(&["--patience", "0"]).unwrap(),
+            Params {
+                patience: 0,
+                ..Params::default()
             }
         );
     }

@@ -19,8 +19,10 @@
 //! - **convergence iteration**: 1-based iteration in which the run's best path was first found
 //!   (`best_iteration + 1`).
 //! - **convergence curve**: for each iteration, the mean over successful runs of the best raw
-//!   length found so far ([`ohaca::CurvePoint::best_so_far`]); a run that stopped early keeps its
-//!   last value; iterations before a run's first arrival are left out of that iteration's mean.
+//!   length found so far ([`ohaca::CurvePoint::best_so_far`]); a run that stopped early carries
+//!   its final best forward. The curve starts at the first iteration in which every successful
+//!   run has a path (before that it has no value), so every point averages the same runs and the
+//!   curve never rises.
 
 use std::fmt::Write as _;
 use std::path::Path;
@@ -264,13 +266,19 @@ impl Outcome {
             .unwrap_or(0);
         (0..n)
             .map(|i| {
-                let vals: Vec<f64> = curves
+                // Every successful run at iteration i (its final best once it has stopped); no
+                // value while some run has no path yet, so the mean is always over the same runs.
+                let vals: Option<Vec<f64>> = curves
                     .iter()
-                    .filter_map(|c| c.get(i).or_else(|| c.last()).copied())
-                    .filter(|v| v.is_finite())
-                    .map(f64::from)
+                    .map(|c| {
+                        c.get(i)
+                            .or_else(|| c.last())
+                            .copied()
+                            .filter(|v| v.is_finite())
+                            .map(f64::from)
+                    })
                     .collect();
-                mean(&vals).unwrap_or(f64::INFINITY)
+                vals.and_then(|v| mean(&v)).unwrap_or(f64::INFINITY)
             })
             .collect()
     }
@@ -595,7 +603,22 @@ mod tests {
         o.runs[0].best_so_far = vec![10.0, 8.0];
         o.runs[1].best_so_far = vec![f32::INFINITY, 12.0, 9.0, 6.0];
         let c = o.convergence_of(Algorithm::Aca);
-        assert_eq!(c, vec![10.0, 10.0, 8.5, 7.0]);
+        assert_eq!(c, vec![f64::INFINITY, 10.0, 8.5, 7.0]);
+    }
+
+    #[test]
+    fn the_convergence_curve_never_rises() {
+        let mut o = run(&scenario(), &config(), &|| {}).unwrap();
+        o.runs.truncate(3);
+        // A run that stopped at once on a short path, one that found a long path late (ants that
+        // die may find none for a while), one that stopped after two iterations.
+        o.runs[0].best_so_far = vec![5.0];
+        o.runs[1].best_so_far = vec![f32::INFINITY, f32::INFINITY, 20.0, 11.0];
+        o.runs[2].best_so_far = vec![9.0, 8.0];
+        let c = o.convergence_of(Algorithm::Aca);
+        assert_eq!(c, vec![f64::INFINITY, f64::INFINITY, 11.0, 8.0]);
+        let finite: Vec<f64> = c.into_iter().filter(|v| v.is_finite()).collect();
+        assert!(finite.windows(2).all(|w| w[1] <= w[0]), "{finite:?}");
     }
 
     #[test]

@@ -154,7 +154,7 @@ impl MapArgs {
 /// (alias `--algorithms`), for the commands that run several variants.
 #[derive(Clone, Debug, PartialEq)]
 pub struct MultiParamArgs {
-    /// Every planner flag; `params.algorithm` is the first algorithm given.
+    /// Every planner flag; `params.params().algorithm` is the first algorithm given.
     pub params: ParamArgs,
     /// The algorithms given, in order, without repeats (empty if none was given).
     pub given: Vec<Algorithm>,
@@ -295,12 +295,12 @@ mod tests {
         };
         let p = with(&[]);
         assert!(p.given.is_empty());
-        assert_eq!(p.params.algorithm, Algorithm::Ohaca);
+        assert_eq!(p.params.params().algorithm, Algorithm::Ohaca);
         assert_eq!(p.algorithms(&Algorithm::ALL), Algorithm::ALL.to_vec());
         let p = with(&["--algorithm", "aca", "--algorithm", "ohaca", "--ants", "7"]);
         assert_eq!(p.given, vec![Algorithm::Aca, Algorithm::Ohaca]);
-        assert_eq!(p.params.algorithm, Algorithm::Aca);
-        assert_eq!(p.params.ants, 7);
+        assert_eq!(p.params.params().algorithm, Algorithm::Aca);
+        assert_eq!(p.params.params().ants, 7);
         let p = with(&["--algorithms", "haca,paca,haca"]);
         assert_eq!(p.given, vec![Algorithm::Haca, Algorithm::Paca]);
         assert!(parse(&[&base[..], &["--algorithm", "bee"]].concat()).is_err());

@@ -56,7 +56,7 @@ pub mod output;
 pub mod plan_map;
 pub mod trace;
 
-pub use args::{parse_point, ParamArgs};
+pub use args::{parse_point, ParamArgs, Preset};
 pub use map::{Map, MapError};
 pub use ohaca::heap::HeapStorage;
 pub use output::PlanReport;

@@ -722,7 +722,7 @@ const EXAMPLE_WAYPOINTS: [Point; 4] = [
 ];
 const EXAMPLE_DIRECTIONS: [u8; 4] = [0, 0, 1, 2];
 /// Ticks (µs of virtual time) the QEMU firmware reported for the example plan.
-const EXAMPLE_TICKS: u64 = 1649;
+const EXAMPLE_TICKS: u64 = 885;
 
 fn example_path() -> PathReply<'static> {
     PathReply {

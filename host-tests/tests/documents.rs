@@ -1,0 +1,166 @@
+//! Figures in the documents that a test can produce, checked here so they cannot go stale
+//! (the byte-exact example of `docs/PROTOCOL.md`, and that its plan is the core's, are checked by
+//! `src/protocol/tests.rs`):
+//!
+//! - the request size limits of `docs/PROTOCOL.md`: the reader's 259 COBS bytes (delimiter not
+//!   counted), `TooLarge` reporting the frame's whole length, and the largest request's size;
+//! - the parameter table of `docs/ALGORITHM.md` against `Params::default()` and `Params::paper()`.
+
+use ohaca::protocol::{
+    encode_request, Feed, Request, RequestReader, MAX_CHUNK, MAX_REQUEST, MAX_REQUEST_WIRE,
+};
+use ohaca::{DeadEnd, Params, SmoothingKind};
+
+fn doc(name: &str) -> String {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../docs")
+        .join(name);
+    std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
+/// The number after `label` in `text` (digits, possibly with a thousands separator).
+fn number_after(text: &str, label: &str) -> u64 {
+    let at = text
+        .find(label)
+        .unwrap_or_else(|| panic!("{label:?} not in the document"));
+    text[at + label.len()..]
+        .trim_start()
+        .chars()
+        .take_while(|c| c.is_ascii_digit() || *c == ',')
+        .filter(|c| c.is_ascii_digit())
+        .collect::<String>()
+        .parse()
+        .unwrap_or_else(|_| panic!("no number after {label:?}"))
+}
+
+#[test]
+fn the_request_size_limits_are_the_documents() {
+    let text = doc("PROTOCOL.md");
+    assert_eq!(number_after(&text, "| `MAX_REQUEST` |"), MAX_REQUEST as u64);
+    assert_eq!(
+        number_after(&text, "its reader holds `MAX_REQUEST_WIRE` ="),
+        MAX_REQUEST_WIRE as u64
+    );
+    // The reader holds MAX_REQUEST_WIRE bytes before the delimiter, not counting it.
+    let feed = |n: usize| {
+        let mut r = RequestReader::new();
+        for _ in 0..n {
+            assert!(matches!(r.push(0x01), Feed::Pending));
+        }
+        match r.push(0) {
+            Feed::Frame(f) => Ok(f.len()),
+            Feed::TooLarge { len } => Err(len),
+            Feed::Pending => panic!("no frame"),
+        }
+    };
+    assert_eq!(feed(MAX_REQUEST_WIRE), Ok(MAX_REQUEST_WIRE));
+    // One more: dropped, and TooLarge reports the frame's whole length (without the 00).
+    assert_eq!(feed(MAX_REQUEST_WIRE + 1), Err(MAX_REQUEST_WIRE + 1));
+    assert_eq!(feed(1000), Err(1000));
+    // COBS makes at most 258 bytes of a 256-byte payload (one code byte per 254, plus one).
+    let most = number_after(&text, "(at most");
+    assert_eq!(most as usize, MAX_REQUEST + MAX_REQUEST.div_ceil(254));
+    assert!(most as usize <= MAX_REQUEST_WIRE);
+    // The largest request: a SetMap with a full chunk and every number at its longest varint.
+    let big = [0xffu8; MAX_CHUNK];
+    let req = Request::SetMap {
+        width: u16::MAX,
+        height: u16::MAX,
+        offset: u32::MAX,
+        total_len: u32::MAX,
+        chunk: &big,
+    };
+    let largest = number_after(
+        &text,
+        "the largest request, a `SetMap` with a full chunk, is",
+    );
+    assert_eq!(
+        largest as usize,
+        postcard_len(&req),
+        "docs/PROTOCOL.md: the largest request's size"
+    );
+    assert!(largest as usize <= MAX_REQUEST);
+    let params = Request::SetParams(Params {
+        seed: u64::MAX,
+        ants: u16::MAX,
+        iterations: u16::MAX,
+        patience: u16::MAX,
+        ..Params::default()
+    });
+    assert!(postcard_len(&params) < largest as usize);
+}
+
+/// Payload bytes (postcard + CRC) of `req` with the longest id.
+fn postcard_len(req: &Request<'_>) -> usize {
+    let mut buf = [0u8; 2 * MAX_REQUEST_WIRE];
+    let n = encode_request(u32::MAX, req, &mut buf).expect("encode");
+    // Undo COBS: the decoded length is what the reader hands the decoder.
+    let body = &buf[..n - 1];
+    let mut out = Vec::new();
+    let mut i = 0;
+    while i < body.len() {
+        let code = body[i] as usize;
+        out.extend_from_slice(&body[i + 1..i + code]);
+        i += code;
+        if code != 0xff && i < body.len() {
+            out.push(0);
+        }
+    }
+    out.len()
+}
+
+#[test]
+fn the_parameter_table_is_the_cores() {
+    let text = doc("ALGORITHM.md");
+    let row = |name: &str| -> Vec<String> {
+        let line = text
+            .lines()
+            .find(|l| l.starts_with(&format!("| `{name}` |")))
+            .unwrap_or_else(|| panic!("no row for {name} in ALGORITHM.md's parameter table"));
+        line.split('|').map(|c| c.trim().to_string()).collect()
+    };
+    let (d, p) = (Params::default(), Params::paper());
+    let num = |s: &str| s.parse::<f32>().unwrap_or_else(|_| panic!("{s:?}"));
+    for (name, dv, pv) in [
+        ("alpha", d.alpha, p.alpha),
+        ("beta", d.beta, p.beta),
+        ("rho", d.rho, p.rho),
+        ("q", d.q, p.q),
+        ("a", d.a, p.a),
+        ("xi", d.xi, p.xi),
+        ("ants", f32::from(d.ants), f32::from(p.ants)),
+        (
+            "iterations",
+            f32::from(d.iterations),
+            f32::from(p.iterations),
+        ),
+        ("patience", f32::from(d.patience), f32::from(p.patience)),
+    ] {
+        let r = row(name);
+        assert_eq!(
+            (num(&r[2]), num(&r[3])),
+            (dv, pv),
+            "ALGORITHM.md row {name}"
+        );
+    }
+    let words = |name: &str| {
+        let r = row(name);
+        (r[2].clone(), r[3].clone())
+    };
+    let dead = |x: DeadEnd| x.name().to_string();
+    assert_eq!(words("dead_end"), (dead(d.dead_end), dead(p.dead_end)));
+    let smooth = |k: SmoothingKind| {
+        match k {
+            SmoothingKind::Shortest => "shortest",
+            SmoothingKind::Greedy => "greedy",
+            SmoothingKind::None => "none",
+        }
+        .to_string()
+    };
+    assert_eq!(
+        words("smoothing"),
+        (smooth(d.smoothing), smooth(p.smoothing))
+    );
+    let on = |b: bool| if b { "on" } else { "off" }.to_string();
+    assert_eq!(words("tighten"), (on(d.tighten), on(p.tighten)));
+}
