@@ -301,19 +301,21 @@ impl Upload {
         self.open.is_some()
     }
 
-    /// Check `c` without touching the map. `Ok(true)`: it starts a new upload (offset 0 and a
-    /// good header): the caller must stop using the active map before [`Upload::write`]
-    /// overwrites it. `Ok(false)`: it continues the open upload. Errors, in this order:
-    /// `TooLarge` (chunk over [`MAX_CHUNK`] or empty: detail = its length), and at offset 0
-    /// `BadMap` (a zero side: 0 / 0; raw `total_len` not `ceil(cells / 8)`: total_len /
-    /// expected; run-length `total_len` 0: 0 / 0), `MapTooLarge` (a side over the limits:
-    /// detail = width, limit = max_width, else height / max_height); then `BadChunk` (no upload
-    /// open, or other sides, total_len or encoding, `offset` past the bytes received or the
-    /// chunk past `total_len`: detail = bytes received, limit = total_len, 0 / 0 when none is
-    /// open). A refused offset-0 chunk leaves an open upload (and the map) as they were.
+    /// Check `c` without touching the map. `Ok(true)`: it starts a new upload (offset 0, a good
+    /// header and a good chunk): the caller must stop using the active map before
+    /// [`Upload::write`] overwrites it. `Ok(false)`: it continues the open upload. Errors, in
+    /// this order: `TooLarge` (chunk over [`MAX_CHUNK`]: detail = its length, limit =
+    /// `MAX_CHUNK`); at offset 0 `BadMap` (a zero side: 0 / 0; raw `total_len` not
+    /// `ceil(cells / 8)`: total_len / expected; run-length `total_len` 0: 0 / 0) and
+    /// `MapTooLarge` (a side over the limits: detail = width, limit = max_width, else height /
+    /// max_height), which leave an open upload as it was; then `BadChunk` (no upload open; other
+    /// sides, total_len or encoding; `offset` past the bytes received, the chunk past
+    /// `total_len`, or an empty chunk: detail = bytes received, limit = total_len, 0 / 0 when
+    /// none is open). An offset-0 chunk with a good header opens its upload even when the chunk
+    /// itself is refused (nothing received yet: the map is untouched).
     pub fn accept(&mut self, c: &MapChunk<'_>, limits: MapLimits) -> Result<bool, ErrorReply> {
         let len = u32::try_from(c.chunk.len()).unwrap_or(u32::MAX);
-        if c.chunk.is_empty() || c.chunk.len() > MAX_CHUNK {
+        if c.chunk.len() > MAX_CHUNK {
             return Err(err(ErrorCode::TooLarge, len, MAX_CHUNK as u32));
         }
         if c.offset == 0 {
@@ -358,7 +360,7 @@ impl Upload {
         let end = c.offset.saturating_add(len);
         let same = (c.encoding, c.width, c.height, c.total_len)
             == (o.encoding, o.width, o.height, o.total_len);
-        if same && c.offset <= o.received && end <= o.total_len {
+        if same && c.offset <= o.received && end <= o.total_len && len > 0 {
             Ok(())
         } else {
             Err(err(ErrorCode::BadChunk, o.received, o.total_len))

@@ -201,7 +201,7 @@ fn upload_headers_are_checked() {
     let mut up = Upload::new();
     let big = [0u8; MAX_CHUNK + 1];
     let cases: Vec<(MapChunk<'_>, ErrorReply)> = vec![
-        (chunk(Raw, 4, 3, 0, 2, &[]), e(ErrorCode::TooLarge, 0, 128)),
+        (chunk(Raw, 4, 3, 0, 2, &[]), e(ErrorCode::BadChunk, 0, 2)),
         (
             chunk(Rle, 4, 3, 0, 2, &big),
             e(ErrorCode::TooLarge, 129, 128),
@@ -227,8 +227,15 @@ fn upload_headers_are_checked() {
         ),
     ];
     for (c, want) in cases {
-        assert_eq!(up.accept(&c, LIMITS), Err(want), "{c:?}");
+        assert_eq!(Upload::new().accept(&c, LIMITS), Err(want), "{c:?}");
     }
+    // An empty first chunk opens its upload with nothing received (the map is untouched).
+    assert!(up.accept(&chunk(Raw, 4, 3, 0, 2, &[]), LIMITS).is_err());
+    assert!(up.is_open());
+    assert_eq!(
+        up.accept(&chunk(Raw, 4, 3, 1, 2, &[0]), LIMITS),
+        Err(e(ErrorCode::BadChunk, 0, 2))
+    );
     // A good start, then chunks that do not continue it.
     let mut up = Upload::new();
     assert_eq!(up.accept(&chunk(Rle, 4, 3, 0, 3, &[5]), LIMITS), Ok(true));
