@@ -1498,3 +1498,67 @@ mod tests {
         assert_eq!(core_error(&ErrorReply::new(ErrorCode::BadCrc)), None);
     }
 }
+
+/// Upload sizes of real maps, raw against run-length coded, in bytes on the wire (frames
+/// included) and seconds at 115200 baud: `cargo test --release -p ohaca-host --target
+/// host-tuple --lib upload_sizes -- --ignored --nocapture` (needs `../shared/maps/large`).
+#[cfg(test)]
+mod upload_sizes {
+    use super::*;
+    use std::path::Path;
+
+    /// Bytes on the wire of `code`'s upload: every frame, delimiters included, ids from 2.
+    fn wire_bytes(w: u16, h: u16, code: &MapCode) -> (usize, usize) {
+        let b = code.bytes();
+        let mut total = 0;
+        let mut frames = 0;
+        let mut buf = [0u8; MAX_REQUEST_WIRE];
+        for (k, c) in b.chunks(MAX_CHUNK).enumerate() {
+            let req = code.request(w, h, k * MAX_CHUNK, c);
+            total += encode_request(2 + k as u32, &req, &mut buf).unwrap();
+            frames += 1;
+        }
+        (total, frames)
+    }
+
+    #[test]
+    #[ignore = "prints upload sizes of the shared large maps and lab.yaml"]
+    fn print_upload_sizes() {
+        let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+        let mut maps: Vec<(String, Map)> = vec![];
+        let lab = root.join("host/assets/ros/lab.yaml");
+        let (m, _) = crate::input::prepare_map(&lab, Default::default(), Some(0.2), None).unwrap();
+        maps.push(("lab.yaml (5 cm, inflated 0.2 m)".into(), m));
+        let large = root.join("../shared/maps/large");
+        let mut names: Vec<_> = std::fs::read_dir(&large)
+            .map(|d| d.filter_map(|e| e.ok()).map(|e| e.path()).collect())
+            .unwrap_or_default();
+        names.retain(|p| p.extension().is_some_and(|e| e == "map"));
+        names.sort();
+        for p in names {
+            if let Ok(m) = Map::load(&p) {
+                if m.width <= 512 && m.height <= 512 {
+                    maps.push((p.file_name().unwrap().to_string_lossy().into(), m));
+                }
+            }
+        }
+        println!("| map | cells | packed | run-length code | on the wire (RLE) | frames | at 115200 baud | raw upload at 115200 |");
+        println!("| --- | --- | --- | --- | --- | --- | --- | --- |");
+        for (name, m) in maps {
+            let cells = u32::from(m.width) * u32::from(m.height);
+            let rle: Vec<u8> = RleEncoder::new(&m.bits, cells).collect();
+            let (wr, fr) = wire_bytes(m.width, m.height, &MapCode::Rle(rle.clone()));
+            let (ww, _) = wire_bytes(m.width, m.height, &MapCode::Raw(m.bits.clone()));
+            println!(
+                "| {name} | {}x{} | {} | {} ({:.1} %) | {wr} | {fr} | {:.2} s | {:.2} s |",
+                m.width,
+                m.height,
+                m.bits.len(),
+                rle.len(),
+                100.0 * rle.len() as f64 / m.bits.len() as f64,
+                wr as f64 / 11520.0,
+                ww as f64 / 11520.0
+            );
+        }
+    }
+}
