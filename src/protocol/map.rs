@@ -264,7 +264,9 @@ pub struct MapLimits {
 impl MapLimits {
     /// Bytes of a buffer that holds the largest map.
     pub const fn bytes(&self) -> usize {
-        (self.max_width as usize * self.max_height as usize).div_ceil(8)
+        (self.max_width as usize)
+            .saturating_mul(self.max_height as usize)
+            .div_ceil(8)
     }
 }
 
