@@ -136,7 +136,7 @@ def unframe(wire):
 
 # ---- messages --------------------------------------------------------------------------------
 
-PROTOCOL_VERSION = 2
+PROTOCOL_VERSION = 3
 ALGORITHMS = ["aca", "paca", "haca", "ohaca"]
 DEAD_ENDS = ["backtrack", "die"]
 SMOOTHING = ["none", "greedy", "shortest"]
@@ -144,7 +144,7 @@ ERRORS = {
     1: "BadMap", 2: "MapTooLarge", 3: "StartOutOfBounds", 4: "GoalOutOfBounds",
     5: "StartBlocked", 6: "GoalBlocked", 7: "BadParam", 8: "NoPath", 9: "Cancelled",
     10: "NoAntArrived", 16: "BadCrc", 17: "Undecodable", 18: "TooLarge", 19: "NoMap",
-    20: "Busy", 21: "BadChunk", 22: "Internal",
+    20: "Busy", 21: "BadChunk", 22: "Internal", 23: "BadRle", 24: "OutsideMap",
 }
 PARAM_FIELDS = [
     ("algorithm", "enum"), ("ants", "u"), ("iterations", "u"), ("alpha", "f"), ("beta", "f"),
@@ -377,8 +377,10 @@ def selftest(dev, map_path):
         expect(dev.call(req_plan((0, 0), (1, 1))), "Error", "NoMap")
 
     # Map uploads: too large, out-of-sequence chunk, then the real one in small chunks.
-    r = expect(dev.call(req_set_map(40, 40, 0, 200, b"\x00" * 16)), "Error", "MapTooLarge")
-    assert (r["detail"], r["limit"]) == (1600, hello["capacity"]["cells"]), r
+    wide = hello["capacity"]["max_width"] + 1
+    r = expect(dev.call(req_set_map(wide, 2, 0, (wide * 2 + 7) // 8, b"\x00" * 16)), "Error",
+               "MapTooLarge")
+    assert (r["detail"], r["limit"]) == (wide, wide - 1), r
     expect(dev.call(req_set_map(w, h, 5, len(bits), b"\x00")), "Error", "BadChunk")
     r = expect(dev.call(req_set_map(w, h, 0, 200, b"\x00" * 200)), "Error", "TooLarge")
     assert (r["detail"], r["limit"]) == (200, hello["capacity"]["max_chunk"]), r
@@ -474,7 +476,9 @@ def synthetic_maps():
     return [
         ("open-32x32", open32, (0, 0), (31, 31)),
         ("snake-32x32", snake, (0, 0), (0, 30)),
-        ("row-1024x1", ["." * 1024], (0, 0), (1023, 0)),
+        # The longest path that fits 1024 cells and 512 columns: along row 0, down at the
+        # right end, back along row 2 (681 cells).
+        ("zigzag-341x3", ["." * 341, "@" * 340 + ".", "." * 341], (0, 0), (0, 2)),
     ]
 
 

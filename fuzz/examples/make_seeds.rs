@@ -128,6 +128,63 @@ fn wire_frame_seeds(root: &Path) -> Result<Vec<(String, Vec<u8>)>> {
     ));
     out.push(("session-random32".into(), session));
 
+    // Protocol 3: a run-length upload of complex-26 in 16-byte chunks, cell updates, warm plan.
+    let cells = u32::from(complex.width) * u32::from(complex.height);
+    let code: Vec<u8> = ohaca::protocol::RleEncoder::new(&complex.bits, cells).collect();
+    let mut session = Vec::new();
+    for (k, c) in code.chunks(16).enumerate() {
+        session.extend(req(
+            20 + k as u32,
+            &Request::SetMapRle {
+                width: complex.width,
+                height: complex.height,
+                offset: (k * 16) as u32,
+                total_len: code.len() as u32,
+                chunk: c,
+            },
+        ));
+    }
+    session.extend(req(
+        60,
+        &Request::SetRect {
+            x: 3,
+            y: 4,
+            width: 5,
+            height: 2,
+            blocked: true,
+        },
+    ));
+    let pts = [Point::new(1, 1), Point::new(25, 25), Point::new(26, 0)];
+    session.extend(req(
+        61,
+        &Request::SetCells {
+            blocked: false,
+            cells: Waypoints::Points(&pts),
+        },
+    ));
+    session.extend(req(
+        62,
+        &Request::PlanWarm {
+            start: Point::new(0, 0),
+            goal: Point::new(25, 25),
+            seed: Some(3),
+        },
+    ));
+    out.push(("session-rle-updates".into(), session));
+    out.push((
+        "req-set-map-rle-bad".into(),
+        req(
+            70,
+            &Request::SetMapRle {
+                width: 4,
+                height: 3,
+                offset: 0,
+                total_len: 3,
+                chunk: &[5, 1, 7],
+            },
+        ),
+    ));
+
     // Replies, as the host reads them.
     let hello = HelloReply {
         protocol_version: VERSION,

@@ -14,15 +14,128 @@
 //!   decodes back;
 //! * a decoded message re-encodes (never larger than the original payload, so within the
 //!   protocol limits whenever the original was) and decodes back to the same value, bit for bit;
-//! * a decoded path reply streamed by [`PathStream`] gives exactly the bytes of [`encode_reply`].
+//! * a decoded path reply streamed by [`PathStream`] gives exactly the bytes of [`encode_reply`];
+//! * map uploads (raw and run-length) and cell updates go through the device's own state machine
+//!   ([`Upload`], [`set_rect`], [`set_cells`]) on a 512x512 buffer, kept across the frames of one
+//!   input as on the device: a completed map fits the limits, an accepted update did what it said.
 
 use core::fmt::Debug;
 
 use ohaca::protocol::{
-    decode_reply, decode_request, encode_reply, encode_request, DecodeError, EncodeError,
-    ErrorReply, PathStream, Reply, ReplyReader, Request, RequestReader, MAX_REPLY, MAX_REPLY_WIRE,
-    MAX_REQUEST, MAX_REQUEST_WIRE, UNKNOWN_ID,
+    decode_reply, decode_request, encode_reply, encode_request, set_cells, set_rect, DecodeError,
+    EncodeError, Encoding, ErrorReply, MapChunk, MapLimits, PathStream, Reply, ReplyReader,
+    Request, RequestReader, Upload, MAX_REPLY, MAX_REPLY_WIRE, MAX_REQUEST, MAX_REQUEST_WIRE,
+    UNKNOWN_ID,
 };
+use std::cell::RefCell;
+
+const LIMITS: MapLimits = MapLimits {
+    max_width: 512,
+    max_height: 512,
+};
+
+/// The device's map state for one fuzz input: the upload, the buffer, the map's size.
+struct MapState {
+    upload: Upload,
+    bits: Vec<u8>,
+    size: Option<(u16, u16)>,
+}
+
+thread_local! {
+    static MAP: RefCell<MapState> = RefCell::new(MapState {
+        upload: Upload::new(),
+        bits: vec![0; LIMITS.bytes()],
+        size: None,
+    });
+}
+
+fn bit(bits: &[u8], w: u16, x: u16, y: u16) -> bool {
+    let i = usize::from(y) * usize::from(w) + usize::from(x);
+    bits[i / 8] >> (i % 8) & 1 == 1
+}
+
+/// Apply a decoded request to the map state as `src/firmware/rx.rs` does.
+fn apply_map_request(req: &Request<'_>) {
+    MAP.with(|m| {
+        let m = &mut *m.borrow_mut();
+        let chunk = match *req {
+            Request::SetMap {
+                width,
+                height,
+                offset,
+                total_len,
+                chunk,
+            } => (Encoding::Raw, width, height, offset, total_len, chunk),
+            Request::SetMapRle {
+                width,
+                height,
+                offset,
+                total_len,
+                chunk,
+            } => (Encoding::Rle, width, height, offset, total_len, chunk),
+            Request::SetRect {
+                x,
+                y,
+                width,
+                height,
+                blocked,
+            } => {
+                if let Some(size) = m.size {
+                    if set_rect(size, &mut m.bits, (x, y, width, height), blocked).is_ok()
+                        && width > 0
+                        && height > 0
+                    {
+                        assert_eq!(bit(&m.bits, size.0, x, y), blocked);
+                        let (fx, fy) = (x + width - 1, y + height - 1);
+                        assert_eq!(bit(&m.bits, size.0, fx, fy), blocked);
+                    }
+                }
+                return;
+            }
+            Request::SetCells { blocked, cells } => {
+                if let Some(size) = m.size {
+                    if set_cells(size, &mut m.bits, &cells, blocked).is_ok() {
+                        for p in cells.iter() {
+                            assert_eq!(bit(&m.bits, size.0, p.x, p.y), blocked);
+                        }
+                    }
+                }
+                return;
+            }
+            _ => return,
+        };
+        let (encoding, width, height, offset, total_len, bytes) = chunk;
+        let c = MapChunk {
+            encoding,
+            width,
+            height,
+            offset,
+            total_len,
+            chunk: bytes,
+        };
+        match m.upload.accept(&c, LIMITS) {
+            Ok(start) => {
+                if start {
+                    m.size = None;
+                }
+                match m.upload.write(&c, &mut m.bits) {
+                    Ok(Some((w, h))) => {
+                        assert!(w <= 512 && h <= 512 && w > 0 && h > 0);
+                        assert!(!m.upload.is_open());
+                        m.size = Some((w, h));
+                    }
+                    Ok(None) => assert!(m.upload.is_open()),
+                    Err(e) => {
+                        let _ = format!("{e}");
+                    }
+                }
+            }
+            Err(e) => {
+                let _ = format!("{e}");
+            }
+        }
+    });
+}
 use ohaca::Point;
 use ohaca_host::link::{request_name, LinkError, Response};
 
@@ -177,6 +290,7 @@ fn check_request_frame(frame: &mut [u8]) -> bool {
             if let Request::SetParams(p) = req {
                 let _ = p.validate();
             }
+            apply_map_request(&req);
             let _ = request_name(&req);
             check_roundtrip(
                 id,
@@ -329,6 +443,12 @@ pub fn check_streams(data: &[u8]) -> (usize, usize) {
 
 /// The `frame` fuzz target.
 pub fn fuzz_wire_frame(data: &[u8]) {
+    // Every input starts on a device without a map.
+    MAP.with(|m| {
+        let m = &mut *m.borrow_mut();
+        m.upload = Upload::new();
+        m.size = None;
+    });
     check_streams(data);
 }
 

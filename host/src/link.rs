@@ -9,7 +9,9 @@
 //!   for (a late answer to a timed-out request, the device's `id 0` answers to frames it could
 //!   not read) are *strays*: skipped, counted and kept for the caller to report
 //!   ([`Link::take_strays`]).
-//! * Maps are uploaded in chunks of at most [`MAX_CHUNK`] bytes (less if the device says so).
+//! * Maps are uploaded in chunks of at most [`MAX_CHUNK`] bytes (less if the device says so),
+//!   run-length coded when that is shorter ([`Link::set_map`], [`MapCode`]), with up to
+//!   [`UPLOAD_WINDOW`] chunks in flight.
 //! * [`Link::plan_many`] pipelines plans, keeping up to the device's `plan_queue` in flight, and
 //!   returns the outcomes in request order.
 //! * Every failure is a [`LinkError`]: a timeout, a device error reply (with its code), a closed
@@ -37,8 +39,8 @@ use std::time::{Duration, Instant};
 use ohaca::grid::{DX, DY};
 use ohaca::protocol::{
     decode_reply, encode_request, Capacity, DecodeError, EncodeError, ErrorCode, ErrorReply,
-    HelloReply, PathReply, Reply, ReplyReader, Request, StatsReply, MAX_CHUNK, MAX_REPLY_WIRE,
-    MAX_REQUEST_WIRE, UNKNOWN_ID, VERSION,
+    HelloReply, PathReply, Reply, ReplyReader, Request, RleEncoder, StatsReply, Waypoints,
+    MAX_CHUNK, MAX_REPLY_WIRE, MAX_REQUEST_WIRE, MAX_UPDATE_CELLS, UNKNOWN_ID, VERSION,
 };
 use ohaca::{Params, Point};
 
@@ -49,6 +51,62 @@ pub const DEFAULT_TIMEOUT: Duration = Duration::from_secs(10);
 
 /// The serial line speed unless told otherwise (the firmware's UART: 115200 8N1).
 pub const DEFAULT_BAUD: u32 = 115_200;
+
+/// Map chunks in flight during an upload: 3 frames of at most ~150 bytes stay well within a
+/// board's 1 KiB receive ring (docs/FIRMWARE.md), and hide the round trip of each `Ack`.
+pub const UPLOAD_WINDOW: usize = 3;
+
+/// How a map goes on the wire: the packed bits (`SetMap`) or their run-length code
+/// (`SetMapRle`), whichever is shorter.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum MapCode {
+    /// The packed bits.
+    Raw(Vec<u8>),
+    /// The run-length code ([`RleEncoder`]).
+    Rle(Vec<u8>),
+}
+
+impl MapCode {
+    /// The shorter coding of `map`.
+    pub fn of(map: &Map) -> Self {
+        let cells = u32::from(map.width) * u32::from(map.height);
+        let rle: Vec<u8> = RleEncoder::new(&map.bits, cells).collect();
+        if rle.len() < map.bits.len() {
+            MapCode::Rle(rle)
+        } else {
+            MapCode::Raw(map.bits.clone())
+        }
+    }
+
+    /// The bytes uploaded.
+    pub fn bytes(&self) -> &[u8] {
+        match self {
+            MapCode::Raw(b) | MapCode::Rle(b) => b,
+        }
+    }
+
+    /// The request carrying `chunk` at `offset`.
+    fn request<'a>(&self, width: u16, height: u16, offset: usize, chunk: &'a [u8]) -> Request<'a> {
+        let offset = u32::try_from(offset).unwrap_or(u32::MAX);
+        let total_len = u32::try_from(self.bytes().len()).unwrap_or(u32::MAX);
+        match self {
+            MapCode::Raw(_) => Request::SetMap {
+                width,
+                height,
+                offset,
+                total_len,
+                chunk,
+            },
+            MapCode::Rle(_) => Request::SetMapRle {
+                width,
+                height,
+                offset,
+                total_len,
+                chunk,
+            },
+        }
+    }
+}
 
 /// Most stray frames kept for [`Link::take_strays`] (older ones are only counted).
 const MAX_STRAYS: usize = 64;
@@ -251,6 +309,10 @@ pub fn request_name(r: &Request<'_>) -> &'static str {
         Request::Plan { .. } => "Plan",
         Request::Cancel => "Cancel",
         Request::Stats => "Stats",
+        Request::SetMapRle { .. } => "SetMapRle",
+        Request::SetRect { .. } => "SetRect",
+        Request::SetCells { .. } => "SetCells",
+        Request::PlanWarm { .. } => "PlanWarm",
     }
 }
 
@@ -613,35 +675,99 @@ impl<T: Transport> Link<T> {
         }
     }
 
-    /// Upload `map` in chunks of at most [`MAX_CHUNK`] bytes (or the device's `max_chunk`, if
-    /// smaller). It becomes the active map when the last chunk is acknowledged.
+    /// Upload `map`, run-length coded if that is shorter ([`MapCode::of`]), in chunks of at most
+    /// [`MAX_CHUNK`] bytes (or the device's `max_chunk`, if smaller), [`UPLOAD_WINDOW`] in
+    /// flight. The device has no map from the first chunk on; `map` becomes its map when the
+    /// last chunk is acknowledged.
     pub fn set_map(&mut self, map: &Map) -> Result<(), LinkError> {
-        self.set_map_bits(map.width, map.height, &map.bits)
+        self.upload(map.width, map.height, &MapCode::of(map))
     }
 
-    /// [`Link::set_map`] from raw parts: `bits` packed as [`ohaca::grid`] stores them.
+    /// [`Link::set_map`] from raw parts, always as `SetMap`: `bits` packed as [`ohaca::grid`]
+    /// stores them (the device checks their length).
     pub fn set_map_bits(&mut self, width: u16, height: u16, bits: &[u8]) -> Result<(), LinkError> {
+        self.upload(width, height, &MapCode::Raw(bits.to_vec()))
+    }
+
+    /// Upload a map coded as `code`: its chunks, [`UPLOAD_WINDOW`] in flight. The first device
+    /// error ends the upload (the replies of the chunks behind it are awaited and dropped).
+    pub fn upload(&mut self, width: u16, height: u16, code: &MapCode) -> Result<(), LinkError> {
         let chunk = self
             .info
             .as_ref()
             .map_or(MAX_CHUNK, |i| usize::from(i.capacity.max_chunk))
             .clamp(1, MAX_CHUNK);
-        let total_len = u32::try_from(bits.len()).unwrap_or(u32::MAX);
+        let bytes = code.bytes();
+        let mut in_flight: VecDeque<(u32, &'static str)> = VecDeque::new();
+        let mut first_error = None;
         let mut offset = 0usize;
         // An empty map still goes out once, so the device says what is wrong with it.
         loop {
-            let end = (offset + chunk).min(bits.len());
-            self.call_ack(&Request::SetMap {
-                width,
-                height,
-                offset: u32::try_from(offset).unwrap_or(u32::MAX),
-                total_len,
-                chunk: bits.get(offset..end).unwrap_or(&[]),
-            })?;
+            let end = (offset + chunk).min(bytes.len());
+            let req = code.request(width, height, offset, bytes.get(offset..end).unwrap_or(&[]));
+            in_flight.push_back((self.send(&req)?, request_name(&req)));
             offset = end;
-            if offset >= bits.len() {
+            let last = offset >= bytes.len();
+            while in_flight.len() >= UPLOAD_WINDOW
+                || ((last || first_error.is_some()) && !in_flight.is_empty())
+            {
+                let (id, name) = in_flight.pop_front().unwrap_or((0, "SetMap"));
+                match self.wait_for(id, name)? {
+                    Response::Ack => {}
+                    other => {
+                        first_error.get_or_insert(unexpected(name, other));
+                    }
+                }
+            }
+            if let Some(e) = first_error {
+                return Err(e);
+            }
+            if last {
                 return Ok(());
             }
+        }
+    }
+
+    /// `SetRect`: block (`blocked`) or clear the cells of a rectangle of the device's map (its
+    /// running and queued plans are cancelled).
+    pub fn set_rect(
+        &mut self,
+        (x, y): (u16, u16),
+        (width, height): (u16, u16),
+        blocked: bool,
+    ) -> Result<(), LinkError> {
+        self.call_ack(&Request::SetRect {
+            x,
+            y,
+            width,
+            height,
+            blocked,
+        })
+    }
+
+    /// `SetCells`: block or clear a list of cells, in requests of at most
+    /// [`MAX_UPDATE_CELLS`] (each cancels the device's running and queued plans).
+    pub fn set_cells(&mut self, cells: &[Point], blocked: bool) -> Result<(), LinkError> {
+        for part in cells.chunks(MAX_UPDATE_CELLS) {
+            self.call_ack(&Request::SetCells {
+                blocked,
+                cells: Waypoints::Points(part),
+            })?;
+        }
+        Ok(())
+    }
+
+    /// `PlanWarm`: [`Link::plan`], asking the device to keep the colony of its previous plan to
+    /// the same goal (a device may plan cold).
+    pub fn plan_warm(
+        &mut self,
+        start: Point,
+        goal: Point,
+        seed: Option<u64>,
+    ) -> Result<DevicePath, LinkError> {
+        match self.call(&Request::PlanWarm { start, goal, seed })? {
+            Response::Path(p) => Ok(p),
+            other => Err(unexpected("PlanWarm", other)),
         }
     }
 
@@ -1046,7 +1172,7 @@ mod tests {
         assert_eq!(e.code(), Some(ErrorCode::MapTooLarge));
         assert_eq!(
             e.to_string(),
-            "device refused SetMap: map too large (1600 cells, capacity 1024) (error code 2)"
+            "device refused SetMapRle: map too large (1600 cells, capacity 1024) (error code 2)"
         );
     }
 
@@ -1077,14 +1203,140 @@ mod tests {
             }
             _ => vec![],
         });
-        // Without a Hello: MAX_CHUNK.
-        let m = Map::from_fn(32, 32, |x, y| x == y);
+        // Without a Hello: MAX_CHUNK. A checkerboard: its run-length code is longer, so raw.
+        let m = Map::from_fn(32, 32, |x, y| (x + y) % 2 == 0);
         link.set_map(&m).unwrap();
         assert_eq!(*chunks.borrow(), vec![(0, 128, MAX_CHUNK)]);
         chunks.borrow_mut().clear();
         link.hello().unwrap();
         link.set_map(&m).unwrap();
         assert_eq!(*chunks.borrow(), vec![(0, 128, 100), (100, 128, 28)]);
+    }
+
+    /// A fake device that applies uploads and cell updates with the protocol's own state
+    /// machine (`ohaca::protocol::Upload`), answering each chunk only when the next request
+    /// arrives or the window would stall, so the link's window is exercised.
+    #[test]
+    fn maps_go_run_length_coded_when_shorter_and_arrive_whole() {
+        use ohaca::protocol::{set_cells, set_rect, Encoding, MapChunk, MapLimits, Upload};
+        use std::cell::RefCell;
+        use std::rc::Rc;
+        let limits = MapLimits {
+            max_width: 512,
+            max_height: 512,
+        };
+        let state = Rc::new(RefCell::new((
+            Upload::new(),
+            vec![0u8; limits.bytes()],
+            None::<(u16, u16)>,
+            Vec::<&'static str>::new(),
+        )));
+        let st = state.clone();
+        let mut link = fake(move |id, req| {
+            let mut g = st.borrow_mut();
+            let (up, buf, size, log) = &mut *g;
+            log.push(request_name(&req));
+            let chunk = match req {
+                Request::SetMap {
+                    width,
+                    height,
+                    offset,
+                    total_len,
+                    chunk,
+                } => Some((Encoding::Raw, width, height, offset, total_len, chunk)),
+                Request::SetMapRle {
+                    width,
+                    height,
+                    offset,
+                    total_len,
+                    chunk,
+                } => Some((Encoding::Rle, width, height, offset, total_len, chunk)),
+                _ => None,
+            };
+            let r = if let Some((encoding, width, height, offset, total_len, chunk)) = chunk {
+                let c = MapChunk {
+                    encoding,
+                    width,
+                    height,
+                    offset,
+                    total_len,
+                    chunk,
+                };
+                up.accept(&c, limits).and_then(|start| {
+                    if start {
+                        *size = None;
+                    }
+                    up.write(&c, buf).map(|done| {
+                        if done.is_some() {
+                            *size = done;
+                        }
+                    })
+                })
+            } else {
+                match (req, *size) {
+                    (
+                        Request::SetRect {
+                            x,
+                            y,
+                            width,
+                            height,
+                            blocked,
+                        },
+                        Some(sz),
+                    ) => set_rect(sz, buf, (x, y, width, height), blocked),
+                    (Request::SetCells { blocked, cells }, Some(sz)) => {
+                        set_cells(sz, buf, &cells, blocked)
+                    }
+                    _ => Err(ErrorReply::new(ErrorCode::NoMap)),
+                }
+            };
+            vec![(
+                id,
+                match r {
+                    Ok(()) => Response::Ack,
+                    Err(e) => Response::Error(e),
+                },
+            )]
+        });
+        // A 256x256 map of long runs: run-length coded, far fewer bytes than 8 KiB.
+        let m = Map::from_fn(256, 256, |x, y| (x / 16 + y / 32) % 3 == 0 && y % 7 != 0);
+        let code = MapCode::of(&m);
+        assert!(matches!(code, MapCode::Rle(_)));
+        assert!(
+            code.bytes().len() < m.bits.len() / 2,
+            "{}",
+            code.bytes().len()
+        );
+        link.set_map(&m).unwrap();
+        {
+            let g = state.borrow();
+            assert_eq!(g.2, Some((256, 256)));
+            assert!(
+                (0..65536).all(|i| (g.1[i / 8] >> (i % 8)) & 1 == (m.bits[i / 8] >> (i % 8)) & 1)
+            );
+            assert!(g.3.iter().all(|n| *n == "SetMapRle"));
+            assert_eq!(g.3.len(), code.bytes().len().div_ceil(MAX_CHUNK));
+        }
+        // Cell updates change the device's map.
+        link.set_rect((1, 1), (3, 2), true).unwrap();
+        let many: Vec<Point> = (0..130).map(|i| Point::new(i, 200)).collect();
+        link.set_cells(&many, true).unwrap();
+        {
+            let g = state.borrow();
+            let at = |x: usize, y: usize| (g.1[(y * 256 + x) / 8] >> ((y * 256 + x) % 8)) & 1 == 1;
+            assert!(at(1, 1) && at(3, 2) && at(129, 200));
+            // 130 cells went as 60 + 60 + 10.
+            assert_eq!(g.3.iter().filter(|n| **n == "SetCells").count(), 3);
+        }
+        let e = link.set_rect((250, 0), (10, 1), false).unwrap_err();
+        assert_eq!(e.code(), Some(ErrorCode::OutsideMap));
+        // A broken run-length code: the error of its chunk, and no stray afterwards.
+        let bad = MapCode::Rle(vec![0xFF; 300]);
+        let e = link.upload(16, 16, &bad).unwrap_err();
+        assert_eq!(e.code(), Some(ErrorCode::BadRle), "{e}");
+        assert_eq!(state.borrow().2, None);
+        assert_eq!(link.stray_count(), 0);
+        assert!(link.outstanding.is_empty());
     }
 
     #[test]
@@ -1191,5 +1443,69 @@ mod tests {
         );
         assert!(raw_path(Point::new(0, 0), &[8]).is_err());
         assert!(raw_path(Point::new(0, 0), &[4]).is_err());
+    }
+}
+
+/// Upload sizes of real maps, raw against run-length coded, in bytes on the wire (frames
+/// included) and seconds at 115200 baud: `cargo test --release -p ohaca-host --target
+/// host-tuple --lib upload_sizes -- --ignored --nocapture` (needs `../shared/maps/large`).
+#[cfg(test)]
+mod upload_sizes {
+    use super::*;
+    use std::path::Path;
+
+    /// Bytes on the wire of `code`'s upload: every frame, delimiters included, ids from 2.
+    fn wire_bytes(w: u16, h: u16, code: &MapCode) -> (usize, usize) {
+        let b = code.bytes();
+        let mut total = 0;
+        let mut frames = 0;
+        let mut buf = [0u8; MAX_REQUEST_WIRE];
+        for (k, c) in b.chunks(MAX_CHUNK).enumerate() {
+            let req = code.request(w, h, k * MAX_CHUNK, c);
+            total += encode_request(2 + k as u32, &req, &mut buf).unwrap();
+            frames += 1;
+        }
+        (total, frames)
+    }
+
+    #[test]
+    #[ignore = "prints upload sizes of the shared large maps and lab.yaml"]
+    fn print_upload_sizes() {
+        let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+        let mut maps: Vec<(String, Map)> = vec![];
+        let lab = root.join("host/assets/ros/lab.yaml");
+        let (m, _) = crate::input::prepare_map(&lab, Default::default(), Some(0.2), None).unwrap();
+        maps.push(("lab.yaml (5 cm, inflated 0.2 m)".into(), m));
+        let large = root.join("../shared/maps/large");
+        let mut names: Vec<_> = std::fs::read_dir(&large)
+            .map(|d| d.filter_map(|e| e.ok()).map(|e| e.path()).collect())
+            .unwrap_or_default();
+        names.retain(|p| p.extension().is_some_and(|e| e == "map"));
+        names.sort();
+        for p in names {
+            if let Ok(m) = Map::load(&p) {
+                if m.width <= 512 && m.height <= 512 {
+                    maps.push((p.file_name().unwrap().to_string_lossy().into(), m));
+                }
+            }
+        }
+        println!("| map | cells | packed | run-length code | on the wire (RLE) | frames | at 115200 baud | raw upload at 115200 |");
+        println!("| --- | --- | --- | --- | --- | --- | --- | --- |");
+        for (name, m) in maps {
+            let cells = u32::from(m.width) * u32::from(m.height);
+            let rle: Vec<u8> = RleEncoder::new(&m.bits, cells).collect();
+            let (wr, fr) = wire_bytes(m.width, m.height, &MapCode::Rle(rle.clone()));
+            let (ww, _) = wire_bytes(m.width, m.height, &MapCode::Raw(m.bits.clone()));
+            println!(
+                "| {name} | {}x{} | {} | {} ({:.1} %) | {wr} | {fr} | {:.2} s | {:.2} s |",
+                m.width,
+                m.height,
+                m.bits.len(),
+                rle.len(),
+                100.0 * rle.len() as f64 / m.bits.len() as f64,
+                wr as f64 / 11520.0,
+                ww as f64 / 11520.0
+            );
+        }
     }
 }

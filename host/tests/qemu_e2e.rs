@@ -503,18 +503,35 @@ fn refusals_no_map_map_too_large_busy_and_cancel() {
     let e = error_code(link.plan(Point::new(0, 0), Point::new(1, 1), None));
     assert_eq!(e.code, ErrorCode::NoMap, "{e}");
 
-    // A map one row and column larger than the capacity's square.
-    let side = (1..).find(|s: &u32| s * s > cells).expect("a side") as u16;
-    let big = Map::from_fn(side, side, |_, _| false);
-    let e = error_code(link.set_map(&big));
+    // A map one column wider than the device holds.
+    let wide = Map::from_fn(info.capacity.max_width + 1, 2, |_, _| false);
+    let e = error_code(link.set_map(&wide));
+    let w = info.capacity.max_width;
     assert_eq!(
         e,
-        ErrorReply::with(
-            ErrorCode::MapTooLarge,
-            u32::from(side) * u32::from(side),
-            cells
-        )
+        ErrorReply::with(ErrorCode::MapTooLarge, u32::from(w) + 1, u32::from(w))
     );
+    // A map the device holds but plans on only if it has as many cells: a square one cell
+    // larger than `cells` is refused when planned on (and no map is left for the next check).
+    let side = (1..).find(|s: &u32| s * s > cells).expect("a side") as u16;
+    if side <= w {
+        let big = Map::from_fn(side, side, |_, _| false);
+        link.set_map(&big).expect("held");
+        let e = error_code(link.plan(Point::new(0, 0), Point::new(1, 1), None));
+        let n = u32::from(side) * u32::from(side);
+        assert_eq!(e, ErrorReply::with(ErrorCode::MapTooLarge, n, cells));
+    }
+    // An upload left unfinished: the device has no map from its first chunk on.
+    let first = link.call(&Request::SetMap {
+        width: 100,
+        height: 100,
+        offset: 0,
+        total_len: 1250,
+        chunk: &[0; MAX_CHUNK],
+    });
+    assert_eq!(first.expect("first chunk"), Response::Ack);
+    let e = error_code(link.plan(Point::new(0, 0), Point::new(1, 1), None));
+    assert_eq!(e.code, ErrorCode::NoMap, "{e}");
     // A wrong total_len, and a chunk that does not continue an upload.
     let e = error_code(link.set_map_bits(10, 10, &[0; 3]));
     assert_eq!(e, ErrorReply::with(ErrorCode::BadMap, 3, 13));
@@ -621,11 +638,10 @@ fn refusals_no_map_map_too_large_busy_and_cancel() {
     assert_eq!(link.stray_count(), 0, "{:?}", link.take_strays());
 }
 
-/// `docs/PROTOCOL.md`, SetMap: "Activating a map cancels every plan received before it: the
-/// running one and the queued ones are answered with `Error Cancelled`; plans received
-/// afterwards use the new map." An upload's first chunk changes nothing (the old map stays in
-/// force and the plan keeps running); a plan received between the first and the last chunk is
-/// for the old map, so it is cancelled too.
+/// `docs/PROTOCOL.md`, SetMap: "The device holds one map: an upload's first chunk drops the
+/// previous map and cancels every plan received before it (the running one and the queued ones
+/// are answered with `Error Cancelled`); from then until the last byte arrives the device has no
+/// map (plans get `NoMap`, `Stats` reports 0 x 0). Plans received afterwards use the new map."
 #[test]
 fn a_new_map_cancels_running_and_queued_plans_and_later_plans_use_it() {
     need_qemu!();
@@ -673,20 +689,12 @@ fn a_new_map_cancels_running_and_queued_plans_and_later_plans_use_it() {
             chunk: bytes,
         }
     }
-    let ack = link
-        .call(&chunk(&new, 0, &new.bits[..half]))
+    let first = link
+        .send(&chunk(&new, 0, &new.bits[..half]))
         .expect("first chunk");
-    assert_eq!(ack, Response::Ack);
-    let st = link.stats().expect("stats");
-    assert_eq!((st.map_width, st.map_height), (26, 26), "{st:?}");
-    assert!(st.planning && st.queued == 2 && st.cancelled == 0, "{st:?}");
-    let between = plan(&mut link, 4);
-    let last = link
-        .send(&chunk(&new, half, &new.bits[half..]))
-        .expect("last chunk");
-    // The map's Ack may come before or after the Cancelled errors: wait for each by id.
-    assert_eq!(link.wait_for(last, "SetMap").expect("ack"), Response::Ack);
-    for id in [running, queued[0], queued[1], between] {
+    // The chunk's Ack may come before or after the Cancelled errors: wait for each by id.
+    assert_eq!(link.wait_for(first, "SetMap").expect("ack"), Response::Ack);
+    for id in [running, queued[0], queued[1]] {
         let r = link.wait_for(id, "Plan").expect("cancelled");
         assert_eq!(
             r,
@@ -695,11 +703,24 @@ fn a_new_map_cancels_running_and_queued_plans_and_later_plans_use_it() {
         );
     }
     let st = link.stats().expect("stats");
+    assert_eq!((st.map_width, st.map_height), (0, 0), "{st:?}");
+    assert!(
+        !st.planning && st.queued == 0 && st.cancelled == 3,
+        "{st:?}"
+    );
+    let between = plan(&mut link, 4);
+    let r = link.wait_for(between, "Plan").expect("no map");
+    assert_eq!(r, Response::Error(ErrorReply::new(ErrorCode::NoMap)));
+    let last = link
+        .call(&chunk(&new, half, &new.bits[half..]))
+        .expect("last chunk");
+    assert_eq!(last, Response::Ack);
+    let st = link.stats().expect("stats");
     assert_eq!((st.map_width, st.map_height), (20, 20), "{st:?}");
     assert!(!st.planning && st.queued == 0, "{st:?}");
     assert_eq!(
         (st.cancelled, st.plans, st.plan_errors),
-        (4, 0, 0),
+        (3, 0, 0),
         "{st:?}"
     );
 
@@ -1308,5 +1329,180 @@ fn set_map_chunks_are_refused_as_the_document_says() {
         call(&mut link, &chunk(w, h, half, total, &[])),
         err(ErrorCode::BadChunk, 0, 0)
     );
+    assert_eq!(link.stray_count(), 0, "{:?}", link.take_strays());
+}
+
+// ---- big maps and cell updates (docs/PROTOCOL.md, "Big maps and cell updates") ------------
+
+/// Block (or clear) one cell of a host map.
+fn set_cell(map: &mut Map, p: Point, blocked: bool) {
+    let i = usize::from(p.y) * usize::from(map.width) + usize::from(p.x);
+    if blocked {
+        map.bits[i / 8] |= 1 << (i % 8);
+    } else {
+        map.bits[i / 8] &= !(1 << (i % 8));
+    }
+}
+
+/// A 256x256 map of city blocks: long runs, as real maps have.
+fn blocks_256() -> Map {
+    Map::from_fn(256, 256, |x, y| {
+        (x % 32 >= 6 && y % 24 >= 5) && !(x % 32 == 19 || y % 24 == 14)
+    })
+}
+
+/// A 256x256 map goes up run-length coded in chunks, the device reports its size, and a plan on
+/// it is answered as the device's `cells` allows (a path, or `MapTooLarge` with the numbers).
+/// The upload's bytes and time are printed (`--nocapture`), not asserted.
+#[test]
+fn a_256x256_map_goes_up_run_length_coded() {
+    need_qemu!();
+    let q = Qemu::tcp();
+    let mut link = q.link();
+    let info = link.hello().expect("hello");
+    let map = blocks_256();
+    let code = ohaca_host::link::MapCode::of(&map);
+    assert!(matches!(code, ohaca_host::link::MapCode::Rle(_)));
+    let t0 = Instant::now();
+    link.set_map(&map).expect("upload");
+    let took = t0.elapsed();
+    let frames = code.bytes().len().div_ceil(MAX_CHUNK);
+    println!(
+        "256x256: {} bytes packed, {} bytes run-length coded, {frames} chunks, {:.0} ms over QEMU's UART",
+        map.bits.len(),
+        code.bytes().len(),
+        took.as_secs_f64() * 1e3
+    );
+    let st = link.stats().expect("stats");
+    assert_eq!((st.map_width, st.map_height), (256, 256), "{st:?}");
+    assert_eq!(st.frames_bad, 0);
+    let (s, g) = (Point::new(0, 0), Point::new(255, 255));
+    let cells = info.capacity.cells;
+    match link.plan(s, g, None) {
+        Ok(dev) if cells >= 65536 => {
+            let host = core_plan(&map, s, g, &Params::default()).expect("host plan");
+            assert_core_path("256x256", &host, &dev);
+        }
+        r => {
+            let e = error_code(r);
+            assert_eq!(e, ErrorReply::with(ErrorCode::MapTooLarge, 65536, cells));
+        }
+    }
+    // A broken run-length code: BadRle, and no map is left.
+    let e = error_code(link.upload(16, 16, &ohaca_host::link::MapCode::Rle(vec![200, 2])));
+    assert_eq!(e, ErrorReply::with(ErrorCode::BadRle, 0, 256));
+    let st = link.stats().expect("stats");
+    assert_eq!((st.map_width, st.map_height), (0, 0), "{st:?}");
+    assert_eq!(link.stray_count(), 0, "{:?}", link.take_strays());
+}
+
+/// Cell updates between plans change the device's answer, exactly as the same change does on
+/// the host: a wall across the map makes the goal unreachable (`NoPath`), a gap opened in it
+/// makes it reachable again, through the gap; `PlanWarm` answers as `Plan` (this firmware plans
+/// it cold). Updates outside the map change nothing.
+#[test]
+fn cell_updates_between_plans_change_the_answer() {
+    need_qemu!();
+    let q = Qemu::tcp();
+    let mut link = q.link();
+    link.hello().expect("hello");
+    let mut map = Map::from_fn(20, 20, |_, _| false);
+    link.set_map(&map).expect("set map");
+    let (s, g) = (Point::new(0, 10), Point::new(19, 10));
+    let p = Params::default();
+    link.plan(s, g, None).expect("open map");
+
+    // A wall at x = 10, the whole height.
+    link.set_rect((10, 0), (1, 20), true).expect("wall");
+    let e = error_code(link.plan(s, g, None));
+    assert_eq!(e.code, ErrorCode::NoPath, "{e}");
+    // Outside: refused, and nothing changed.
+    let e = error_code(link.set_rect((10, 15), (1, 6), false));
+    assert_eq!(e, ErrorReply::with(ErrorCode::OutsideMap, 10, 20));
+    let e = error_code(link.set_cells(&[Point::new(10, 3), Point::new(20, 3)], false));
+    assert_eq!(e, ErrorReply::with(ErrorCode::OutsideMap, 20, 3));
+    let e = error_code(link.plan_warm(s, g, None));
+    assert_eq!(e.code, ErrorCode::NoPath, "{e}");
+
+    // A gap at (10, 3): reachable, through the gap, bit-identical to the host on that map.
+    link.set_cells(&[Point::new(10, 3)], false).expect("gap");
+    for y in 0..20 {
+        set_cell(&mut map, Point::new(10, y), y != 3);
+    }
+    let host = core_plan(&map, s, g, &p).expect("host plan");
+    let dev = link.plan(s, g, None).expect("through the gap");
+    assert_core_path("through the gap", &host, &dev);
+    assert!(dev.raw(s).expect("raw").contains(&Point::new(10, 3)));
+    let warm = link.plan_warm(s, g, None).expect("warm");
+    assert_core_path("warm = cold", &host, &warm);
+    let st = link.stats().expect("stats");
+    assert_eq!(
+        (st.plans, st.plan_errors, st.cancelled),
+        (3, 2, 0),
+        "{st:?}"
+    );
+    assert_eq!(link.stray_count(), 0, "{:?}", link.take_strays());
+}
+
+/// `docs/PROTOCOL.md`: "a cell update cancels the running plan and the queued ones (`Error
+/// Cancelled`), then changes the map"; plans received after it plan on the changed map.
+#[test]
+fn a_cell_update_during_a_plan_cancels_it() {
+    need_qemu!();
+    let q = Qemu::tcp();
+    let mut link = q.link();
+    link.hello().expect("hello");
+    let map = load("complex-26.map");
+    link.set_map(&map).expect("set map");
+    let slow = Params {
+        iterations: 60_000,
+        patience: 0,
+        ..Params::default()
+    };
+    link.set_params(&slow).expect("set params");
+    let (s, g) = (Point::new(0, 0), Point::new(25, 25));
+    let plan = |link: &mut Link<_>| {
+        link.send(&Request::Plan {
+            start: s,
+            goal: g,
+            seed: None,
+        })
+        .expect("send")
+    };
+    let running = plan(&mut link);
+    let t0 = Instant::now();
+    while !link.stats().expect("stats").planning {
+        assert!(t0.elapsed() < TIMEOUT, "the plan never started");
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    let queued = plan(&mut link);
+    // Block the goal's neighbours but one: the update is acknowledged, both plans cancelled.
+    let wall = [Point::new(24, 24), Point::new(24, 25)];
+    let upd = link
+        .send(&Request::SetCells {
+            blocked: true,
+            cells: ohaca::protocol::Waypoints::Points(&wall),
+        })
+        .expect("send update");
+    assert_eq!(link.wait_for(upd, "SetCells").expect("ack"), Response::Ack);
+    for id in [running, queued] {
+        let r = link.wait_for(id, "Plan").expect("cancelled");
+        assert_eq!(
+            r,
+            Response::Error(ErrorReply::new(ErrorCode::Cancelled)),
+            "{id}"
+        );
+    }
+    // The next plan runs on the changed map.
+    link.set_params(&Params::default()).expect("params");
+    let mut changed = map.clone();
+    for p in wall {
+        set_cell(&mut changed, p, true);
+    }
+    let host = core_plan(&changed, s, g, &Params::default()).expect("host");
+    let dev = link.plan(s, g, None).expect("plan after the update");
+    assert_core_path("after the update", &host, &dev);
+    let st = link.stats().expect("stats");
+    assert_eq!((st.cancelled, st.plans), (2, 1), "{st:?}");
     assert_eq!(link.stray_count(), 0, "{:?}", link.take_strays());
 }

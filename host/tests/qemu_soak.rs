@@ -228,14 +228,14 @@ struct Upload {
 
 /// The device's receive task (`src/firmware/rx.rs`, `Session`) and counters, on the host.
 struct Session {
-    cells: u32,
-    map_bytes: usize,
+    max_width: u16,
+    max_height: u16,
     frames_ok: u32,
     frames_bad: u32,
     params: Params,
     upload: Option<Upload>,
     map: Option<Rc<Map>>,
-    /// Bumped by `Cancel` and by every new map.
+    /// Bumped by `Cancel` and by every map upload's first chunk.
     generation: u32,
 }
 
@@ -289,6 +289,7 @@ impl Session {
                 self.generation += 1;
                 Want::Exact(Response::Ack)
             }
+            other => panic!("the soak does not send {other:?}"),
         };
         Event::Rx { id, want }
     }
@@ -310,8 +311,15 @@ impl Session {
             if cells == 0 {
                 return error(ErrorCode::BadMap, 0, 0);
             }
-            if cells > self.cells {
-                return error(ErrorCode::MapTooLarge, cells, self.cells);
+            if width > self.max_width {
+                return error(ErrorCode::MapTooLarge, width.into(), self.max_width.into());
+            }
+            if height > self.max_height {
+                return error(
+                    ErrorCode::MapTooLarge,
+                    height.into(),
+                    self.max_height.into(),
+                );
             }
             let want = cells.div_ceil(8);
             if total_len != want {
@@ -322,7 +330,7 @@ impl Session {
                 height,
                 total_len,
                 received: 0,
-                bits: vec![0; self.map_bytes],
+                bits: vec![0; total_len as usize],
             });
         }
         let Some(up) = self.upload.as_mut() else {
@@ -338,6 +346,11 @@ impl Session {
             return error(ErrorCode::BadChunk, up.received, up.total_len);
         };
         slot.copy_from_slice(chunk);
+        if offset == 0 {
+            // The device holds one map: an upload's first chunk drops it and cancels the plans.
+            self.map = None;
+            self.generation += 1;
+        }
         up.received = up.received.max(end);
         if up.received == up.total_len {
             let map = Map {
@@ -346,7 +359,6 @@ impl Session {
                 bits: up.bits[..up.total_len as usize].to_vec(),
             };
             self.upload = None;
-            self.generation += 1;
             self.map = Some(Rc::new(map));
         }
         Want::Exact(Response::Ack)
@@ -638,7 +650,12 @@ impl Soak {
             };
             return match r.below(5) {
                 0 => {
-                    let (w, h) = (r.range(33, 200) as u16, r.range(33, 200) as u16);
+                    // A side over the device's 512.
+                    let (w, h) = if r.chance(0.5) {
+                        (r.range(513, 2000) as u16, r.range(1, 100) as u16)
+                    } else {
+                        (r.range(1, 100) as u16, r.range(513, 2000) as u16)
+                    };
                     let t = (u32::from(w) * u32::from(h)).div_ceil(8);
                     encode(id, &req(w, h, 0, t, &chunk))
                 }
@@ -1111,8 +1128,8 @@ fn soak_thousands_of_valid_and_broken_frames() {
         model: Model {
             reader: Box::new(RequestReader::new()),
             session: Session {
-                cells: cap.cells,
-                map_bytes: (cap.cells as usize).div_ceil(8),
+                max_width: cap.max_width,
+                max_height: cap.max_height,
                 frames_ok: 0,
                 frames_bad: 0,
                 params: info.defaults,

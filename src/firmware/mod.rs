@@ -2,10 +2,12 @@
 //! [`ohaca::protocol`] over a UART.
 //!
 //! ```text
-//!   UART rx --> [rx task] --decode--> Hello / Stats / SetParams / SetMap / Cancel: answered here
-//!                  |                  Plan: queued (JOBS, 4 deep; full -> Busy)
+//!   UART rx --> [rx task] --decode--> Hello / Stats / SetParams / Cancel: answered here
+//!                  |                  SetMap(Rle) / SetRect / SetCells: cancel, lock MAP, write
+//!                  |                  Plan / PlanWarm: queued (JOBS, 4 deep; full -> Busy)
 //!                  v
-//!              [planner task] one Run::step() per iteration, then yield; checks for cancellation
+//!              [planner task] holds MAP's lock for a plan; one Run::step() per iteration, then
+//!                  |            yield; checks for cancellation (then releases MAP)
 //!                  |            path frames: streamed into the UART a piece at a time --+
 //!                  v                                                                     |
 //!   UART tx <-- [tx task] <-- OUT channel (small replies by value)  <--------------------+
@@ -27,9 +29,10 @@ use static_cell::{ConstStaticCell, StaticCell};
 use board::Board;
 use ohaca::planner::Storage;
 
-/// The planner's workspace: maps of up to [`state::CELLS`] cells (zero-initialised, so it lives
-/// in `.bss`).
-static STORAGE: ConstStaticCell<Storage<{ state::CELLS }>> = ConstStaticCell::new(Storage::new());
+/// The planner's workspace: maps of up to [`state::PLAN_CELLS`] cells (zero-initialised, so it
+/// lives in `.bss`).
+static STORAGE: ConstStaticCell<Storage<{ state::PLAN_CELLS }>> =
+    ConstStaticCell::new(Storage::new());
 
 /// The UART's transmitting half, shared by the transmitter and the planner.
 static TX: StaticCell<state::TxPort> = StaticCell::new();
@@ -43,12 +46,15 @@ pub fn run(spawner: Spawner) {
     let (rx, tx) = board::Active::init();
     let boots = state::count_boot();
     defmt::info!(
-        "ohaca {} on {}: boot {}, {} cells, storage {} bytes",
+        "ohaca {} on {}: boot {}, maps up to {}x{} ({} bytes), plans on {} cells, storage {} bytes",
         env!("CARGO_PKG_VERSION"),
         board::Active::NAME,
         boots,
-        state::CELLS,
-        core::mem::size_of::<Storage<{ state::CELLS }>>()
+        state::MAX_WIDTH,
+        state::MAX_HEIGHT,
+        state::MAP_BYTES,
+        state::PLAN_CELLS,
+        core::mem::size_of::<Storage<{ state::PLAN_CELLS }>>()
     );
     defmt::info!(
         "stack: {} bytes (RAM above the statics), {} used at boot",

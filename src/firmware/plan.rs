@@ -1,7 +1,9 @@
 //! The planning task: takes plan requests from the queue and runs them one iteration at a time,
 //! yielding to the executor after every iteration so frames keep arriving and `Cancel` works.
 //! A path is streamed into the UART as it is encoded ([`PathStream`]), a piece at a time: no
-//! buffer for a whole frame (up to 5 KiB).
+//! buffer for a whole frame (up to 5 KiB). The planner reads the map in place: it holds
+//! [`MAP`]'s lock from `Run::new` to `Run::finish`, and a writer (a map upload, a cell update)
+//! cancels the plan first, so it gives the lock up at its next yield.
 
 use core::sync::atomic::Ordering;
 
@@ -14,14 +16,14 @@ use ohaca::planner::{Run, Storage};
 use ohaca::protocol::{ErrorCode, ErrorReply, PathReply, PathStream, Reply, Waypoints};
 
 use super::stack;
-use super::state::{self, count, Job, TxPort, CELLS, JOBS, MAP, PLANNING};
+use super::state::{self, count, Job, TxPort, JOBS, MAP, PLANNING, PLAN_CELLS};
 use super::tx::sent_one;
 
 /// Bytes of a path frame encoded per write to the UART.
 const PIECE: usize = 64;
 
 #[embassy_executor::task]
-pub async fn planner_task(storage: &'static mut Storage<CELLS>, port: &'static TxPort) {
+pub async fn planner_task(storage: &'static mut Storage<PLAN_CELLS>, port: &'static TxPort) {
     loop {
         let job = JOBS.receive().await;
         PLANNING.store(true, Ordering::Relaxed);
@@ -48,7 +50,7 @@ pub async fn planner_task(storage: &'static mut Storage<CELLS>, port: &'static T
 
 /// Run one job and send its path; returns the ticks it took.
 async fn plan(
-    storage: &mut Storage<CELLS>,
+    storage: &mut Storage<PLAN_CELLS>,
     job: &Job,
     port: &'static TxPort,
 ) -> Result<u64, ErrorReply> {
@@ -56,11 +58,17 @@ async fn plan(
     if state::cancelled(job.generation) {
         return Err(cancelled());
     }
-    // A private copy: the receiver may switch maps while this plan runs (and cancels it then).
-    let map = MAP
-        .lock(|m| m.get())
-        .ok_or(ErrorReply::new(ErrorCode::NoMap))?;
-    let grid = Grid::new(map.width, map.height, &map.bits)?;
+    // The map, in place. A writer cancels before it waits for the lock, so check again once
+    // it is ours: a plan never starts on a map that changed after it was received.
+    let map = MAP.lock().await;
+    if state::cancelled(job.generation) {
+        return Err(cancelled());
+    }
+    let (width, height) = state::map_size().ok_or(ErrorReply::new(ErrorCode::NoMap))?;
+    let grid = Grid::new(width, height, &map[..])?;
+    if job.warm {
+        defmt::debug!("plan {}: warm start asked, planned cold", job.id);
+    }
     let t0 = Instant::now();
     let mut run = Run::new(&grid, job.start, job.goal, &job.params, storage.workspace())?;
     let t_new = Instant::now();
@@ -86,6 +94,8 @@ async fn plan(
     let t_finish = Instant::now();
     let plan = run.finish()?;
     let t_end = Instant::now();
+    // The path is in `storage`: the map is free for writers while it is sent.
+    drop(map);
     let ticks = t_end.saturating_duration_since(t0).as_ticks();
     defmt::info!(
         "plan {}: {} iterations, length {}, {} waypoints, {} ticks (new {}, steps {}, finish {})",

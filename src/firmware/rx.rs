@@ -1,5 +1,8 @@
 //! The receive task: splits the UART stream into frames, decodes them, answers everything but
-//! `Plan` at once and queues plans for the planner.
+//! plans at once and queues plans for the planner. Map uploads and cell updates are written into
+//! the one map buffer ([`MAP`]): checked first (a refused one changes nothing), then the running
+//! and queued plans are cancelled, then the buffer's lock is taken (the planner gives it up at
+//! its next yield).
 
 use embassy_futures::yield_now;
 use embassy_sync::channel::TrySendError;
@@ -8,13 +11,15 @@ use embedded_io_async::Read;
 use ohaca::grid::Point;
 use ohaca::planner::Params;
 use ohaca::protocol::{
-    decode_request, Capacity, ErrorCode, ErrorReply, HelloReply, Reply, Request, RequestReader,
-    MAX_CHUNK, MAX_REQUEST, MAX_REQUEST_WIRE, VERSION,
+    check_cells, check_rect, decode_request, set_cells, set_rect, Capacity, Encoding, ErrorCode,
+    ErrorReply, HelloReply, MapChunk, Reply, Request, RequestReader, Upload, Waypoints, MAX_CHUNK,
+    MAX_REQUEST, MAX_REQUEST_WIRE, VERSION,
 };
 
 use super::board::{self, Board};
 use super::state::{
-    self, count, reply, ActiveMap, Job, CELLS, GENERATION, JOBS, MAP, MAP_BYTES, PLAN_QUEUE,
+    self, count, reply, Job, GENERATION, JOBS, LIMITS, MAP, MAX_CELLS, MAX_HEIGHT, MAX_WIDTH,
+    PLAN_CELLS, PLAN_QUEUE,
 };
 
 #[embassy_executor::task]
@@ -52,19 +57,16 @@ pub async fn rx_task(mut rx: board::Rx) {
     }
 }
 
-/// A map upload in progress.
-struct Upload {
-    width: u16,
-    height: u16,
-    total_len: u32,
-    received: u32,
-    bits: [u8; MAP_BYTES],
-}
-
 /// What the receiver keeps between requests.
 struct Session {
     params: Params,
-    upload: Option<Upload>,
+    upload: Upload,
+}
+
+/// A cell update: a rectangle or a list.
+enum Update<'a> {
+    Rect(u16, u16, u16, u16),
+    Cells(Waypoints<'a>),
 }
 
 fn error(code: ErrorCode, detail: u32, limit: u32) -> Reply<'static> {
@@ -77,9 +79,9 @@ fn hello() -> HelloReply<'static> {
         firmware_version: env!("CARGO_PKG_VERSION"),
         board: board::Active::NAME,
         capacity: Capacity {
-            cells: CELLS as u32,
-            max_width: CELLS as u16,
-            max_height: CELLS as u16,
+            cells: PLAN_CELLS.min(MAX_CELLS) as u32,
+            max_width: MAX_WIDTH,
+            max_height: MAX_HEIGHT,
             max_chunk: MAX_CHUNK as u16,
             max_request: MAX_REQUEST as u16,
             plan_queue: PLAN_QUEUE as u8,
@@ -93,7 +95,7 @@ impl Session {
     fn new() -> Self {
         Session {
             params: Params::default(),
-            upload: None,
+            upload: Upload::new(),
         }
     }
 
@@ -106,7 +108,42 @@ impl Session {
                 offset,
                 total_len,
                 chunk,
-            } => self.set_map(width, height, offset, total_len, chunk),
+            } => {
+                let c = MapChunk {
+                    encoding: Encoding::Raw,
+                    width,
+                    height,
+                    offset,
+                    total_len,
+                    chunk,
+                };
+                self.set_map(&c).await
+            }
+            Request::SetMapRle {
+                width,
+                height,
+                offset,
+                total_len,
+                chunk,
+            } => {
+                let c = MapChunk {
+                    encoding: Encoding::Rle,
+                    width,
+                    height,
+                    offset,
+                    total_len,
+                    chunk,
+                };
+                self.set_map(&c).await
+            }
+            Request::SetRect {
+                x,
+                y,
+                width,
+                height,
+                blocked,
+            } => update(Update::Rect(x, y, width, height), blocked).await,
+            Request::SetCells { blocked, cells } => update(Update::Cells(cells), blocked).await,
             Request::SetParams(p) => match p.validate() {
                 Ok(()) => {
                     self.params = p;
@@ -115,16 +152,19 @@ impl Session {
                 }
                 Err(e) => Reply::Error(e.into()),
             },
-            Request::Plan { start, goal, seed } => match self.enqueue(id, start, goal, seed) {
-                Ok(()) => {
-                    // The planner answers. Let it take the plan now if it is idle, before the
-                    // next frame is handled: a burst of plans then fills the queue behind the
-                    // running one, and `Busy` comes exactly when `plan_queue` plans wait.
-                    yield_now().await;
-                    return;
+            Request::Plan { start, goal, seed } | Request::PlanWarm { start, goal, seed } => {
+                let warm = matches!(req, Request::PlanWarm { .. });
+                match self.enqueue(id, start, goal, seed, warm) {
+                    Ok(()) => {
+                        // The planner answers. Let it take the plan now if it is idle, before the
+                        // next frame is handled: a burst of plans then fills the queue behind the
+                        // running one, and `Busy` comes exactly when `plan_queue` plans wait.
+                        yield_now().await;
+                        return;
+                    }
+                    Err(e) => e,
                 }
-                Err(e) => e,
-            },
+            }
             Request::Cancel => {
                 state::cancel_all();
                 Reply::Ack
@@ -140,8 +180,9 @@ impl Session {
         start: Point,
         goal: Point,
         seed: Option<u64>,
+        warm: bool,
     ) -> Result<(), Reply<'static>> {
-        if MAP.lock(|m| m.get().is_none()) {
+        if state::map_size().is_none() {
             return Err(error(ErrorCode::NoMap, 0, 0));
         }
         let params = Params {
@@ -154,6 +195,7 @@ impl Session {
             goal,
             params,
             generation: GENERATION.load(core::sync::atomic::Ordering::Acquire),
+            warm,
         };
         match JOBS.try_send(job) {
             Ok(()) => Ok(()),
@@ -164,65 +206,51 @@ impl Session {
         }
     }
 
-    fn set_map(
-        &mut self,
-        width: u16,
-        height: u16,
-        offset: u32,
-        total_len: u32,
-        chunk: &[u8],
-    ) -> Reply<'static> {
-        if chunk.len() > MAX_CHUNK {
-            return error(ErrorCode::TooLarge, chunk.len() as u32, MAX_CHUNK as u32);
-        }
-        if offset == 0 {
-            // A new upload; the previous unfinished one (if any) is dropped.
-            self.upload = None;
-            let cells = u32::from(width) * u32::from(height);
-            if cells == 0 {
-                return error(ErrorCode::BadMap, 0, 0);
-            }
-            if cells > CELLS as u32 {
-                return error(ErrorCode::MapTooLarge, cells, CELLS as u32);
-            }
-            let want = cells.div_ceil(8);
-            if total_len != want {
-                return error(ErrorCode::BadMap, total_len, want);
-            }
-            self.upload = Some(Upload {
-                width,
-                height,
-                total_len,
-                received: 0,
-                bits: [0; MAP_BYTES],
-            });
-        }
-        let Some(up) = self.upload.as_mut() else {
-            return error(ErrorCode::BadChunk, 0, 0);
+    /// One chunk of a map upload (raw or run-length). A good first chunk drops the map: plans
+    /// get `NoMap` until the last chunk arrives (or a broken upload ends it with no map).
+    async fn set_map(&mut self, c: &MapChunk<'_>) -> Reply<'static> {
+        let starts = match self.upload.accept(c, LIMITS) {
+            Ok(s) => s,
+            Err(e) => return Reply::Error(e),
         };
-        let end = offset.saturating_add(chunk.len() as u32);
-        let fits = (width, height, total_len) == (up.width, up.height, up.total_len)
-            && offset <= up.received
-            && end <= up.total_len
-            && !chunk.is_empty();
-        let slot = up.bits.get_mut(offset as usize..end as usize);
-        let (true, Some(slot)) = (fits, slot) else {
-            return error(ErrorCode::BadChunk, up.received, up.total_len);
-        };
-        slot.copy_from_slice(chunk);
-        up.received = up.received.max(end);
-        if up.received == up.total_len {
-            let map = ActiveMap {
-                width: up.width,
-                height: up.height,
-                bits: up.bits,
-            };
-            self.upload = None;
-            // Plans received before this map are for the old one: cancel them, then switch.
+        if starts {
+            // Plans received before this map are for the old one.
             state::cancel_all();
-            MAP.lock(|m| m.set(Some(map)));
-            defmt::info!("map {}x{} active", map.width, map.height);
+            state::set_map_size(None);
         }
-        Reply::Ack
+        let mut map = MAP.lock().await;
+        match self.upload.write(c, &mut map[..]) {
+            Ok(Some((w, h))) => {
+                state::set_map_size(Some((w, h)));
+                defmt::info!("map {}x{} active", w, h);
+                Reply::Ack
+            }
+            Ok(None) => Reply::Ack,
+            Err(e) => Reply::Error(e),
+        }
+    }
+}
+
+/// Block or clear cells of the map in place; cancels the running and queued plans.
+async fn update(u: Update<'_>, blocked: bool) -> Reply<'static> {
+    let Some(size) = state::map_size() else {
+        return error(ErrorCode::NoMap, 0, 0);
+    };
+    let checked = match &u {
+        Update::Rect(x, y, w, h) => check_rect(size, *x, *y, *w, *h),
+        Update::Cells(c) => check_cells(size, c),
+    };
+    if let Err(e) = checked {
+        return Reply::Error(e);
+    }
+    state::cancel_all();
+    let mut map = MAP.lock().await;
+    let done = match u {
+        Update::Rect(x, y, w, h) => set_rect(size, &mut map[..], (x, y, w, h), blocked),
+        Update::Cells(c) => set_cells(size, &mut map[..], &c, blocked),
+    };
+    match done {
+        Ok(()) => Reply::Ack,
+        Err(e) => Reply::Error(e),
     }
 }

@@ -1,5 +1,12 @@
-//! State shared between the tasks: the active map, the cancel generation, the plan queue, the
-//! reply channel, the counters.
+//! State shared between the tasks: the map buffer and the size of the map it holds, the cancel
+//! generation, the plan queue, the reply channel, the counters.
+//!
+//! The map lives once, in [`MAP`] (32 KiB for 512x512 cells, 1 bit a cell): the planner holds
+//! its lock for a whole plan and reads it in place (no copy); the receiver writes uploads and
+//! cell updates into it. A writer first bumps [`GENERATION`] (cancelling the running plan, which
+//! sees it at its next yield and releases the lock: a writer waits at most one planner
+//! iteration), and an upload first clears [`MAP_SIZE`] (no map until its last chunk), so a plan
+//! never reads a half-written or changed map.
 
 use core::cell::Cell;
 use core::sync::atomic::{AtomicBool, AtomicU32, Ordering};
@@ -11,15 +18,27 @@ use embassy_sync::mutex::Mutex;
 
 use ohaca::grid::Point;
 use ohaca::planner::Params;
-use ohaca::protocol::{Reply, StatsReply};
+use ohaca::protocol::{MapLimits, Reply, StatsReply};
 
 use super::board::{self, Board};
 use super::stack;
 
-/// Largest map, in cells (32 x 32).
-pub const CELLS: usize = 1024;
-/// Bytes of the largest packed map.
-pub const MAP_BYTES: usize = CELLS.div_ceil(8);
+/// Widest map the device holds (the same on every board, so what QEMU proves holds on the chip).
+pub const MAX_WIDTH: u16 = 512;
+/// Tallest map the device holds.
+pub const MAX_HEIGHT: u16 = 512;
+/// Most cells of a map the device holds.
+pub const MAX_CELLS: usize = MAX_WIDTH as usize * MAX_HEIGHT as usize;
+/// Bytes of the map buffer.
+pub const MAP_BYTES: usize = MAX_CELLS.div_ceil(8);
+/// Most cells of a map the planner plans on: the size of its `Storage` (the one constant to
+/// change with the planning core). A bigger map is held, and plans on it get `MapTooLarge`.
+pub const PLAN_CELLS: usize = 1024;
+/// The map limits, for [`ohaca::protocol::Upload`].
+pub const LIMITS: MapLimits = MapLimits {
+    max_width: MAX_WIDTH,
+    max_height: MAX_HEIGHT,
+};
 /// Plan requests that can wait while one runs.
 pub const PLAN_QUEUE: usize = 4;
 /// Replies waiting for the transmitter.
@@ -36,15 +55,9 @@ pub struct Job {
     pub params: Params,
     /// [`GENERATION`] when it was received; a different value now means cancelled.
     pub generation: u32,
-}
-
-/// The map plans run on. The planner copies it when a plan starts, so the receiver may replace
-/// it at any time (which also bumps [`GENERATION`]).
-#[derive(Clone, Copy)]
-pub struct ActiveMap {
-    pub width: u16,
-    pub height: u16,
-    pub bits: [u8; MAP_BYTES],
+    /// `PlanWarm`: keep the previous plan's colony if it was to the same goal (planned cold
+    /// until the core can).
+    pub warm: bool,
 }
 
 /// A small reply (every reply but a path) for the transmitter: the request id and the reply.
@@ -55,8 +68,13 @@ pub struct Out(pub u32, pub Reply<'static>);
 /// frame, so frames never interleave.
 pub type TxPort = Mutex<Raw, board::Tx>;
 
-pub static MAP: BlockingMutex<Raw, Cell<Option<ActiveMap>>> = BlockingMutex::new(Cell::new(None));
-/// Bumped by `Cancel` and by every new map: plans received under an older value are cancelled.
+/// The map buffer, packed as `ohaca::grid` stores a map; [`MAP_SIZE`] says what it holds.
+pub static MAP: Mutex<Raw, [u8; MAP_BYTES]> = Mutex::new([0; MAP_BYTES]);
+/// Width and height of the complete map in [`MAP`]; `None`: no map (none yet, an upload in
+/// progress, or a failed one).
+static MAP_SIZE: BlockingMutex<Raw, Cell<Option<(u16, u16)>>> = BlockingMutex::new(Cell::new(None));
+/// Bumped by `Cancel`, by every map upload and by every cell update: plans received under an
+/// older value are cancelled.
 pub static GENERATION: AtomicU32 = AtomicU32::new(0);
 pub static PLANNING: AtomicBool = AtomicBool::new(false);
 pub static JOBS: Channel<Raw, Job, PLAN_QUEUE> = Channel::new();
@@ -95,13 +113,23 @@ pub fn stats() -> StatsReply {
     let mut s = STATS.lock(Cell::get);
     s.uptime = embassy_time::Instant::now().as_ticks();
     s.rx_overruns = s.rx_overruns.wrapping_add(board::Active::rx_overruns());
-    if let Some(m) = MAP.lock(Cell::get) {
-        (s.map_width, s.map_height) = (m.width, m.height);
+    if let Some((w, h)) = map_size() {
+        (s.map_width, s.map_height) = (w, h);
     }
     s.queued = u8::try_from(JOBS.len()).unwrap_or(u8::MAX);
     s.planning = PLANNING.load(Ordering::Relaxed);
     s.stack_peak = stack::peak();
     s
+}
+
+/// The size of the map in [`MAP`], if it holds a complete one.
+pub fn map_size() -> Option<(u16, u16)> {
+    MAP_SIZE.lock(Cell::get)
+}
+
+/// Record what [`MAP`] holds.
+pub fn set_map_size(size: Option<(u16, u16)>) {
+    MAP_SIZE.lock(|c| c.set(size));
 }
 
 /// True if plans received under `generation` are cancelled.

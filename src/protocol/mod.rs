@@ -36,17 +36,23 @@ use crate::grid::Point;
 use crate::planner::Params;
 
 mod frame;
+mod map;
 mod stream;
 mod wire;
 
 pub use frame::{cobs_overhead, crc32, wire_len, Feed, FrameReader};
+pub use map::{
+    check_cells, check_rect, set_cells, set_rect, Encoding, MapChunk, MapLimits, RleDecoder,
+    RleEncoder, RleError, Upload, MAX_UPDATE_CELLS,
+};
 pub use stream::PathStream;
 use wire::PointDef;
 pub use wire::{Waypoints, WAYPOINT_BYTES};
 
 /// Protocol version, reported in [`HelloReply::protocol_version`]. Bumped on any change to the
-/// bytes of an existing message (2: [`StatsReply::stack_peak`]).
-pub const VERSION: u16 = 2;
+/// bytes or meaning of a message (2: [`StatsReply::stack_peak`]; 3: run-length uploads, cell
+/// updates, warm plans, [`Capacity`]'s sides are the largest map held).
+pub const VERSION: u16 = 3;
 
 /// The id of replies to frames whose request id could not be read. Hosts should not use it.
 pub const UNKNOWN_ID: u32 = 0;
@@ -124,6 +130,58 @@ pub enum Request<'a> {
     Cancel,
     /// `5`: counters, answered with [`Reply::Stats`].
     Stats,
+    /// `6`: one chunk of a run-length coded map upload (see [`RleEncoder`]): the same fields
+    /// and rules as [`Request::SetMap`], but `offset` and `total_len` count bytes of the code.
+    SetMapRle {
+        /// Columns.
+        width: u16,
+        /// Rows.
+        height: u16,
+        /// Byte offset of `chunk` in the code.
+        offset: u32,
+        /// Bytes of the whole code.
+        total_len: u32,
+        /// The bytes.
+        chunk: &'a [u8],
+    },
+    /// `7`: block (`blocked`) or clear every cell of a rectangle of the active map, answered
+    /// with [`Reply::Ack`] (or `NoMap`, `OutsideMap`: nothing changes). Cancels the running and
+    /// queued plans, as a new map does.
+    SetRect {
+        /// Left column.
+        x: u16,
+        /// Top row.
+        y: u16,
+        /// Columns.
+        width: u16,
+        /// Rows.
+        height: u16,
+        /// Block (true) or clear (false).
+        blocked: bool,
+    },
+    /// `8`: block or clear a list of at most [`MAX_UPDATE_CELLS`] cells, 4 bytes each on the
+    /// wire as [`PathReply::waypoints`]; answered and cancelling like [`Request::SetRect`] (and
+    /// `TooLarge` for a longer list).
+    SetCells {
+        /// Block (true) or clear (false).
+        blocked: bool,
+        /// The cells.
+        #[serde(borrow)]
+        cells: Waypoints<'a>,
+    },
+    /// `9`: as [`Request::Plan`], asking for a warm start: keep the colony (pheromone) of the
+    /// previous plan to the same goal on this map, across cell updates. A device may plan it
+    /// cold; the path is valid either way.
+    PlanWarm {
+        /// Start cell (the robot's cell now).
+        #[serde(with = "PointDef")]
+        start: Point,
+        /// Goal cell.
+        #[serde(with = "PointDef")]
+        goal: Point,
+        /// Overrides the parameters' seed for this plan only.
+        seed: Option<u64>,
+    },
 }
 
 /// Device to host.
@@ -159,11 +217,12 @@ pub struct HelloReply<'a> {
 /// The device's limits.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Capacity {
-    /// Most map cells (`width * height`).
+    /// Most cells (`width * height`) of a map the device plans on; a bigger map it holds is
+    /// answered `MapTooLarge` when planned on.
     pub cells: u32,
-    /// Widest map (with height 1).
+    /// Widest map the device holds (a map upload over it gets `MapTooLarge`).
     pub max_width: u16,
-    /// Tallest map (with width 1).
+    /// Tallest map the device holds.
     pub max_height: u16,
     /// Most bytes per [`Request::SetMap`] chunk.
     pub max_chunk: u16,
@@ -303,6 +362,8 @@ impl fmt::Display for ErrorReply {
             ),
             ErrorCode::Busy => write!(f, " ({} of {} queued)", self.detail, self.limit),
             ErrorCode::BadParam => write!(f, " (parameter #{})", self.detail),
+            ErrorCode::BadRle => write!(f, " ({} of {} cells)", self.detail, self.limit),
+            ErrorCode::OutsideMap => write!(f, " (cell {}, {})", self.detail, self.limit),
             _ => Ok(()),
         }
     }
@@ -354,11 +415,17 @@ pub enum ErrorCode {
     BadChunk = 21,
     /// The device could not build the reply (e.g. a path longer than the protocol's limits).
     Internal = 22,
+    /// A run-length map code overruns the map or ends short of it: `detail` = cells decoded,
+    /// `limit` = the map's cells. The upload is dropped.
+    BadRle = 23,
+    /// A cell update reaches outside the active map: `detail` = x, `limit` = y of the first cell
+    /// outside.
+    OutsideMap = 24,
 }
 
 impl ErrorCode {
     /// Every code, in numeric order.
-    pub const ALL: [ErrorCode; 17] = [
+    pub const ALL: [ErrorCode; 19] = [
         ErrorCode::BadMap,
         ErrorCode::MapTooLarge,
         ErrorCode::StartOutOfBounds,
@@ -376,6 +443,8 @@ impl ErrorCode {
         ErrorCode::Busy,
         ErrorCode::BadChunk,
         ErrorCode::Internal,
+        ErrorCode::BadRle,
+        ErrorCode::OutsideMap,
     ];
 
     /// The byte on the wire.
@@ -408,6 +477,8 @@ impl ErrorCode {
             ErrorCode::Busy => "busy: plan queue full",
             ErrorCode::BadChunk => "map chunk out of sequence",
             ErrorCode::Internal => "internal error",
+            ErrorCode::BadRle => "bad run-length map code",
+            ErrorCode::OutsideMap => "cell outside the map",
         }
     }
 }
@@ -684,5 +755,7 @@ pub fn decode_reply(frame: &mut [u8]) -> Result<(u32, Reply<'_>), DecodeError> {
     decode(frame)
 }
 
+#[cfg(test)]
+mod map_tests;
 #[cfg(test)]
 mod tests;

@@ -114,6 +114,33 @@ fn requests() -> Vec<Request<'static>> {
         },
         Request::Cancel,
         Request::Stats,
+        Request::SetMapRle {
+            width: 256,
+            height: 256,
+            offset: 128,
+            total_len: 1000,
+            chunk: &[5, 1, 6],
+        },
+        Request::SetRect {
+            x: 1,
+            y: 2,
+            width: 3,
+            height: 4,
+            blocked: true,
+        },
+        Request::SetCells {
+            blocked: false,
+            cells: Waypoints::Points(&WPTS),
+        },
+        Request::SetCells {
+            blocked: true,
+            cells: Waypoints::Points(&[]),
+        },
+        Request::PlanWarm {
+            start: Point::new(3, 4),
+            goal: Point::new(500, 511),
+            seed: Some(9),
+        },
     ]
 }
 
@@ -124,8 +151,8 @@ fn hello() -> HelloReply<'static> {
         board: "qemu-mps2-an386",
         capacity: Capacity {
             cells: 1024,
-            max_width: 1024,
-            max_height: 1024,
+            max_width: 512,
+            max_height: 512,
             max_chunk: MAX_CHUNK as u16,
             max_request: MAX_REQUEST as u16,
             plan_queue: 4,
