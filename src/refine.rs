@@ -29,8 +29,8 @@
 //! **What it cannot do.** A window only sees its piece: a detour around the wrong side of a block
 //! larger than the window stays (the colony's choice of corridor), and so does a path that runs
 //! one row off the optimum for longer than a window (the two diagonals that would fix it are too
-//! far apart). Both are rare on the Moving AI maps; see `BENCHMARKS.md` / the `refine_large`
-//! example for figures.
+//! far apart). Both are rare on the Moving AI maps; `docs/ALGORITHM.md` has the figures of the
+//! `refine_large` example.
 //!
 //! **Exact integer costs.** A straight step costs [`STRAIGHT`] = 13860 and a diagonal
 //! [`DIAGONAL`] = 19601 (a convergent of `sqrt 2`: `19601 / 13860 = 1.41421356`, off by

@@ -21,7 +21,7 @@
 //! the all-pairs DP's (`K = n`), for several `K`, the greedy rule's, and the time per path of the
 //! all-pairs DP and of the default look-back (wall clock, for the documentation only).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use ohaca::refine::{Budget, Refiner, Scratch};
@@ -34,7 +34,7 @@ use ohaca_host_tests::quality::par_map;
 use ohaca_host_tests::reference::astar8;
 
 /// Raw path of the default plan, from the cache or planned (and cached).
-fn raw_path(cache: &PathBuf, m: &LargeMap, c: usize, seed: u64) -> Vec<Point> {
+fn raw_path(cache: &Path, m: &LargeMap, c: usize, seed: u64) -> Vec<Point> {
     let case = &m.cases[c];
     let file = cache.join(format!(
         "{}-{}-{}-{}-{}-s{seed}.txt",
