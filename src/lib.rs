@@ -18,6 +18,7 @@
 //! | [`colony`] | one ant: the transition rule, tabu list, backtracking (or dying) |
 //! | [`update`] | the per-iteration pheromone update: classic deposit and the wolves rule |
 //! | [`smoothing`] | line-of-sight smoothing of the raw ant path |
+//! | [`refine`] | local search: the exact shortest path in a window sliding along a raw path |
 //! | [`planner`] | parameters, caller-provided storage, the iteration loop and the result |
 //! | `heap` | (feature `alloc`) the planner's storage on the heap, sized at run time |
 //! | `protocol` | (feature `protocol`) the wire protocol between a host and the firmware |
@@ -99,6 +100,7 @@ pub mod pheromone;
 pub mod planner;
 #[cfg(feature = "protocol")]
 pub mod protocol;
+pub mod refine;
 pub mod rng;
 pub mod smoothing;
 pub mod update;

@@ -7,11 +7,15 @@
 //! Three kinds:
 //!
 //! - [`SmoothingKind::Shortest`] (default for OHACA): the shortest path that visits a subsequence
-//!   of the raw path's cells, found by dynamic programming over all pairs that see each other
-//!   (`O(n^2)` segment tests at worst for `n` raw cells, pruned by length). This is the reading
-//!   that works: on the shared maps it lands on average within 1% of the any-angle optimum through
-//!   cell centres, where the paper's greedy rule is up to 5% above it, because greedy keeps the
-//!   first cell it cannot see past rather than the best one.
+//!   of the raw path's cells, found by dynamic programming over the pairs that see each other and
+//!   lie at most [`LOOKBACK`] raw cells apart (segment tests pruned by length). This is the
+//!   reading that works: on the shared maps it lands on average within 1% of the any-angle optimum
+//!   through cell centres, where the paper's greedy rule is up to 5% above it, because greedy
+//!   keeps the first cell it cannot see past rather than the best one. Paths of at most
+//!   `LOOKBACK + 1` cells (every shared small-map path) get the exact all-pairs DP, bit for bit as
+//!   before the look-back existed. Longer paths get the windowed DP and then one greedy
+//!   line-of-sight pass over its waypoints (a waypoint goes when its neighbours see each other),
+//!   so a long straight stretch still ends up as one segment. See [`LOOKBACK`] for the cost.
 //! - [`SmoothingKind::Greedy`]: the paper's steps 1-5 literally: from the anchor `S`, extend `N`
 //!   along the path while `S` sees `N`; when it does not, the node before `N` becomes the next
 //!   anchor and a waypoint. Kept for faithful comparisons.
@@ -120,9 +124,37 @@ pub fn drop_collinear(pts: &mut [Point], n: usize) -> usize {
     k.wrapping_add(1)
 }
 
+/// How many raw cells back the [`SmoothingKind::Shortest`] DP looks for a cell that sees the
+/// current one (`K`).
+///
+/// Cost: per raw cell at most `K` candidate segments, each tested only when it would shorten the
+/// path so far, at about `|dx| + |dy| <= 2K` cells per test: `O(n K^2)` cell tests at worst, in
+/// practice far fewer (most candidates fail the length test). The all-pairs DP is `O(n^3)` cell
+/// tests at worst and `O(n^2)` length tests always. Measured on the colony's raw paths of the 20
+/// longest scenarios of each of the 20 large Moving AI maps (43 to 4,844 cells; `cargo run
+/// --release -p ohaca-host-tests --target host-tuple --example refine_large -- --smooth 1`):
+/// with `K = 128` the smoothed length is on average within 0.22 % of the all-pairs DP's on every
+/// map (worst single path +1.7 %), `K = 64` loses up to 1.4 % on average and `K = 256` at most
+/// 0.04 %; on the longest paths (2,300-4,800 cells) the all-pairs DP takes 1.6-2.6 s per path on
+/// the host and `K = 128` 35-115 ms.
+pub const LOOKBACK: usize = 128;
+
+/// Scratch entries [`smooth`] needs for a path of `n` cells: `(dist, prev)` =
+/// `(min(n, LOOKBACK + 1), n)`. `dist` is a ring over the look-back window; `prev` holds one link
+/// per raw cell to recover the chosen cells.
+pub const fn scratch_for(n: usize) -> (usize, usize) {
+    let ring = if n <= LOOKBACK {
+        n
+    } else {
+        LOOKBACK.wrapping_add(1)
+    };
+    (ring, n)
+}
+
 /// Smooth the path `pts[..n]` in place; returns the number of waypoints now in `pts`.
-/// `dist` and `prev` are scratch of at least `n` entries (only [`SmoothingKind::Shortest`] uses
-/// them; if they are too short it falls back to [`SmoothingKind::Greedy`]).
+/// `dist` and `prev` are scratch of at least [`scratch_for`]`(n)` entries (only
+/// [`SmoothingKind::Shortest`] uses them; if they are too short it falls back to
+/// [`SmoothingKind::Greedy`]).
 pub fn smooth(
     grid: &Grid<'_>,
     kind: SmoothingKind,
@@ -138,13 +170,7 @@ pub fn smooth(
     let k = match kind {
         SmoothingKind::None => n,
         SmoothingKind::Greedy => greedy(grid, pts, n),
-        SmoothingKind::Shortest => {
-            if dist.len() < n || prev.len() < n {
-                greedy(grid, pts, n)
-            } else {
-                shortest(grid, pts, n, dist, prev)
-            }
-        }
+        SmoothingKind::Shortest => shortest_with(grid, pts, n, dist, prev, LOOKBACK),
     };
     drop_collinear(pts, k)
 }
@@ -181,14 +207,56 @@ fn greedy(grid: &Grid<'_>, pts: &mut [Point], n: usize) -> usize {
     out.wrapping_add(1)
 }
 
-/// Shortest subsequence path by dynamic programming, in place.
+/// [`SmoothingKind::Shortest`] with a look-back of `lookback` raw cells instead of [`LOOKBACK`]
+/// (at least 1), in place, without the final collinear-point pass of [`smooth`]: for measuring
+/// the choice of `K`. Falls back to the greedy rule when the scratch is short of
+/// `(min(n, lookback + 1), n)` entries.
+pub fn shortest_with(
+    grid: &Grid<'_>,
+    pts: &mut [Point],
+    n: usize,
+    dist: &mut [f32],
+    prev: &mut [u32],
+    lookback: usize,
+) -> usize {
+    let n = n.min(pts.len());
+    if n < 3 {
+        return n;
+    }
+    let lookback = lookback.max(1);
+    let ring = n.min(lookback.saturating_add(1));
+    if dist.len() < ring || prev.len() < n {
+        return greedy(grid, pts, n);
+    }
+    let k = shortest(
+        grid,
+        pts,
+        n,
+        dist.get_mut(..ring).unwrap_or_default(),
+        prev,
+        lookback,
+    );
+    if ring < n {
+        merge(grid, pts, k)
+    } else {
+        k
+    }
+}
+
+/// Shortest subsequence path by dynamic programming, in place. `dist` is a ring of `ring =
+/// min(n, lookback + 1)` entries (cell `i` in slot `i % ring`), so for `n <= lookback + 1` it is
+/// the plain all-pairs DP.
 fn shortest(
     grid: &Grid<'_>,
     pts: &mut [Point],
     n: usize,
     dist: &mut [f32],
     prev: &mut [u32],
+    lookback: usize,
 ) -> usize {
+    let ring = dist.len();
+    // `ring >= 1` (n >= 3), so the `checked_rem` never fails.
+    let slot = |i: usize| i.checked_rem(ring).unwrap_or(0);
     if let (Some(d0), Some(p0)) = (dist.get_mut(0), prev.get_mut(0)) {
         *d0 = 0.0;
         *p0 = 0;
@@ -197,12 +265,12 @@ fn shortest(
         let Some(&pj) = pts.get(j) else { break };
         // Default: come from the previous raw cell (always clear: it is a legal move).
         let before = j.wrapping_sub(1); // j >= 1
-        let (mut best, mut from) = match (dist.get(before), pts.get(before)) {
+        let (mut best, mut from) = match (dist.get(slot(before)), pts.get(before)) {
             (Some(&d), Some(&p)) => (d + distance(p, pj), before),
             _ => break,
         };
-        for i in 0..j.saturating_sub(1) {
-            let (Some(&di), Some(&pi)) = (dist.get(i), pts.get(i)) else {
+        for i in j.saturating_sub(lookback)..j.saturating_sub(1) {
+            let (Some(&di), Some(&pi)) = (dist.get(slot(i)), pts.get(i)) else {
                 break;
             };
             let cand = di + distance(pi, pj);
@@ -212,7 +280,7 @@ fn shortest(
                 from = i;
             }
         }
-        if let (Some(d), Some(p)) = (dist.get_mut(j), prev.get_mut(j)) {
+        if let (Some(d), Some(p)) = (dist.get_mut(slot(j)), prev.get_mut(j)) {
             *d = best;
             *p = from as u32;
         }
@@ -245,6 +313,40 @@ fn shortest(
         }
     }
     k
+}
+
+/// One greedy line-of-sight pass over the waypoints `pts[..k]`, in place: a waypoint goes when
+/// the last kept one sees the next one (never longer, by the triangle inequality). Returns the
+/// new count. Cost: one segment test per waypoint, from the last kept one; only a stretch that
+/// collapses to one long segment makes these tests grow, to `O(n^2 / K)` cells for `n` raw cells.
+fn merge(grid: &Grid<'_>, pts: &mut [Point], k: usize) -> usize {
+    let k = k.min(pts.len());
+    if k < 3 {
+        return k;
+    }
+    // Bounds: 1 <= out <= i < k - 1 < pts.len(), so no `wrapping_` here wraps.
+    let last = k.wrapping_sub(1);
+    let mut out = 1usize;
+    for i in 1..last {
+        let (Some(&a), Some(&b), Some(&c)) = (
+            pts.get(out.wrapping_sub(1)),
+            pts.get(i),
+            pts.get(i.wrapping_add(1)),
+        ) else {
+            break;
+        };
+        if !segment_clear(grid, a, c) {
+            if let Some(slot) = pts.get_mut(out) {
+                *slot = b;
+            }
+            out = out.wrapping_add(1);
+        }
+    }
+    let end = pts.get(last).copied();
+    if let (Some(end), Some(slot)) = (end, pts.get_mut(out)) {
+        *slot = end;
+    }
+    out.wrapping_add(1)
 }
 
 #[cfg(test)]
@@ -337,6 +439,179 @@ mod tests {
         }
         assert!(lens[1] <= lens[0] + 1e-5, "{lens:?}");
         assert!(lens[1] < polyline_length(&raw));
+    }
+
+    /// The all-pairs DP as it was before the look-back (kept to prove short paths unchanged).
+    fn old_shortest(g: &Grid<'_>, pts: &mut [Point], n: usize) -> usize {
+        let mut dist = vec![0f32; n];
+        let mut prev = vec![0u32; n];
+        dist[0] = 0.0;
+        for j in 1..n {
+            let (mut best, mut from) = (dist[j - 1] + distance(pts[j - 1], pts[j]), j - 1);
+            for i in 0..j.saturating_sub(1) {
+                let cand = dist[i] + distance(pts[i], pts[j]);
+                if cand < best && segment_clear(g, pts[i], pts[j]) {
+                    best = cand;
+                    from = i;
+                }
+            }
+            dist[j] = best;
+            prev[j] = from as u32;
+        }
+        let mut chain = vec![n - 1];
+        while *chain.last().unwrap() != 0 {
+            chain.push(prev[*chain.last().unwrap()] as usize);
+        }
+        chain.reverse();
+        let out: Vec<Point> = chain.iter().map(|&i| pts[i]).collect();
+        pts[..out.len()].copy_from_slice(&out);
+        drop_collinear(pts, out.len())
+    }
+
+    /// A random map (`density` blocked) and a random walk of `steps` legal moves on it.
+    fn random_walk(
+        rng: &mut crate::rng::Xoshiro128pp,
+        w: u16,
+        h: u16,
+        density: f32,
+        steps: usize,
+    ) -> (Vec<u8>, Vec<Point>) {
+        loop {
+            let cells = usize::from(w) * usize::from(h);
+            let mut b = vec![0u8; cells.div_ceil(8)];
+            for i in 0..cells {
+                if rng.next_unit() < density {
+                    b[i / 8] |= 1 << (i % 8);
+                }
+            }
+            let g = Grid::new(w, h, &b).unwrap();
+            let start = Point::new(
+                (rng.next_word() % u32::from(w)) as u16,
+                (rng.next_word() % u32::from(h)) as u16,
+            );
+            if !g.is_free(start) || g.move_mask(start) == 0 {
+                continue;
+            }
+            let mut path = vec![start];
+            let mut d = (rng.next_word() % 8) as u8;
+            while path.len() <= steps {
+                let p = *path.last().unwrap();
+                // Mostly keep the heading, so walks travel instead of dithering.
+                if rng.next_unit() < 0.3 {
+                    d = (rng.next_word() % 8) as u8;
+                }
+                if let Some(q) = g.step(p, d) {
+                    path.push(q);
+                } else {
+                    d = (rng.next_word() % 8) as u8;
+                }
+            }
+            return (b, path);
+        }
+    }
+
+    #[test]
+    fn short_paths_are_bit_identical_to_the_all_pairs_dp() {
+        let mut rng = crate::rng::Xoshiro128pp::from_u64(7);
+        for case in 0..300 {
+            let steps = 2 + case % (LOOKBACK - 1); // n = steps + 1 <= LOOKBACK + 1
+            let (b, raw) = random_walk(&mut rng, 40, 30, 0.15, steps);
+            let g = Grid::new(40, 30, &b).unwrap();
+            let n = raw.len();
+            let mut want = raw.clone();
+            let kw = old_shortest(&g, &mut want, n);
+            let (dn, pn) = scratch_for(n);
+            assert_eq!(dn, n);
+            let mut got = raw.clone();
+            let kg = smooth(
+                &g,
+                SmoothingKind::Shortest,
+                &mut got,
+                n,
+                &mut vec![0.0; dn],
+                &mut vec![0; pn],
+            );
+            assert_eq!(&got[..kg], &want[..kw], "case {case}");
+        }
+    }
+
+    #[test]
+    fn long_paths_stay_valid_and_no_longer_than_greedy() {
+        let mut rng = crate::rng::Xoshiro128pp::from_u64(11);
+        let (mut worse, mut total_gain) = (0, 0.0f32);
+        for case in 0..60 {
+            let steps = 200 + case * 37;
+            let (b, raw) = random_walk(&mut rng, 120, 90, 0.04 + 0.002 * case as f32, steps);
+            let g = Grid::new(120, 90, &b).unwrap();
+            let n = raw.len();
+            let (dn, pn) = scratch_for(n);
+            assert_eq!(dn, LOOKBACK + 1);
+            let mut got = raw.clone();
+            let k = smooth(
+                &g,
+                SmoothingKind::Shortest,
+                &mut got,
+                n,
+                &mut vec![0.0; dn],
+                &mut vec![0; pn],
+            );
+            let wp = &got[..k];
+            assert_eq!(wp[0], raw[0]);
+            assert_eq!(wp[k - 1], raw[n - 1]);
+            for s in wp.windows(2) {
+                assert!(segment_clear(&g, s[0], s[1]), "case {case} {s:?}");
+            }
+            let mut gr = raw.clone();
+            let kg = smooth(&g, SmoothingKind::Greedy, &mut gr, n, &mut [], &mut []);
+            let (ls, lg) = (polyline_length(wp), polyline_length(&gr[..kg]));
+            assert!(ls <= polyline_length(&raw));
+            if ls > lg + 1e-3 {
+                worse += 1;
+            }
+            total_gain += lg - ls;
+        }
+        assert_eq!(worse, 0, "windowed DP longer than greedy in {worse} cases");
+        assert!(total_gain > 0.0);
+    }
+
+    #[test]
+    fn a_long_straight_stretch_becomes_one_segment() {
+        // 600 cells along an open strip, wobbling by one row: far beyond the look-back.
+        let (b, w, h) = {
+            let rows: Vec<String> = (0..3).map(|_| ".".repeat(601)).collect();
+            let r: Vec<&str> = rows.iter().map(String::as_str).collect();
+            grid(&r)
+        };
+        let g = Grid::new(w, h, &b).unwrap();
+        let raw: Vec<Point> = (0..=600u16)
+            .map(|x| Point::new(x, if (x / 7) % 2 == 0 { 1 } else { 0 }))
+            .collect();
+        // Every step is a legal move (a row change is a diagonal on an open map).
+        let n = raw.len();
+        let (dn, pn) = scratch_for(n);
+        let mut p = raw.clone();
+        let k = smooth(
+            &g,
+            SmoothingKind::Shortest,
+            &mut p,
+            n,
+            &mut vec![0.0; dn],
+            &mut vec![0; pn],
+        );
+        assert_eq!(&p[..k], &[raw[0], raw[n - 1]]);
+        // Scratch: the ring only, not n floats.
+        assert_eq!(dn, LOOKBACK + 1);
+        // Too little ring: greedy (which also finds the one segment here).
+        let mut q = raw.clone();
+        let k = smooth(
+            &g,
+            SmoothingKind::Shortest,
+            &mut q,
+            n,
+            &mut vec![0.0; LOOKBACK],
+            &mut vec![0; n],
+        );
+        assert_eq!(&q[..k], &[raw[0], raw[n - 1]]);
     }
 
     #[test]

@@ -11,6 +11,7 @@
 //! | [`check`] | validators for raw paths, smoothed waypoints and reported lengths |
 //! | [`gen`] | random map and endpoint generators (proptest strategies) |
 //! | [`quality`] | the shared-map quality runs used by the tests and the examples |
+//! | [`large`] | the large Moving AI maps of `maps/large/` and their longest scenarios |
 //!
 //! This crate does not depend on the host tool (`ohaca-host`): it only needs the core.
 
