@@ -5,6 +5,8 @@
 //! ```text
 //! cargo run --release -p ohaca-host-tests --target host-tuple --example fingerprint > before.txt
 //! ```
+//!
+//! `OHACA_NO_PRUNE=1` turns dead-end pruning off (`Params::prune`).
 
 use std::hash::{DefaultHasher, Hash, Hasher};
 
@@ -22,6 +24,7 @@ fn main() {
                     let p = Params {
                         algorithm: alg,
                         seed,
+                        prune: std::env::var_os("OHACA_NO_PRUNE").is_none(),
                         ..Params::default()
                     };
                     let line = match plan(&grid, case.start, case.goal, &p, st.workspace()) {

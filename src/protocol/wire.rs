@@ -72,6 +72,7 @@ pub(crate) struct ParamsDef {
     #[serde(with = "SmoothingDef")]
     smoothing: SmoothingKind,
     tighten: bool,
+    prune: bool,
 }
 
 /// Bytes per waypoint on the wire: `x` then `y`, each a little-endian `u16`.
