@@ -323,3 +323,73 @@ fn dijkstra(blocks: Blocks, goal_block: usize, words: &mut [u32], mut heap: Heap
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::grid::Grid;
+
+    /// A 64 x 64 map (2 x 2 blocks would be 1024: the route uses single cells up to 4096 cells, so
+    /// take 128 x 64 = 8192 cells: 2 x 2 blocks) with a wall between start and goal that has one
+    /// gap at the bottom.
+    fn walled() -> (Vec<u8>, u16, u16) {
+        let (w, h) = (128u16, 64u16);
+        let mut b = vec![0u8; (usize::from(w) * usize::from(h)).div_ceil(8)];
+        for y in 0..h - 4 {
+            let i = usize::from(y) * usize::from(w) + 64;
+            b[i / 8] |= 1 << (i % 8);
+        }
+        (b, w, h)
+    }
+
+    #[test]
+    fn sub_goals_lead_around_the_wall() {
+        let (b, w, h) = walled();
+        let g = Grid::new(w, h, &b).unwrap();
+        let blocks = blocks(w, h);
+        assert_eq!(blocks.shift(), 1);
+        let moves = Moves::new(g, &[]);
+        let dead = vec![0u32; crate::bitmap::words(g.cells())];
+        let mut words = vec![0u32; GUIDE_BLOCKS];
+        let mut heap = vec![0u32; GUIDE_BLOCKS];
+        let goal = Point::new(100, 2);
+        assert!(build(&moves, blocks, goal, &dead, &mut words, &mut heap));
+        let route = Route::new(blocks, &words, goal, w, h);
+        // From the top left the straight pull would hit the wall; the sub-goal leads down.
+        let t = route.target(Point::new(20, 2));
+        assert!(t.y > 2, "{t:?}");
+        // Follow the sub-goals: they reach the goal through the gap.
+        let mut p = Point::new(20, 2);
+        for _ in 0..400 {
+            let t = route.target(p);
+            if t == goal {
+                break;
+            }
+            assert!(t.x != 64 || t.y >= h - 4, "a sub-goal in the wall: {t:?}");
+            p = t;
+        }
+        assert_eq!(route.target(p), goal);
+        // Next to the goal, the goal itself.
+        assert_eq!(route.target(Point::new(101, 3)), goal);
+    }
+
+    #[test]
+    fn distances_are_exact_on_blocks() {
+        // An empty map: the distance of a block is the octile-like 10/14 distance to the goal's.
+        let g = Grid::new(128, 64, &[0u8; 1024]).unwrap();
+        let blocks = blocks(128, 64);
+        let moves = Moves::new(g, &[]);
+        let dead = vec![0u32; crate::bitmap::words(g.cells())];
+        let mut words = vec![0u32; GUIDE_BLOCKS];
+        let mut heap = vec![0u32; GUIDE_BLOCKS];
+        assert!(build(&moves, blocks, Point::new(0, 0), &dead, &mut words, &mut heap));
+        for (b, w) in words.iter().take(blocks.count()).enumerate() {
+            let (bx, by) = ((b % blocks.across()) as u32, (b / blocks.across()) as u32);
+            let (hi, lo) = (bx.max(by), bx.min(by));
+            assert_eq!(dist(*w), 10 * (hi - lo) + 14 * lo, "block {b}");
+        }
+        // Too short a heap: no route.
+        let mut short = vec![0u32; 10];
+        assert!(!build(&moves, blocks, Point::new(0, 0), &dead, &mut words, &mut short));
+    }
+}
