@@ -8,6 +8,11 @@ use crate::smoothing::SmoothingKind;
 /// The four variants the paper compares.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(rename_all = "lowercase")
+)]
 pub enum Algorithm {
     /// Plain ant colony: `eta = 1 / d_ij`, classic ant-system update.
     Aca,
@@ -63,9 +68,16 @@ impl Algorithm {
     }
 }
 
-/// Every tunable of the planner. [`Params::default`] is the paper's setting.
+/// Every tunable of the planner.
+///
+/// Two presets: [`Params::default`] is this project's setting (the paper's `alpha`, `beta`, `rho`,
+/// `Q`, `a`, `xi`, `M` and `N`, plus backtracking ants, path tightening, dead-end pruning, early
+/// stopping after 10 stale iterations and shortest smoothing); [`Params::paper`] is the paper's
+/// algorithm as written (ants die at dead ends, no tightening, no pruning, always all `N`
+/// iterations, greedy smoothing).
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Params {
     /// Which variant to run.
     pub algorithm: Algorithm,
@@ -133,6 +145,35 @@ impl Default for Params {
 }
 
 impl Params {
+    /// The paper's setting as written: `alpha = 1`, `beta = 2`, `rho = 0.1`, `Q = 1`, `a = 0.05`,
+    /// `xi = 1`, `M = 50` ants, always the full `N = 100` iterations (`patience = 0`), ants that
+    /// die at dead ends, no path tightening, no dead-end pruning and the paper's greedy smoothing
+    /// (section 4.3). The pheromone bounds and the seed are [`Params::default`]'s (the paper gives
+    /// `delta = 0.01` and no initial value). Use it for faithful comparisons; `docs/ALGORITHM.md`
+    /// lists where the default differs and why.
+    pub const fn paper() -> Self {
+        Params {
+            algorithm: Algorithm::Ohaca,
+            ants: 50,
+            iterations: 100,
+            alpha: 1.0,
+            beta: 2.0,
+            rho: 0.1,
+            q: 1.0,
+            a: 0.05,
+            xi: 1.0,
+            tau0: 1.0,
+            tau_min: 0.01,
+            tau_max: 100.0,
+            patience: 0,
+            seed: 1,
+            dead_end: DeadEnd::Die,
+            smoothing: SmoothingKind::Greedy,
+            tighten: false,
+            prune: false,
+        }
+    }
+
     /// Check every field's range.
     pub fn validate(&self) -> Result<(), Error> {
         let bad = |p| Err(Error::BadParam(p));

@@ -189,10 +189,18 @@ impl<'g, 'a> Run<'g, 'a> {
     /// Run one iteration (all ants, then the pheromone update). Returns `true` while there is more
     /// to do.
     pub fn step(&mut self) -> bool {
+        self.step_observed(|_| {})
+    }
+
+    /// [`Run::step`], calling `on_tour` with the path of every ant that arrived, in ant order,
+    /// as directions from the start: exactly the path the ant deposits on (after tightening).
+    /// With these, the iteration's pheromone update (eq. 11-13) can be recomputed by hand; the
+    /// tests do.
+    pub fn step_observed(&mut self, on_tour: impl FnMut(&[Dir])) -> bool {
         if self.done {
             return false;
         }
-        let it = self.walk_ants();
+        let it = self.walk_ants(on_tour);
         self.update(&it);
         self.record(&it);
         !self.done
@@ -200,7 +208,7 @@ impl<'g, 'a> Run<'g, 'a> {
 
     /// Every ant walks start -> goal on `tau(t)` and deposits `Q / L` into the increment table;
     /// the iteration's best and worst paths are kept for the wolves rule.
-    fn walk_ants(&mut self) -> Iteration {
+    fn walk_ants(&mut self, mut on_tour: impl FnMut(&[Dir])) -> Iteration {
         let p = self.params;
         let Workspace {
             tau,
@@ -257,6 +265,7 @@ impl<'g, 'a> Run<'g, 'a> {
             let Some(path) = tour.get(..walk.steps) else {
                 continue;
             };
+            on_tour(path);
             let b = Best::of(&walk);
             let len = b.length();
             it.sum += len;

@@ -155,6 +155,23 @@ fn storage_size_matches_the_formula() {
 }
 
 #[test]
+fn paper_preset_differs_from_default_only_where_documented() {
+    let d = Params::default();
+    assert_eq!(
+        Params::paper(),
+        Params {
+            patience: 0,
+            dead_end: crate::DeadEnd::Die,
+            smoothing: crate::SmoothingKind::Greedy,
+            tighten: false,
+            prune: false,
+            ..d
+        }
+    );
+    assert_eq!(Params::paper().validate(), Ok(()));
+}
+
+#[test]
 fn deterministic_per_seed() {
     let (b, w, h) = grid(&ROWS);
     let g = Grid::new(w, h, &b).unwrap();
