@@ -17,10 +17,12 @@
 //! The path is recorded as one direction byte per step, so a tour costs one byte per step whatever
 //! the map size.
 
-use crate::grid::{is_diagonal, opposite, Dir, Grid, Point, DX, DY};
+use crate::bitmap;
+use crate::grid::{is_diagonal, neighbour, opposite, Dir, Moves, Point};
 use crate::heuristic::Heuristic;
 use crate::pheromone::{slot_offsets, Table};
 use crate::rng::Xoshiro128pp;
+use crate::route::Route;
 
 /// What an ant does when every neighbour is blocked or already visited.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
@@ -80,10 +82,22 @@ pub struct Walk {
     pub may_tighten: bool,
 }
 
+/// Why a walk ended without reaching the goal.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Lost {
+    /// [`DeadEnd::Die`]: the ant died at a dead end.
+    Died,
+    /// The path grew longer than the tour buffer holds; the ant is dropped.
+    Overflow,
+    /// [`DeadEnd::Backtrack`]: the ant backed out of every branch to the start: the goal is not
+    /// reachable (a proof, since pruned cells never disconnect the start from the goal).
+    Exhausted,
+}
+
 /// Everything an ant reads; borrowed for one iteration.
 pub struct Colony<'g, 't, 'h> {
-    /// The map.
-    pub grid: &'g Grid<'g>,
+    /// The map's allowed moves.
+    pub moves: &'g Moves<'g>,
     /// Start cell.
     pub start: Point,
     /// Goal cell.
@@ -96,8 +110,10 @@ pub struct Colony<'g, 't, 'h> {
     pub alpha: f32,
     /// Dead-end behaviour.
     pub dead_end: DeadEnd,
-    /// Allowed-move mask of every cell ([`Grid::move_mask`]), computed once per plan.
-    pub moves: &'t [u8],
+    /// Cells no ant enters ([`crate::prune`]); every walk's tabu list starts as this set.
+    pub dead: &'t [u32],
+    /// Sub-goals of the potential field on large maps ([`crate::route`]); `None`: the goal.
+    pub route: Option<&'t Route<'t>>,
 }
 
 /// `tau^alpha` with the common exponents done without `powf`.
@@ -115,20 +131,21 @@ fn pow_alpha(tau: f32, alpha: f32) -> f32 {
 }
 
 impl Colony<'_, '_, '_> {
-    /// Walk one ant. `visited[i] == stamp` marks cell `i` as visited (the caller changes `stamp`
-    /// between ants, so the buffer is never cleared); `tour` receives the directions.
-    /// Returns `None` if the ant died (or, which cannot happen after the reachability check, the
-    /// start ran out of moves).
+    /// Walk one ant. `tabu` is a bit set of at least `words(cells)` words (its content is
+    /// replaced: it starts as the dead cells); `tour` receives the directions and bounds the path's
+    /// length.
     pub fn walk(
         &self,
         rng: &mut Xoshiro128pp,
-        visited: &mut [u8],
-        stamp: u8,
+        tabu: &mut [u32],
         tour: &mut [Dir],
-    ) -> Option<Walk> {
-        let grid = self.grid;
+    ) -> Result<Walk, Lost> {
+        let grid = self.moves.grid();
+        bitmap::copy(tabu, self.dead, grid.cells());
         let offsets = grid.offsets();
         let slots = slot_offsets(&offsets);
+        let blocks = self.tau.blocks();
+        let per_cell = blocks.shift() == 0;
         let tau = self.tau.flat();
         let goal = grid.index(self.goal);
         let mut cur = self.start;
@@ -136,10 +153,23 @@ impl Colony<'_, '_, '_> {
         let mut steps = 0usize;
         let mut moves = 0u32;
         let mut may_tighten = false;
-        *visited.get_mut(ci)? = stamp;
+        bitmap::set(tabu, ci);
+        // The sub-goal changes only when the ant enters another block.
+        let mut block = usize::MAX;
+        let mut target = self.goal;
         while ci != goal {
-            let eta = self.heuristic.row(cur);
-            let mut mask = *self.moves.get(ci)?;
+            let eta = match self.route {
+                None => self.heuristic.row(cur),
+                Some(r) => {
+                    let b = r.block(cur);
+                    if b != block {
+                        block = b;
+                        target = r.target(cur);
+                    }
+                    self.heuristic.row_toward(cur, target)
+                }
+            };
+            let mut mask = self.moves.at(ci, cur);
             let mut cand_dir = [0u8; 8];
             let mut cand_w = [0.0f32; 8];
             let mut n = 0usize;
@@ -151,17 +181,28 @@ impl Colony<'_, '_, '_> {
                 // knows it is in range for the 8-entry tables below.
                 let di = mask.trailing_zeros() as usize & 7;
                 mask &= mask.wrapping_sub(1); // mask != 0: clears the lowest set bit
-                let ni = ci.wrapping_add_signed(*offsets.get(di)?);
-                if *visited.get(ni)? == stamp {
-                    seen = seen.wrapping_add(1); // at most 8: one per bit of the mask
+                let ni = ci.wrapping_add_signed(offsets.get(di).copied().unwrap_or(0));
+                if bitmap::get(tabu, ni) {
+                    // A visited neighbour (not a pruned one) may offer a shortcut.
+                    if !bitmap::get(self.dead, ni) {
+                        seen = seen.wrapping_add(1); // at most 8: one per bit of the mask
+                    }
                     continue;
                 }
-                // `ci` is a cell index (it was checked against `visited`) and the table holds 16
-                // bytes a cell in memory, so `4 * ci` does not wrap (if it did, `get` would fail).
-                let t = *tau.get(ci.wrapping_mul(4).wrapping_add_signed(*slots.get(di)?))?;
+                let ti = if per_cell {
+                    // `ci` is a cell index and the table holds 16 bytes a cell in memory, so
+                    // `4 * ci` does not wrap (if it did, `get` would fail).
+                    ci.wrapping_mul(4)
+                        .wrapping_add_signed(slots.get(di).copied().unwrap_or(0))
+                } else {
+                    blocks.index(cur, di as u8)
+                };
+                let t = tau.get(ti).copied().unwrap_or(0.0);
                 let w = pow_alpha(t, self.alpha) * eta.get(di);
-                *cand_dir.get_mut(n)? = di as u8;
-                *cand_w.get_mut(n)? = w;
+                if let (Some(cd), Some(cw)) = (cand_dir.get_mut(n), cand_w.get_mut(n)) {
+                    *cd = di as u8;
+                    *cw = w;
+                }
                 total += w;
                 n = n.wrapping_add(1); // at most 8, like `seen`
             }
@@ -170,11 +211,13 @@ impl Colony<'_, '_, '_> {
             may_tighten |= seen > 1;
             let d = if n == 0 {
                 match self.dead_end {
-                    DeadEnd::Die => return None,
+                    DeadEnd::Die => return Err(Lost::Died),
                     DeadEnd::Backtrack => {
-                        steps = steps.checked_sub(1)?;
-                        let back = opposite(*tour.get(steps)?);
-                        ci = ci.wrapping_add_signed(*offsets.get(usize::from(back))?);
+                        steps = steps.checked_sub(1).ok_or(Lost::Exhausted)?;
+                        let back = opposite(tour.get(steps).copied().ok_or(Lost::Overflow)?);
+                        ci = ci.wrapping_add_signed(
+                            offsets.get(usize::from(back)).copied().unwrap_or(0),
+                        );
                         cur = neighbour(cur, back);
                         continue;
                     }
@@ -182,32 +225,35 @@ impl Colony<'_, '_, '_> {
             } else if n == 1 {
                 cand_dir[0]
             } else {
-                *cand_dir.get(roulette(rng, cand_w.get(..n)?, total))?
+                let k = roulette(rng, cand_w.get(..n).unwrap_or(&[]), total);
+                cand_dir.get(k).copied().unwrap_or(0)
             };
-            ci = ci.wrapping_add_signed(*offsets.get(usize::from(d))?);
-            cur = neighbour(cur, d);
-            *visited.get_mut(ci)? = stamp;
-            *tour.get_mut(steps)? = d;
+            let slot = tour.get_mut(steps).ok_or(Lost::Overflow)?;
+            *slot = d;
             steps = steps.wrapping_add(1); // < tour.len() + 1: the slot existed
+            ci = ci.wrapping_add_signed(offsets.get(usize::from(d)).copied().unwrap_or(0));
+            cur = neighbour(cur, d);
+            bitmap::set(tabu, ci);
         }
         // The loop checks for a second visited neighbour at every cell but the goal; a detour
         // whose only shortcut ends at the goal (e.g. (0,0) -> (0,1) -> (1,0) on an empty map) is
         // caught here.
         if !may_tighten {
-            let mut mask = *self.moves.get(goal)?;
+            let mut mask = self.moves.at(goal, self.goal);
             let mut seen = 0u32;
             while mask != 0 {
                 let di = mask.trailing_zeros() as usize & 7;
                 mask &= mask.wrapping_sub(1);
-                let ni = goal.wrapping_add_signed(*offsets.get(di)?);
+                let ni = goal.wrapping_add_signed(offsets.get(di).copied().unwrap_or(0));
                 // At most 8, one per bit of the mask.
-                seen = seen.wrapping_add(u32::from(*visited.get(ni)? == stamp));
+                let visited = bitmap::get(tabu, ni) && !bitmap::get(self.dead, ni);
+                seen = seen.wrapping_add(u32::from(visited));
             }
             may_tighten = seen > 1;
         }
-        let path = tour.get(..steps)?;
+        let path = tour.get(..steps).ok_or(Lost::Overflow)?;
         let diagonal = path.iter().filter(|&&d| is_diagonal(d)).count() as u32;
-        Some(Walk {
+        Ok(Walk {
             steps,
             // diagonal <= steps, and steps < cells < 2^32 (each step enters an unvisited cell), so
             // the cast is lossless and the difference does not wrap.
@@ -217,16 +263,6 @@ impl Colony<'_, '_, '_> {
             may_tighten,
         })
     }
-}
-
-/// The cell one move `d` from `p` (no checks: callers only move along allowed moves).
-#[inline]
-fn neighbour(p: Point, d: Dir) -> Point {
-    let di = usize::from(d & 7);
-    // A u16 plus -1..=1: no i32 overflow.
-    let x = i32::from(p.x).wrapping_add(DX.get(di).copied().unwrap_or(0));
-    let y = i32::from(p.y).wrapping_add(DY.get(di).copied().unwrap_or(0));
-    Point::new(x as u16, y as u16)
 }
 
 /// Roulette-wheel choice: index `i` with probability `w[i] / total` (one uniform draw). If every
@@ -257,17 +293,21 @@ fn roulette(rng: &mut Xoshiro128pp, w: &[f32], total: f32) -> usize {
 /// three sides of a square where one step would do). Cutting such bulges before the pheromone
 /// update makes every ant deposit on a tighter path, which is what lets the colony settle on
 /// near-optimal 8-connected paths within a few iterations (see `docs/ALGORITHM.md`). It costs at
-/// most 8 lookups per path cell. `cells` and `pos` are scratch of at least as many entries as the
-/// map has cells; `moves` holds the allowed-move masks ([`Grid::move_mask`]).
+/// most 8 lookups per path cell.
+///
+/// `cells` is scratch of at least `steps + 1` points. `pos` finds a cell's position on the path:
+/// with one entry per map cell it is indexed by cell; shorter, it is an open-addressing hash
+/// table over the path's cells, which needs a power of two of at least twice the path's cells
+/// (a longer path is returned untightened). Both give the same result.
 pub fn tighten(
-    grid: &Grid<'_>,
+    moves: &Moves<'_>,
     start: Point,
     walk: Walk,
     tour: &mut [Dir],
-    moves: &[u8],
     cells: &mut [Point],
     pos: &mut [u32],
 ) -> Walk {
+    let grid = moves.grid();
     // Cannot wrap for a real walk (steps < cells); were `steps` usize::MAX, `tour.get(..steps)`
     // below would fail and the walk come back unchanged.
     let n = walk.steps.wrapping_add(1);
@@ -275,13 +315,15 @@ pub fn tighten(
     let (Some(cells), Some(path)) = (cells.get_mut(..n), tour.get(..walk.steps)) else {
         return walk;
     };
-    // Lay the path out as cell indices and remember each cell's position on it.
+    let mut index = match PathIndex::new(pos, grid.cells(), n) {
+        Some(ix) => ix,
+        None => return walk,
+    };
+    // Lay the path out as cells and remember each cell's position on it.
     let mut p = start;
     for (i, slot) in cells.iter_mut().enumerate() {
         *slot = p;
-        if let Some(q) = pos.get_mut(grid.index(p)) {
-            *q = i as u32;
-        }
+        index.insert(grid.index(p), i as u32);
         if let Some(&d) = path.get(i) {
             p = neighbour(p, d);
         }
@@ -294,18 +336,17 @@ pub fn tighten(
     while i.wrapping_add(1) < n {
         let Some(&cp) = cells.get(i) else { break };
         let ci = grid.index(cp);
-        let mut mask = moves.get(ci).copied().unwrap_or(0);
+        let mut mask = moves.at(ci, cp);
         // Furthest later path cell one allowed move away (the next cell always qualifies).
         let mut best = (i, 0u8);
         while mask != 0 {
             let d = mask.trailing_zeros() as u8;
             mask &= mask.wrapping_sub(1);
             let nb = ci.wrapping_add_signed(offsets.get(usize::from(d)).copied().unwrap_or(0));
-            let Some(&j) = pos.get(nb) else { continue };
-            let j = j as usize;
-            // `pos` is stale for cells of earlier walks: trust it only if it points back here.
-            if j > best.0 && cells.get(j).is_some_and(|&q| grid.index(q) == nb) {
-                best = (j, d);
+            if let Some(j) = index.find(nb, |j| cells.get(j).map(|&q| grid.index(q))) {
+                if j > best.0 {
+                    best = (j, d);
+                }
             }
         }
         let (j, d) = best;
@@ -333,9 +374,88 @@ pub fn tighten(
     }
 }
 
+/// Cell -> position on a path: a per-cell array, or a hash table over the path's cells.
+struct PathIndex<'a> {
+    slots: &'a mut [u32],
+    /// `Some(bits)`: hash table of `2^bits` slots holding `position + 1` (0 = empty).
+    hash: Option<u32>,
+}
+
+impl<'a> PathIndex<'a> {
+    fn new(pos: &'a mut [u32], cells: usize, n: usize) -> Option<Self> {
+        if pos.len() >= cells {
+            return Some(PathIndex {
+                slots: pos,
+                hash: None,
+            });
+        }
+        // The smallest power of two of at least 2n slots (load factor <= 1/2).
+        let want = n.checked_mul(2)?.checked_next_power_of_two()?;
+        let slots = pos.get_mut(..want)?;
+        slots.fill(0);
+        Some(PathIndex {
+            slots,
+            hash: Some(want.trailing_zeros()),
+        })
+    }
+
+    #[inline]
+    fn home(bits: u32, cell: usize) -> usize {
+        // Fibonacci hashing of the (32-bit) cell index onto `bits` bits (1 <= bits <= 32).
+        ((cell as u32).wrapping_mul(0x9E37_79B9) >> (32u32.wrapping_sub(bits) & 31)) as usize
+    }
+
+    fn insert(&mut self, cell: usize, i: u32) {
+        let Some(bits) = self.hash else {
+            if let Some(s) = self.slots.get_mut(cell) {
+                *s = i;
+            }
+            return;
+        };
+        let mask = self.slots.len().wrapping_sub(1);
+        let mut h = Self::home(bits, cell) & mask;
+        // At most n entries in 2n slots: an empty slot is always found.
+        for _ in 0..self.slots.len() {
+            match self.slots.get_mut(h) {
+                Some(s) if *s == 0 => {
+                    *s = i.wrapping_add(1); // i < n <= 2^31
+                    return;
+                }
+                _ => h = h.wrapping_add(1) & mask,
+            }
+        }
+    }
+
+    /// The position of `cell`, checked against the path (`cell_at(j)` = the cell at position `j`):
+    /// a per-cell array may hold stale positions from earlier walks.
+    #[inline]
+    fn find(&self, cell: usize, cell_at: impl Fn(usize) -> Option<usize>) -> Option<usize> {
+        let Some(bits) = self.hash else {
+            let j = *self.slots.get(cell)? as usize;
+            return (cell_at(j) == Some(cell)).then_some(j);
+        };
+        let mask = self.slots.len().wrapping_sub(1);
+        let mut h = Self::home(bits, cell) & mask;
+        for _ in 0..self.slots.len() {
+            let v = *self.slots.get(h)?;
+            if v == 0 {
+                return None;
+            }
+            let j = v.wrapping_sub(1) as usize;
+            if cell_at(j) == Some(cell) {
+                return Some(j);
+            }
+            h = h.wrapping_add(1) & mask;
+        }
+        None
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::grid::Grid;
+    use crate::pheromone::Blocks;
 
     fn setup(rows: &[&str]) -> (Vec<u8>, u16, u16) {
         let w = rows[0].len();
@@ -373,23 +493,26 @@ mod tests {
         let (b, w, h) = setup(rows);
         let g = Grid::new(w, h, &b).unwrap();
         let mut tau_buf = vec![[1.0f32; 4]; g.cells()];
-        let tau = Table::new(w, &mut tau_buf);
+        let tau = Table::new(Blocks::new(w, h), &mut tau_buf);
         let heur = Heuristic::new(goal, true, a, 1.0, 2.0);
-        let moves: Vec<u8> = (0..g.cells()).map(|i| g.move_mask(g.point(i))).collect();
+        let moves = Moves::new(g, &[]);
+        let dead = vec![0u32; bitmap::words(g.cells())];
         let c = Colony {
-            grid: &g,
+            moves: &moves,
             start,
             goal,
             tau: &tau,
             heuristic: &heur,
             alpha: 1.0,
             dead_end,
-            moves: &moves,
+            dead: &dead,
+            route: None,
         };
-        let mut visited = vec![0u8; g.cells()];
+        let mut tabu = vec![0u32; bitmap::words(g.cells())];
         let mut tour = vec![0u8; g.cells()];
         let mut rng = Xoshiro128pp::from_u64(seed);
-        c.walk(&mut rng, &mut visited, 1, &mut tour)
+        c.walk(&mut rng, &mut tabu, &mut tour)
+            .ok()
             .map(|w| (w, tour[..w.steps].to_vec()))
     }
 

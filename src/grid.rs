@@ -214,49 +214,190 @@ impl<'a> Grid<'a> {
         o
     }
 
-    /// Flood fill from `start` over allowed moves; true if `goal` is reached.
+    /// The allowed-move mask of `p` (bit `d` set iff [`Grid::step`] allows move `d`), read from
+    /// the 3 x 3 bits around `p` and a 512-entry table: the same value as [`Grid::move_mask`] at
+    /// a fraction of the cost, for planners without a per-cell mask table.
+    #[inline]
+    pub fn mask_at(&self, p: Point) -> u8 {
+        let (x, y) = (usize::from(p.x), usize::from(p.y));
+        let (w, h) = (usize::from(self.width), usize::from(self.height));
+        // Border cells (and cells off the map) take the slow path, which checks every side.
+        if x == 0 || y == 0 || x.wrapping_add(1) >= w || y.wrapping_add(1) >= h {
+            return self.move_mask(p);
+        }
+        // Interior: x - 1, y - 1 and the rows above and below exist. Each row's three bits start
+        // at bit `(row * w + x - 1)`, which is below `cells`, so nothing here wraps.
+        let mut nb = 0usize;
+        let mut row = y.wrapping_sub(1).wrapping_mul(w).wrapping_add(x).wrapping_sub(1);
+        for r in 0..3usize {
+            let lo = self.bits.get(row >> 3).copied().unwrap_or(0xFF);
+            let hi = self.bits.get((row >> 3).wrapping_add(1)).copied().unwrap_or(0xFF);
+            let three = ((usize::from(hi) << 8 | usize::from(lo)) >> (row & 7)) & 7;
+            nb |= three << r.wrapping_mul(3);
+            row = row.wrapping_add(w);
+        }
+        MASK9.get(nb).copied().unwrap_or(0)
+    }
+
+    /// Flood fill from `start` over allowed moves: is `goal` reachable?
     ///
-    /// `mark` and `queue` are scratch space of at least [`Grid::cells`] entries (the planner lends
-    /// its own buffers). Returns `false` if they are too short.
-    pub fn reachable(&self, start: Point, goal: Point, mark: &mut [u8], queue: &mut [u32]) -> bool {
+    /// `mark` is a bit set of at least [`crate::bitmap::words`]`(cells)` words; `queue` is a ring
+    /// of cell indices of any length. A breadth-first frontier longer than the ring cannot be
+    /// held, and the answer is then [`Reach::Unknown`] (the planner's first backtracking ant
+    /// decides instead).
+    pub fn reachable(&self, start: Point, goal: Point, mark: &mut [u32], queue: &mut [u32]) -> Reach {
         let cells = self.cells();
-        if mark.len() < cells || queue.len() < cells || !self.is_free(start) || !self.is_free(goal)
-        {
-            return false;
+        if !self.is_free(start) || !self.is_free(goal) {
+            return Reach::No;
         }
-        let Some(mark) = mark.get_mut(..cells) else {
-            return false;
-        };
-        mark.fill(0);
-        let (mut head, mut tail) = (0usize, 0usize);
-        let push = |q: &mut [u32], m: &mut [u8], tail: &mut usize, p: Point| {
-            let i = self.index(p);
-            if let (Some(slot), Some(mk)) = (q.get_mut(*tail), m.get_mut(i)) {
-                if *mk == 0 {
-                    *mk = 1;
-                    *slot = i as u32;
-                    // `tail < queue.len()` (the slot exists), so this cannot wrap.
-                    *tail = tail.wrapping_add(1);
-                }
-            }
-        };
-        push(queue, mark, &mut tail, start);
-        while head < tail {
+        let cap = queue.len();
+        if mark.len() < crate::bitmap::words(cells) || cap == 0 {
+            return Reach::Unknown;
+        }
+        crate::bitmap::clear(mark, cells);
+        // Ring buffer: `head` is the next to pop, `len` how many are queued (both < cap).
+        let (mut head, mut len) = (0usize, 0usize);
+        let si = self.index(start);
+        crate::bitmap::set(mark, si);
+        if let Some(s) = queue.get_mut(0) {
+            *s = si as u32; // < cells < 2^32
+        }
+        len = len.wrapping_add(1);
+        let gi = self.index(goal);
+        while len > 0 {
             let Some(&i) = queue.get(head) else { break };
-            head = head.wrapping_add(1); // < tail
-            let p = self.point(i as usize);
-            if p == goal {
-                return true;
+            head = head.wrapping_add(1);
+            if head == cap {
+                head = 0;
             }
-            for d in 0..8 {
-                if let Some(n) = self.step(p, d) {
-                    push(queue, mark, &mut tail, n);
+            len = len.wrapping_sub(1); // > 0
+            let i = i as usize;
+            if i == gi {
+                return Reach::Yes;
+            }
+            let p = self.point(i);
+            let mut m = self.mask_at(p);
+            while m != 0 {
+                let d = m.trailing_zeros() as u8 & 7;
+                m &= m.wrapping_sub(1);
+                let Some(n) = self.step(p, d) else { continue };
+                let ni = self.index(n);
+                if crate::bitmap::insert(mark, ni) {
+                    if len == cap {
+                        return Reach::Unknown;
+                    }
+                    // head < cap and len < cap: the sum is below 2 cap, one subtraction wraps it.
+                    let mut t = head.wrapping_add(len);
+                    if t >= cap {
+                        t = t.wrapping_sub(cap);
+                    }
+                    if let Some(s) = queue.get_mut(t) {
+                        *s = ni as u32;
+                    }
+                    len = len.wrapping_add(1);
                 }
             }
         }
-        false
+        Reach::No
     }
 }
+
+/// The cell one move `d` from `p`, without checks (callers move along allowed moves only; a move
+/// off the map's edge wraps to the far end of the `u16` range, which no map contains).
+#[inline]
+pub fn neighbour(p: Point, d: Dir) -> Point {
+    let di = usize::from(d & 7);
+    // A u16 plus -1..=1: no i32 overflow.
+    let x = i32::from(p.x).wrapping_add(DX.get(di).copied().unwrap_or(0));
+    let y = i32::from(p.y).wrapping_add(DY.get(di).copied().unwrap_or(0));
+    Point::new(x as u16, y as u16)
+}
+
+/// Allowed-move masks, read from a per-cell table when the caller has one (one byte a cell,
+/// [`Grid::move_mask`] of every cell) and computed with [`Grid::mask_at`] otherwise: the same
+/// values either way, so the choice changes speed and memory, never a path.
+#[derive(Clone, Copy, Debug)]
+pub struct Moves<'g> {
+    grid: Grid<'g>,
+    table: &'g [u8],
+}
+
+impl<'g> Moves<'g> {
+    /// Masks of `grid`, from `table` if it holds one entry per cell (else computed).
+    pub fn new(grid: Grid<'g>, table: &'g [u8]) -> Self {
+        let table = if table.len() >= grid.cells() { table } else { &[] };
+        Moves { grid, table }
+    }
+
+    /// Fill `table` with the mask of every cell of `grid` (if it is long enough; returns whether
+    /// it was).
+    pub fn fill(grid: &Grid<'_>, table: &mut [u8]) -> bool {
+        let Some(t) = table.get_mut(..grid.cells()) else {
+            return false;
+        };
+        for (i, m) in t.iter_mut().enumerate() {
+            *m = grid.mask_at(grid.point(i));
+        }
+        true
+    }
+
+    /// The mask of cell `p`, whose index is `ci`.
+    #[inline]
+    pub fn at(&self, ci: usize, p: Point) -> u8 {
+        match self.table.get(ci) {
+            Some(&m) => m,
+            None => self.grid.mask_at(p),
+        }
+    }
+
+    /// The grid.
+    #[inline]
+    pub fn grid(&self) -> &Grid<'g> {
+        &self.grid
+    }
+}
+
+/// The answer of [`Grid::reachable`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Reach {
+    /// The goal is reachable.
+    Yes,
+    /// The goal is not reachable (or an endpoint is blocked).
+    No,
+    /// The flood fill's queue overflowed before it could decide.
+    Unknown,
+}
+
+/// Allowed-move mask from the centre of a 3 x 3 neighbourhood, indexed by its blocked bits
+/// (bit `3 r + c` = cell `(x - 1 + c, y - 1 + r)`): the no-corner-cutting rule as a table.
+#[allow(clippy::indexing_slicing, clippy::arithmetic_side_effects)]
+static MASK9: [u8; 512] = {
+    let mut t = [0u8; 512];
+    const fn blocked(nb: usize, c: i32, r: i32) -> bool {
+        (nb >> ((r * 3 + c) as usize)) & 1 == 1
+    }
+    let mut nb = 0usize;
+    while nb < 512 {
+        let mut m = 0u8;
+        if !blocked(nb, 1, 1) {
+            let mut d = 0usize;
+            while d < 8 {
+                let (dx, dy) = (DX[d], DY[d]);
+                let ok = !blocked(nb, 1 + dx, 1 + dy)
+                    && (dx == 0
+                        || dy == 0
+                        || (!blocked(nb, 1 + dx, 1) && !blocked(nb, 1, 1 + dy)));
+                if ok {
+                    m |= 1 << d;
+                }
+                d += 1;
+            }
+        }
+        t[nb] = m;
+        nb += 1;
+    }
+    t
+};
 
 #[cfg(test)]
 mod tests {
@@ -301,10 +442,35 @@ mod tests {
         let mut b = [0u8; 2];
         let (w, h) = grid_from(&["..#", ".#.", "#.."], &mut b);
         let g = Grid::new(w, h, &b).unwrap();
-        let mut m = [0u8; 9];
+        let mut m = [0u32; 1];
         let mut q = [0u32; 9];
-        assert!(!g.reachable(Point::new(0, 0), Point::new(2, 2), &mut m, &mut q));
-        assert!(g.reachable(Point::new(0, 0), Point::new(0, 1), &mut m, &mut q));
+        assert_eq!(g.reachable(Point::new(0, 0), Point::new(2, 2), &mut m, &mut q), Reach::No);
+        assert_eq!(g.reachable(Point::new(0, 0), Point::new(0, 1), &mut m, &mut q), Reach::Yes);
+        // A ring too short for the frontier cannot decide.
+        let open = Grid::new(8, 8, &[0; 8]).unwrap();
+        let mut m = [0u32; 2];
+        let mut q = [0u32; 2];
+        assert_eq!(open.reachable(Point::new(0, 0), Point::new(7, 7), &mut m, &mut q), Reach::Unknown);
+    }
+
+    #[test]
+    fn mask_at_is_move_mask() {
+        // Every cell of random maps: the table agrees with the rule written out.
+        let mut x = 0x1234_5678u32;
+        for _ in 0..50 {
+            let mut b = [0u8; 13];
+            for byte in &mut b {
+                x ^= x << 13;
+                x ^= x >> 17;
+                x ^= x << 5;
+                *byte = (x & (x >> 8)) as u8; // about 25 % blocked
+            }
+            let g = Grid::new(10, 10, &b).unwrap();
+            for i in 0..100 {
+                let p = g.point(i);
+                assert_eq!(g.mask_at(p), g.move_mask(p), "at {p:?}");
+            }
+        }
     }
 
     #[test]

@@ -2,8 +2,10 @@
 //! [`crate::Storage`], but as `Vec`s sized at run time instead of a compile-time capacity (a
 //! `Storage` for a 512x512 map would be 14 MiB on the stack).
 //!
-//! [`HeapStorage`] owns the buffers and lends them to a run with [`Workspace::from_slices`]; it
-//! is only that wrapper, so it follows whatever buffers the workspace takes. It can be reused for
+//! [`HeapStorage`] owns the buffers and lends them to a run with [`Workspace::new`]; it is only
+//! that wrapper, so it follows whatever buffers the workspace takes. It gives ant paths room for
+//! every cell and the move table, so nothing is ever cut short (the device's [`crate::Storage`]
+//! bounds the paths; [`HeapStorage::with_steps`] gives the same bound on the host). It can be reused for
 //! many runs and grows on demand ([`HeapStorage::ensure`], never shrinking). Allocation uses
 //! `try_reserve`, so a map too large for the machine's memory is an [`AllocError`], not an abort.
 
@@ -11,20 +13,26 @@ use alloc::collections::TryReserveError;
 use alloc::vec::Vec;
 use core::fmt;
 
+use crate::bitmap::words;
 use crate::grid::{Dir, Point};
-use crate::planner::{CurvePoint, Params, Workspace};
+use crate::pheromone::BLOCKS;
+use crate::planner::{Buffers, CurvePoint, Params, Workspace};
+use crate::route::GUIDE_BLOCKS;
 
 /// The planner's buffers, on the heap. See the module docs.
 #[derive(Clone, Debug, Default)]
 pub struct HeapStorage {
+    cells: usize,
     tau: Vec<[f32; 4]>,
     delta: Vec<[f32; 4]>,
-    visited: Vec<u8>,
+    tabu: Vec<u32>,
+    dead: Vec<u32>,
     moves: Vec<u8>,
     tours: [Vec<Dir>; 4],
     points: Vec<Point>,
-    prev: Vec<u32>,
+    links: Vec<u32>,
     curve: Vec<CurvePoint>,
+    guide: Vec<u32>,
 }
 
 /// The buffers could not be allocated.
@@ -75,35 +83,77 @@ impl HeapStorage {
 
     /// Bytes needed for `cells` cells and `iterations` curve entries, saturating.
     pub fn bytes_for(cells: usize, iterations: usize) -> usize {
-        cells
-            .saturating_mul(Workspace::BYTES_PER_CELL)
-            .saturating_add(iterations.saturating_mul(core::mem::size_of::<CurvePoint>()))
+        if cells > usize::MAX / 64 || iterations > usize::MAX / 64 {
+            return usize::MAX;
+        }
+        Workspace::bytes(cells, cells, true, iterations)
+    }
+
+    /// Storage like [`HeapStorage::new`] whose ant paths are bounded to `steps` steps (the
+    /// device's bound), with or without the move table: for host runs that must match a device
+    /// bit for bit.
+    pub fn with_steps(
+        cells: usize,
+        steps: usize,
+        moves: bool,
+        iterations: usize,
+    ) -> Result<Self, AllocError> {
+        let mut s = HeapStorage::new(cells, iterations)?;
+        let steps = steps.max(1);
+        for t in &mut s.tours {
+            t.truncate(steps);
+        }
+        s.points.truncate(steps.saturating_add(1));
+        if cells > steps.saturating_add(1).saturating_mul(2) {
+            let links = steps
+                .saturating_add(1)
+                .saturating_mul(2)
+                .checked_next_power_of_two()
+                .unwrap_or(usize::MAX)
+                .max(GUIDE_BLOCKS);
+            s.links.truncate(links);
+        }
+        if !moves {
+            s.moves.clear();
+        }
+        Ok(s)
     }
 
     /// Grow the buffers (never shrink) to hold at least `cells` cells and `iterations` curve
     /// entries.
     pub fn ensure(&mut self, cells: usize, iterations: usize) -> Result<(), AllocError> {
-        let err = |_| AllocError {
+        let err = |_: ()| AllocError {
             cells,
             iterations,
             bytes: HeapStorage::bytes_for(cells, iterations),
         };
-        grow(&mut self.tau, cells, [0.0; 4]).map_err(err)?;
-        grow(&mut self.delta, cells, [0.0; 4]).map_err(err)?;
-        grow(&mut self.visited, cells, 0).map_err(err)?;
-        grow(&mut self.moves, cells, 0).map_err(err)?;
-        for t in &mut self.tours {
-            grow(t, cells, 0).map_err(err)?;
+        if cells > usize::MAX / 64 {
+            return Err(err(()));
         }
-        grow(&mut self.points, cells, Point::default()).map_err(err)?;
-        grow(&mut self.prev, cells, 0).map_err(err)?;
-        grow(&mut self.curve, iterations, CurvePoint::default()).map_err(err)?;
+        let e = |_: TryReserveError| err(());
+        self.cells = self.cells.max(cells);
+        let cells = self.cells;
+        grow(&mut self.tau, cells.min(BLOCKS), [0.0; 4]).map_err(e)?;
+        grow(&mut self.delta, cells.min(BLOCKS), [0.0; 4]).map_err(e)?;
+        grow(&mut self.tabu, words(cells), 0).map_err(e)?;
+        grow(&mut self.dead, words(cells), 0).map_err(e)?;
+        grow(&mut self.moves, cells, 0).map_err(e)?;
+        let steps = cells.max(1);
+        for t in &mut self.tours {
+            grow(t, steps, 0).map_err(e)?;
+        }
+        grow(&mut self.points, steps.saturating_add(1), Point::default()).map_err(e)?;
+        grow(&mut self.links, cells.max(GUIDE_BLOCKS), 0).map_err(e)?;
+        grow(&mut self.curve, iterations, CurvePoint::default()).map_err(e)?;
+        if cells > BLOCKS {
+            grow(&mut self.guide, GUIDE_BLOCKS, 0).map_err(e)?;
+        }
         Ok(())
     }
 
     /// The largest map (in cells) the storage can plan on.
     pub fn cells(&self) -> usize {
-        self.tau.len()
+        self.cells
     }
 
     /// Curve entries (iterations recorded by [`crate::Plan::curve`]).
@@ -126,9 +176,8 @@ impl HeapStorage {
             *t = core::array::from_fn(|_| (next() % 1000) as f32 / 7.0);
         }
         for b in self
-            .visited
+            .moves
             .iter_mut()
-            .chain(self.moves.iter_mut())
             .chain(self.tours.iter_mut().flatten())
         {
             *b = next() as u8;
@@ -136,24 +185,32 @@ impl HeapStorage {
         for p in &mut self.points {
             *p = Point::new(next() as u16, next() as u16);
         }
-        for p in &mut self.prev {
-            *p = next();
+        for w in self
+            .tabu
+            .iter_mut()
+            .chain(self.dead.iter_mut())
+            .chain(self.links.iter_mut())
+            .chain(self.guide.iter_mut())
+        {
+            *w = next();
         }
     }
 
     /// Borrow the buffers as a workspace for one run.
     pub fn workspace(&mut self) -> Workspace<'_> {
         let [t0, t1, t2, t3] = &mut self.tours;
-        Workspace::from_slices(
-            &mut self.tau,
-            &mut self.delta,
-            &mut self.visited,
-            &mut self.moves,
-            [t0, t1, t2, t3],
-            &mut self.points,
-            &mut self.prev,
-            &mut self.curve,
-        )
+        Workspace::new(Buffers {
+            tau: &mut self.tau,
+            delta: &mut self.delta,
+            tabu: &mut self.tabu,
+            dead: &mut self.dead,
+            moves: &mut self.moves,
+            tours: [t0, t1, t2, t3],
+            points: &mut self.points,
+            links: &mut self.links,
+            curve: &mut self.curve,
+            guide: &mut self.guide,
+        })
     }
 }
 
@@ -170,6 +227,7 @@ mod tests {
         s.ensure(50, 5).unwrap();
         assert_eq!((s.cells(), s.curve_len()), (100, 10), "never shrinks");
         s.ensure(512 * 512, 100).unwrap();
+        assert_eq!(s.cells(), 512 * 512);
         assert_eq!(s.workspace().capacity(), 512 * 512);
         s.scramble(3);
         assert_eq!(s.workspace().capacity(), 512 * 512);

@@ -252,6 +252,22 @@ impl Heuristic {
         }
     }
 
+    /// `eta^beta` of the 8 moves from cell `p` when the potential field pulls towards `target`
+    /// instead of the goal (a sub-goal of [`crate::route`] on large maps).
+    #[inline]
+    pub fn row_toward(&self, p: Point, target: Point) -> Row<'_> {
+        const NONE: [u8; 8] = [(WEIGHTS - 1) as u8; 8];
+        // Differences of u16 values: no i32 overflow.
+        let key = key_of(
+            i32::from(p.x).wrapping_sub(i32::from(target.x)),
+            i32::from(p.y).wrapping_sub(i32::from(target.y)),
+        );
+        Row {
+            class: CLASS.get(key).unwrap_or(&NONE),
+            weights: &self.weights,
+        }
+    }
+
     /// `eta^beta` for moving in direction `d` from `p`.
     #[inline]
     pub fn weight(&self, p: Point, d: Dir) -> f32 {

@@ -12,6 +12,9 @@
 //! | module | owns |
 //! | --- | --- |
 //! | [`grid`] | the occupancy map, cells, the 8 moves and the no-corner-cutting rule, reachability |
+//! | [`bitmap`] | sets of cells at one bit per cell (tabu lists, pruned cells) |
+//! | [`prune`] | dead-end pruning: the cells no shortest path needs |
+//! | [`route`] | the coarse route whose sub-goals the potential field pulls towards on large maps |
 //! | [`geometry`] | path lengths and the segment rule used by smoothing and path checks |
 //! | [`heuristic`] | the distance heuristic and the goal attraction of the potential field |
 //! | [`pheromone`] | the pheromone table: storage, evaporation, deposit, clamping |
@@ -53,8 +56,9 @@
 //!     }
 //! }
 //! let grid = Grid::new(4, 3, &bits).unwrap();
-//! // Storage for maps up to 16 cells; a firmware puts this in a `static`.
-//! let mut storage: Storage<16> = Storage::new();
+//! // Storage for maps up to 32 cells (1 bit-set word), ant paths of up to 15 steps, 32 links and
+//! // the move table; a firmware puts this in a `static`.
+//! let mut storage: Storage<1, 16, 32, 32> = Storage::new();
 //! let plan = plan(&grid, Point::new(0, 0), Point::new(3, 2), &Params::default(),
 //!                 storage.workspace()).unwrap();
 //! assert_eq!(plan.raw().next(), Some(Point::new(0, 0)));
@@ -89,6 +93,7 @@ extern crate alloc;
 
 pub(crate) mod fmt;
 
+pub mod bitmap;
 pub mod colony;
 pub mod error;
 pub mod geometry;
@@ -100,13 +105,15 @@ pub mod pheromone;
 pub mod planner;
 #[cfg(feature = "protocol")]
 pub mod protocol;
+pub mod prune;
 pub mod refine;
 pub mod rng;
+pub mod route;
 pub mod smoothing;
 pub mod update;
 
 pub use colony::DeadEnd;
 pub use error::Error;
 pub use grid::{Grid, Point};
-pub use planner::{plan, Algorithm, CurvePoint, Params, Plan, Run, Storage, Workspace};
+pub use planner::{plan, Algorithm, Buffers, CurvePoint, Params, Plan, RawPath, Run, Storage, Workspace};
 pub use smoothing::SmoothingKind;

@@ -1,10 +1,16 @@
-//! The pheromone table `tau`: one `f32` per undirected edge between 8-connected neighbours.
+//! The pheromone table `tau`: one `f32` per undirected edge between 8-connected neighbours, kept
+//! at a resolution that fits a fixed budget of [`BLOCKS`] entries whatever the map's size.
 //!
 //! Each cell owns the four edges that leave it towards E, SE, S and SW; the other four directions
-//! are the same edges seen from the neighbour. So the table is `[[f32; 4]; cells]`: 16 bytes a
-//! cell (a 32x32 map: 16 KiB), half of what directed edges would cost, and an ant that walks an
-//! edge in either direction reinforces the same entry. The table lives in storage the caller
-//! provides ([`crate::planner::Storage`] or a host `Vec`).
+//! are the same edges seen from the neighbour, so an ant that walks an edge in either direction
+//! reinforces the same entry. On a map of at most [`BLOCKS`] cells (every map up to 32 x 32) each
+//! cell has its own entry: the paper's `tau_ij`, exactly. On a larger map the cells are grouped in
+//! square blocks of `2^k x 2^k` cells (the smallest `k` that gives at most [`BLOCKS`] blocks) and
+//! the cells of a block share its four entries: `tau_ij` is then the pheromone of "moving from this
+//! block towards E (SE, S, SW, or back)", and an ant's deposit on a path through the block adds up
+//! in it. This is how the colony's memory stays at `BLOCKS x 32` bytes (pheromone and its
+//! increment) on a 256 x 256 map, where one entry a cell would need 2 MiB. The choice is a
+//! function of the map's size only, so every platform and every workspace plans the same paths.
 //!
 //! Values are kept in `[tau_min, tau_max]` (max-min ant system bounds): the wolves rule subtracts
 //! pheromone, and without the floor an edge could go to zero or below and never be tried again.
@@ -51,44 +57,122 @@ pub fn slot_offsets(offsets: &[isize; 8]) -> [isize; 8] {
     s
 }
 
-/// A pheromone (or pheromone-increment) table over a map of width `width`.
+/// Most pheromone entries a map gets (each `[f32; 4]`): maps of up to this many cells get one
+/// entry per cell, larger maps one per block (see the module docs).
+pub const BLOCKS: usize = 1024;
+
+/// How a map's cells map onto pheromone entries: blocks of `2^shift x 2^shift` cells.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Blocks {
+    shift: u8,
+    /// Blocks per row.
+    across: usize,
+    count: usize,
+}
+
+impl Blocks {
+    /// The block layout of a `width x height` map: the smallest blocks that give at most
+    /// [`BLOCKS`] entries.
+    pub fn new(width: u16, height: u16) -> Self {
+        Self::with_budget(width, height, BLOCKS)
+    }
+
+    /// The block layout of a `width x height` map with at most `budget` blocks.
+    pub fn with_budget(width: u16, height: u16, budget: usize) -> Self {
+        let mut shift = 0u8;
+        loop {
+            let across = usize::from(width >> shift) + usize::from(width & ((1u16 << shift).wrapping_sub(1)) != 0);
+            let down = usize::from(height >> shift) + usize::from(height & ((1u16 << shift).wrapping_sub(1)) != 0);
+            let count = across.saturating_mul(down);
+            // shift 16 leaves one block: a 65535 x 65535 map ends there at the latest.
+            if count <= budget || shift >= 16 {
+                return Blocks { shift, across, count };
+            }
+            shift = shift.wrapping_add(1);
+        }
+    }
+
+    /// Entries the map needs.
+    pub fn count(&self) -> usize {
+        self.count
+    }
+
+    /// Blocks per row.
+    pub fn across(&self) -> usize {
+        self.across
+    }
+
+    /// Side of a block, as a power of two (0: one entry per cell).
+    pub fn shift(&self) -> u8 {
+        self.shift
+    }
+
+    /// Index of the block holding cell `p`.
+    #[inline]
+    pub fn block(&self, p: Point) -> usize {
+        // Block coordinates are below `across` and the block rows below `count / across`, and
+        // `count <= BLOCKS`: no overflow.
+        usize::from(p.y >> self.shift)
+            .wrapping_mul(self.across)
+            .wrapping_add(usize::from(p.x >> self.shift))
+    }
+
+    /// Flat index (`4 * block + slot`) of the undirected edge `(p, d)`.
+    #[inline]
+    pub fn index(&self, p: Point, d: Dir) -> usize {
+        let d = d & 7;
+        let (q, slot) = if d < 4 {
+            (p, d)
+        } else {
+            let di = usize::from(d);
+            // Callers only ask about allowed moves, so the neighbour is on the map.
+            let x = i32::from(p.x).wrapping_add(DX.get(di).copied().unwrap_or(0));
+            let y = i32::from(p.y).wrapping_add(DY.get(di).copied().unwrap_or(0));
+            (Point::new(x as u16, y as u16), d.wrapping_sub(4))
+        };
+        self.block(q).wrapping_mul(4).wrapping_add(usize::from(slot))
+    }
+}
+
+/// A pheromone (or pheromone-increment) table over a map: [`Blocks::count`] entries.
 #[derive(Debug)]
 pub struct Table<'a> {
-    width: u16,
+    blocks: Blocks,
     tau: &'a mut [[f32; 4]],
 }
 
 impl<'a> Table<'a> {
-    /// A table over `tau` (at least `cells` entries) for a map `width` wide.
-    pub fn new(width: u16, tau: &'a mut [[f32; 4]]) -> Self {
-        Table { width, tau }
+    /// Wrap a buffer (at least [`Blocks::count`] entries; a shorter one reads as 0 past its end).
+    pub fn new(blocks: Blocks, tau: &'a mut [[f32; 4]]) -> Self {
+        let n = blocks.count().min(tau.len());
+        let (tau, _) = tau.split_at_mut(n);
+        Table { blocks, tau }
     }
 
-    /// Set every edge to `value`.
+    /// The block layout.
+    pub fn blocks(&self) -> Blocks {
+        self.blocks
+    }
+
+    /// Set every entry to `value`.
     pub fn fill(&mut self, value: f32) {
         self.tau.fill([value; 4]);
     }
 
-    /// The pheromone on edge `(p, d)` (0 if out of range).
+    /// `tau` of the edge from `p` in direction `d`.
     #[inline]
     pub fn get(&self, p: Point, d: Dir) -> f32 {
-        edge(self.width, p, d)
-            .and_then(|(c, s)| self.tau.get(c).and_then(|e| e.get(s)))
-            .copied()
-            .unwrap_or(0.0)
+        self.flat().get(self.blocks.index(p, d)).copied().unwrap_or(0.0)
     }
 
-    /// Add `amount` (may be negative) to edge `(p, d)`.
+    /// Add `amount` to the edge from `p` in direction `d`.
     #[inline]
     pub fn add(&mut self, p: Point, d: Dir, amount: f32) {
-        if let Some(v) =
-            edge(self.width, p, d).and_then(|(c, s)| self.tau.get_mut(c).and_then(|e| e.get_mut(s)))
-        {
-            *v += amount;
-        }
+        let i = self.blocks.index(p, d);
+        self.add_flat(i, amount);
     }
 
-    /// `tau = clamp((1 - rho) tau + delta, lo, hi)` for every edge, and clears `delta`.
+    /// `tau = clamp((1 - rho) tau + delta, lo, hi)` for every entry, then `delta = 0`.
     pub fn evaporate_and_merge(&mut self, delta: &mut Table<'_>, rho: f32, lo: f32, hi: f32) {
         let keep = 1.0 - rho;
         for (t, d) in self.tau.iter_mut().zip(delta.tau.iter_mut()) {
@@ -109,13 +193,13 @@ impl<'a> Table<'a> {
         }
     }
 
-    /// The table as one flat slice: edge `(cell, slot)` is at `4 * cell + slot`.
+    /// The entries as one flat slice (`4 * block + slot`).
     #[inline]
     pub fn flat(&self) -> &[f32] {
         self.tau.as_flattened()
     }
 
-    /// Add `amount` at a flat index (see [`Table::flat`]); out-of-range indices are ignored.
+    /// Add `amount` at flat index `i` (ignored if out of range).
     #[inline]
     pub fn add_flat(&mut self, i: usize, amount: f32) {
         if let Some(v) = self.tau.as_flattened_mut().get_mut(i) {
@@ -123,7 +207,7 @@ impl<'a> Table<'a> {
         }
     }
 
-    /// The raw entries, `[E, SE, S, SW]` per cell (for pictures and tests).
+    /// The entries (`[E, SE, S, SW]` per block, row-major).
     pub fn entries(&self) -> &[[f32; 4]] {
         self.tau
     }
@@ -137,7 +221,7 @@ mod tests {
     #[test]
     fn both_directions_share_one_entry() {
         let mut buf = [[0.0f32; 4]; 9];
-        let mut t = Table::new(3, &mut buf);
+        let mut t = Table::new(Blocks::new(3, 3), &mut buf);
         let p = Point::new(1, 1);
         for d in 0..8u8 {
             let q = Point::new((1 + DX[d as usize]) as u16, (1 + DY[d as usize]) as u16);
@@ -149,11 +233,33 @@ mod tests {
     }
 
     #[test]
+    fn blocks_fit_the_budget() {
+        assert_eq!(Blocks::new(32, 32).shift(), 0);
+        assert_eq!(Blocks::new(32, 32).count(), 1024);
+        let b = Blocks::new(33, 32);
+        assert_eq!((b.shift(), b.count()), (1, 17 * 16));
+        let b = Blocks::new(256, 256);
+        assert_eq!((b.shift(), b.count()), (3, 1024));
+        let b = Blocks::new(530, 481);
+        assert_eq!(b.shift(), 5);
+        assert!(b.count() <= BLOCKS);
+        assert_eq!(Blocks::new(65535, 65535).count(), 1024);
+        // Both directions of an edge share an entry across a block border too.
+        let b = Blocks::new(64, 64);
+        for d in 0..8u8 {
+            let p = Point::new(2, 2);
+            let q = Point::new((2 + DX[d as usize]) as u16, (2 + DY[d as usize]) as u16);
+            assert_eq!(b.index(p, d), b.index(q, opposite(d)));
+        }
+    }
+
+    #[test]
     fn evaporation_clamps_and_clears_delta() {
         let mut a = [[1.0f32; 4]; 2];
         let mut b = [[0.5f32; 4]; 2];
-        let mut ta = Table::new(2, &mut a);
-        let mut tb = Table::new(2, &mut b);
+        let bl = Blocks::new(2, 1);
+        let mut ta = Table::new(bl, &mut a);
+        let mut tb = Table::new(bl, &mut b);
         ta.evaporate_and_merge(&mut tb, 0.5, 0.01, 0.9);
         assert!(ta.entries().iter().flatten().all(|v| *v == 0.9));
         assert!(tb.entries().iter().flatten().all(|v| *v == 0.0));

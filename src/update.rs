@@ -33,11 +33,21 @@
 //! ACA and PACA use only the first two terms; HACA and OHACA add the wolves terms. Ants that died
 //! deposit nothing.
 
-use crate::grid::{Dir, Grid, Point};
+use crate::grid::{neighbour, Dir, Grid, Point};
 use crate::pheromone::{slot_offsets, Table};
 
 /// Add `amount` to every edge of the path that starts at `start` and follows `tour`.
 pub fn deposit(table: &mut Table<'_>, grid: &Grid<'_>, start: Point, tour: &[Dir], amount: f32) {
+    let blocks = table.blocks();
+    if blocks.shift() != 0 {
+        // Blocks: locate each edge's block from the cell.
+        let mut p = start;
+        for &d in tour {
+            table.add_flat(blocks.index(p, d), amount);
+            p = neighbour(p, d);
+        }
+        return;
+    }
     let offsets = grid.offsets();
     let slots = slot_offsets(&offsets);
     let mut c = grid.index(start);
@@ -77,13 +87,14 @@ pub fn wolves(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::pheromone::Blocks;
 
     #[test]
     fn reward_best_punish_worst() {
         let bits = [0u8; 2];
         let g = Grid::new(4, 3, &bits).unwrap();
         let mut buf = [[0.0f32; 4]; 12];
-        let mut delta = Table::new(4, &mut buf);
+        let mut delta = Table::new(Blocks::new(4, 3), &mut buf);
         let start = Point::new(0, 0);
         let best = [1u8, 0, 0]; // SE, E, E
         let worst = [0u8, 0, 2, 0]; // E, E, S, E
@@ -102,7 +113,7 @@ mod tests {
         assert_eq!(delta.get(Point::new(2, 1), 0), 1.5 - 0.25);
         // Equal lengths: no wolves term.
         let mut buf2 = [[0.0f32; 4]; 12];
-        let mut d2 = Table::new(4, &mut buf2);
+        let mut d2 = Table::new(Blocks::new(4, 3), &mut buf2);
         wolves(&mut d2, &g, start, 1.0, (&best, 2.0, 3), (&worst, 2.0, 1));
         assert!(d2.entries().iter().flatten().all(|v| *v == 0.0));
     }

@@ -5,23 +5,25 @@
 //! ```text
 //! cargo run --release -p ohaca-host-tests --target host-tuple --example fingerprint > before.txt
 //! ```
+//!
+//! `OHACA_NO_PRUNE=1` turns dead-end pruning off (`Params::prune`).
 
 use std::hash::{DefaultHasher, Hash, Hasher};
 
 use ohaca::{plan, Algorithm, Params};
-use ohaca_host_tests::heap::HeapStorage;
 use ohaca_host_tests::maps::scenarios;
 
 fn main() {
     for set in scenarios() {
         let grid = set.map.grid();
-        let mut st = HeapStorage::new(set.map.cells());
+        let mut st = ohaca_host_tests::heap::storage(set.map.cells());
         for (c, case) in set.cases.iter().enumerate().take(5) {
             for alg in Algorithm::ALL {
                 for seed in 1..=3u64 {
                     let p = Params {
                         algorithm: alg,
                         seed,
+                        prune: std::env::var_os("OHACA_NO_PRUNE").is_none(),
                         ..Params::default()
                     };
                     let line = match plan(&grid, case.start, case.goal, &p, st.workspace()) {

@@ -16,7 +16,6 @@ use std::time::Instant;
 
 use ohaca::{plan, Params};
 use ohaca_host_tests::check::check_plan;
-use ohaca_host_tests::heap::HeapStorage;
 use ohaca_host_tests::large::{large_maps, LargeMap};
 use ohaca_host_tests::quality::par_map;
 use ohaca_host_tests::reference::astar8;
@@ -68,7 +67,7 @@ fn main() {
                 opt,
                 case.stated_opt8
             );
-            let mut st = HeapStorage::new(m.map.cells());
+            let mut st = ohaca_host_tests::heap::storage(m.map.cells());
             let grid = m.map.grid();
             let p = Params { seed, ..params };
             let t0 = Instant::now();

@@ -22,7 +22,10 @@ use std::time::Duration;
 
 use ohaca::colony::Colony;
 use ohaca::heuristic::Heuristic;
-use ohaca::pheromone::Table;
+use ohaca::bitmap::words;
+use ohaca::grid::Moves;
+use ohaca::pheromone::{Blocks, Table};
+use ohaca::prune::prune;
 use ohaca::rng::Xoshiro128pp;
 use ohaca::{Algorithm, DeadEnd, Params};
 use ohaca_host_tests::heap;
@@ -35,8 +38,9 @@ fn first_iteration_arrivals(prep: &Prepared, params: &Params, seeds: &[u64]) -> 
     let grid = map.grid();
     let case = &prep.cases[0];
     let cells = map.cells();
-    let mut tau_buf = vec![[params.tau0; 4]; cells];
-    let tau = Table::new(map.width(), &mut tau_buf);
+    let blocks = Blocks::new(map.width(), map.height());
+    let mut tau_buf = vec![[params.tau0; 4]; blocks.count()];
+    let tau = Table::new(blocks, &mut tau_buf);
     let heuristic = Heuristic::new(
         case.goal,
         params.algorithm.attracts(),
@@ -44,34 +48,32 @@ fn first_iteration_arrivals(prep: &Prepared, params: &Params, seeds: &[u64]) -> 
         params.xi,
         params.beta,
     );
-    let moves: Vec<u8> = (0..cells).map(|i| grid.move_mask(grid.point(i))).collect();
+    let moves = Moves::new(grid, &[]);
+    // The first iteration as the planner runs it, pruning included when the parameters ask.
+    let mut dead = vec![0u32; words(cells)];
+    if params.prune {
+        let mut stack = vec![0u32; cells];
+        prune(&moves, case.start, case.goal, &mut dead, &mut stack);
+    }
     let colony = Colony {
-        grid: &grid,
+        moves: &moves,
         start: case.start,
         goal: case.goal,
         tau: &tau,
         heuristic: &heuristic,
         alpha: params.alpha,
         dead_end: params.dead_end,
-        moves: &moves,
+        dead: &dead,
+        route: None,
     };
     let (mut arrived, mut total) = (0u64, 0u64);
-    let mut visited = vec![0u8; cells];
+    let mut tabu = vec![0u32; words(cells)];
     let mut tour = vec![0u8; cells];
     for &seed in seeds {
         let mut rng = Xoshiro128pp::from_u64(seed);
-        for ant in 0..params.ants {
-            // Stamps 1..=255, then clear (as the planner does).
-            let stamp = (ant % 255) as u8 + 1;
-            if stamp == 1 {
-                visited.fill(0);
-            }
+        for _ in 0..params.ants {
             total += 1;
-            arrived += u64::from(
-                colony
-                    .walk(&mut rng, &mut visited, stamp, &mut tour)
-                    .is_some(),
-            );
+            arrived += u64::from(colony.walk(&mut rng, &mut tabu, &mut tour).is_ok());
         }
     }
     arrived as f64 / total as f64

@@ -28,7 +28,6 @@ use ohaca::refine::{Budget, Refiner, Scratch};
 use ohaca::smoothing::{shortest_with, smooth, LOOKBACK};
 use ohaca::{plan, Params, Point, SmoothingKind};
 use ohaca_host_tests::check::check_raw;
-use ohaca_host_tests::heap::HeapStorage;
 use ohaca_host_tests::large::{large_maps, LargeMap};
 use ohaca_host_tests::quality::par_map;
 use ohaca_host_tests::reference::astar8;
@@ -49,7 +48,7 @@ fn raw_path(cache: &Path, m: &LargeMap, c: usize, seed: u64) -> Vec<Point> {
             })
             .collect();
     }
-    let mut st = HeapStorage::new(m.map.cells());
+    let mut st = ohaca_host_tests::heap::storage(m.map.cells());
     let grid = m.map.grid();
     let p = Params {
         seed,

@@ -13,7 +13,6 @@ use ohaca::grid::Dir;
 use ohaca::pheromone::edge;
 use ohaca::protocol::{decode_request, encode_request, Request, MAX_REQUEST_WIRE};
 use ohaca::{plan, Algorithm, DeadEnd, Params, Point, Run, SmoothingKind};
-use ohaca_host_tests::heap::HeapStorage;
 use ohaca_host_tests::maps::{maps_dir, Map};
 
 /// `(straight, diagonal)` steps of a tour.
@@ -35,7 +34,7 @@ fn run_steps(
     iterations: usize,
 ) -> (Vec<Vec<Vec<Dir>>>, Vec<[f32; 4]>) {
     let grid = map.grid();
-    let mut storage = HeapStorage::new(map.cells());
+    let mut storage = ohaca_host_tests::heap::storage(map.cells());
     let mut all = Vec::new();
     {
         let mut run = Run::new(&grid, start, goal, p, storage.workspace()).expect("run");
@@ -232,7 +231,7 @@ const FORK_GOAL: Point = Point::new(10, 1);
 /// The share of ants on the short route in each iteration (from the curve's mean length).
 fn short_share(p: &Params) -> Vec<f64> {
     let map = Map::from_rows(&FORK);
-    let mut storage = HeapStorage::new(map.cells());
+    let mut storage = ohaca_host_tests::heap::storage(map.cells());
     let plan = plan(&map.grid(), FORK_START, FORK_GOAL, p, storage.workspace()).expect("plan");
     assert_eq!(plan.raw_length, 10.0);
     plan.curve()
@@ -366,7 +365,7 @@ fn the_paper_preset_is_the_papers_algorithm() {
     assert!(!p.tighten);
     // Patience 0: always the full N iterations, however early the best path is found.
     let map = complex();
-    let mut storage = HeapStorage::new(map.cells());
+    let mut storage = ohaca_host_tests::heap::storage(map.cells());
     let plan = plan(
         &map.grid(),
         Point::new(0, 0),

@@ -14,7 +14,6 @@ use ohaca::refine::{refine, Budget, Refiner, Scratch, DEFAULT_PASSES};
 use ohaca::{plan, Params, Point};
 use ohaca_host_tests::check::{check_raw, length_tolerance};
 use ohaca_host_tests::gen;
-use ohaca_host_tests::heap::HeapStorage;
 use ohaca_host_tests::maps::Map;
 use ohaca_host_tests::reference::astar8;
 use proptest::prelude::*;
@@ -146,7 +145,7 @@ proptest! {
         side in prop::sample::select(vec![8usize, 13, 20]),
         salt in any::<u32>(),
     ) {
-        let mut st = HeapStorage::new(m.cells());
+        let mut st = ohaca_host_tests::heap::storage(m.cells());
         let p = Params { seed, ..Params::default() };
         let Ok(pl) = plan(&m.grid(), s, g, &p, st.workspace()) else {
             return Ok(());

@@ -203,6 +203,10 @@ pub struct ParamArgs {
     #[arg(long, value_name = "BOOL", value_parser = parse_bool, action = clap::ArgAction::Set,
           help = preset_help("Straighten each ant's path before the pheromone update (not in the paper)", |p| p.tighten.to_string()))]
     pub tighten: Option<bool>,
+    /// Prune the cells no shortest path needs before the ants run (not in the paper)
+    #[arg(long, value_name = "BOOL", value_parser = parse_bool, action = clap::ArgAction::Set,
+          help = preset_help("Prune the cells no shortest path needs before the ants run (not in the paper)", |p| p.prune.to_string()))]
+    pub prune: Option<bool>,
 }
 
 impl ParamArgs {
@@ -228,6 +232,7 @@ impl ParamArgs {
             dead_end: self.dead_end.unwrap_or(base.dead_end),
             smoothing: self.smoothing.unwrap_or(base.smoothing),
             tighten: self.tighten.unwrap_or(base.tighten),
+            prune: self.prune.unwrap_or(base.prune),
         }
     }
 }

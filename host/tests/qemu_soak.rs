@@ -583,6 +583,7 @@ impl Soak {
                 SmoothingKind::Shortest,
             ][r.below(3)],
             tighten: r.chance(0.5),
+            prune: r.chance(0.5),
         };
         if r.chance(0.04) {
             // Now and then slower plans, so that the queue fills and Cancel and new maps catch

@@ -27,12 +27,11 @@ use embassy_sync::mutex::Mutex;
 use static_cell::{ConstStaticCell, StaticCell};
 
 use board::Board;
-use ohaca::planner::Storage;
+use state::PlanStorage;
 
 /// The planner's workspace: maps of up to [`state::PLAN_CELLS`] cells (zero-initialised, so it
 /// lives in `.bss`).
-static STORAGE: ConstStaticCell<Storage<{ state::PLAN_CELLS }>> =
-    ConstStaticCell::new(Storage::new());
+static STORAGE: ConstStaticCell<PlanStorage> = ConstStaticCell::new(PlanStorage::new());
 
 /// The UART's transmitting half, shared by the transmitter and the planner.
 static TX: StaticCell<state::TxPort> = StaticCell::new();
@@ -54,7 +53,7 @@ pub fn run(spawner: Spawner) {
         state::MAX_HEIGHT,
         state::MAP_BYTES,
         state::PLAN_CELLS,
-        core::mem::size_of::<Storage<{ state::PLAN_CELLS }>>()
+        PlanStorage::BYTES
     );
     defmt::info!(
         "stack: {} bytes (RAM above the statics), {} used at boot",

@@ -16,14 +16,14 @@ use ohaca::planner::{Run, Storage};
 use ohaca::protocol::{ErrorCode, ErrorReply, PathReply, PathStream, Reply, Waypoints};
 
 use super::stack;
-use super::state::{self, count, Job, TxPort, JOBS, MAP, PLANNING, PLAN_CELLS};
+use super::state::{self, count, Job, PlanStorage, TxPort, JOBS, MAP, PLANNING};
 use super::tx::sent_one;
 
 /// Bytes of a path frame encoded per write to the UART.
 const PIECE: usize = 64;
 
 #[embassy_executor::task]
-pub async fn planner_task(storage: &'static mut Storage<PLAN_CELLS>, port: &'static TxPort) {
+pub async fn planner_task(storage: &'static mut PlanStorage, port: &'static TxPort) {
     loop {
         let job = JOBS.receive().await;
         PLANNING.store(true, Ordering::Relaxed);
@@ -50,7 +50,7 @@ pub async fn planner_task(storage: &'static mut Storage<PLAN_CELLS>, port: &'sta
 
 /// Run one job and send its path; returns the ticks it took.
 async fn plan(
-    storage: &mut Storage<PLAN_CELLS>,
+    storage: &mut PlanStorage,
     job: &Job,
     port: &'static TxPort,
 ) -> Result<u64, ErrorReply> {

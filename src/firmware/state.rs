@@ -24,16 +24,23 @@ use super::board::{self, Board};
 use super::stack;
 
 /// Widest map the device holds (the same on every board, so what QEMU proves holds on the chip).
-pub const MAX_WIDTH: u16 = 512;
+pub const MAX_WIDTH: u16 = 256;
 /// Tallest map the device holds.
-pub const MAX_HEIGHT: u16 = 512;
+pub const MAX_HEIGHT: u16 = 256;
 /// Most cells of a map the device holds.
 pub const MAX_CELLS: usize = MAX_WIDTH as usize * MAX_HEIGHT as usize;
 /// Bytes of the map buffer.
 pub const MAP_BYTES: usize = MAX_CELLS.div_ceil(8);
-/// Most cells of a map the planner plans on: the size of its `Storage` (the one constant to
-/// change with the planning core). A bigger map is held, and plans on it get `MapTooLarge`.
-pub const PLAN_CELLS: usize = 1024;
+/// Most cells of a map the planner plans on: every map the device holds, at full resolution.
+pub const PLAN_CELLS: usize = MAX_CELLS;
+/// Longest ant path the planner keeps, in steps (an ant whose path grows longer is dropped; a
+/// 256 x 256 map's shortest paths are at most 510 steps).
+pub const PLAN_STEPS: usize = 1023;
+/// The planner's storage: two bits a map cell (tabu list, pruned cells), the pheromone budget,
+/// the coarse route, four ant paths of [`PLAN_STEPS`] steps, links, and the move table for maps of
+/// up to 1024 cells (`ohaca::planner::workspace` lists what each holds).
+pub type PlanStorage =
+    ohaca::planner::Storage<{ ohaca::bitmap::words(PLAN_CELLS) }, { PLAN_STEPS + 1 }, 4096, 1024>;
 /// The map limits, for [`ohaca::protocol::Upload`].
 pub const LIMITS: MapLimits = MapLimits {
     max_width: MAX_WIDTH,

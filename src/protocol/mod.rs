@@ -342,6 +342,8 @@ impl TryFrom<ErrorReply> for Error {
             | ErrorCode::NoMap
             | ErrorCode::Busy
             | ErrorCode::BadChunk
+            | ErrorCode::BadRle
+            | ErrorCode::OutsideMap
             | ErrorCode::Internal => return Err(r),
         })
     }

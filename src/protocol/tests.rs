@@ -80,6 +80,7 @@ fn params() -> Params {
         dead_end: DeadEnd::Die,
         smoothing: SmoothingKind::Greedy,
         tighten: false,
+        prune: true,
     }
 }
 
@@ -874,7 +875,7 @@ fn protocol_doc_example_is_what_the_planner_returns() {
     use crate::grid::Grid;
     use crate::planner::{plan, Storage};
     let g = Grid::new(4, 3, &MAP).unwrap();
-    let mut s: Storage<16> = Storage::new();
+    let mut s: Storage<1, 16, 32, 16> = Storage::new();
     let p = plan(
         &g,
         Point::new(0, 0),

@@ -1,0 +1,56 @@
+//! The planner: parameters, caller-provided storage, the iteration loop, early stopping and the
+//! result.
+//!
+//! ```text
+//! validate parameters, map size, start and goal
+//! flood fill: goal unreachable -> Err(NoPath) at once
+//! prune the cells no shortest path needs                 (prune)
+//! tau = tau0 everywhere
+//! repeat `iterations` times (or until the best has not improved for `patience` iterations):
+//!     each of `ants` ants walks start -> goal            (colony)
+//!     each ant that arrived deposits Q / L on its path    (update)
+//!     HACA/OHACA: reward the iteration's best, punish its worst (update, wolves rule)
+//!     tau = clamp((1 - rho) tau + deposits, tau_min, tau_max)
+//! the best path found -> raw path; OHACA smooths it (smoothing)
+//! ```
+//!
+//! | module | owns |
+//! | --- | --- |
+//! | `params` | [`Algorithm`], [`Params`] and their ranges |
+//! | `workspace` | [`Workspace`], [`Buffers`], [`Storage`]: every buffer, one layout |
+//! | `run` | [`Run`]: the loop as a state machine (walk, update, record) |
+//! | `plan` | [`Plan`], [`RawPath`], [`CurvePoint`]: the result |
+//!
+//! [`Run::step`] does one iteration, so the firmware can yield to its executor between iterations
+//! and cancel a plan by dropping (or finishing) the run. [`plan`] runs it to the end.
+
+mod params;
+mod plan;
+mod run;
+mod workspace;
+
+pub use params::{Algorithm, Params};
+pub use plan::{CurvePoint, Plan, RawPath};
+pub use run::Run;
+pub use workspace::{Buffers, Storage, Workspace};
+
+use crate::error::Error;
+use crate::grid::{Grid, Point};
+
+/// Plan a path: [`Run::new`], [`Run::step`] until done, [`Run::finish`].
+pub fn plan<'a>(
+    grid: &Grid<'_>,
+    start: Point,
+    goal: Point,
+    params: &Params,
+    ws: Workspace<'a>,
+) -> Result<Plan<'a>, Error> {
+    // The run borrows the grid only while it runs; the plan keeps the workspace's buffers.
+    let grid = *grid;
+    let mut run = Run::new(&grid, start, goal, params, ws)?;
+    while run.step() {}
+    run.finish()
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,217 @@
+//! The planner's parameters: which variant runs ([`Algorithm`]) and every tunable ([`Params`]),
+//! with their valid ranges ([`Params::validate`]).
+
+use crate::colony::DeadEnd;
+use crate::error::{Error, Param};
+use crate::smoothing::SmoothingKind;
+
+/// The four variants the paper compares.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(rename_all = "lowercase")
+)]
+pub enum Algorithm {
+    /// Plain ant colony: `eta = 1 / d_ij`, classic ant-system update.
+    Aca,
+    /// ACA plus the potential field's goal attraction in `eta`.
+    Paca,
+    /// PACA plus the wolves-distribution pheromone update.
+    Haca,
+    /// HACA plus line-of-sight smoothing of the result.
+    #[default]
+    Ohaca,
+}
+
+impl core::fmt::Display for Algorithm {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl Algorithm {
+    /// All four, in the paper's order.
+    pub const ALL: [Algorithm; 4] = [
+        Algorithm::Aca,
+        Algorithm::Paca,
+        Algorithm::Haca,
+        Algorithm::Ohaca,
+    ];
+
+    /// Lower-case name (`"aca"`, ...).
+    pub const fn name(self) -> &'static str {
+        match self {
+            Algorithm::Aca => "aca",
+            Algorithm::Paca => "paca",
+            Algorithm::Haca => "haca",
+            Algorithm::Ohaca => "ohaca",
+        }
+    }
+
+    /// Parse a lower-case name.
+    pub fn from_name(s: &str) -> Option<Self> {
+        Self::ALL
+            .into_iter()
+            .find(|a| a.name().eq_ignore_ascii_case(s))
+    }
+
+    /// Uses the goal attraction in the heuristic.
+    pub const fn attracts(self) -> bool {
+        !matches!(self, Algorithm::Aca)
+    }
+
+    /// Uses the wolves-distribution update.
+    pub const fn wolves(self) -> bool {
+        matches!(self, Algorithm::Haca | Algorithm::Ohaca)
+    }
+}
+
+/// Every tunable of the planner.
+///
+/// Two presets: [`Params::default`] is this project's setting (the paper's `alpha`, `beta`, `rho`,
+/// `Q`, `a`, `xi`, `M` and `N`, plus backtracking ants, path tightening, dead-end pruning, early
+/// stopping after 10 stale iterations and shortest smoothing); [`Params::paper`] is the paper's
+/// algorithm as written (ants die at dead ends, no tightening, no pruning, always all `N`
+/// iterations, greedy smoothing).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct Params {
+    /// Which variant to run.
+    pub algorithm: Algorithm,
+    /// Ants per iteration (paper: M = 50).
+    pub ants: u16,
+    /// Maximum iterations (paper: N = 100).
+    pub iterations: u16,
+    /// Pheromone exponent (paper: 1).
+    pub alpha: f32,
+    /// Heuristic exponent (paper: 2).
+    pub beta: f32,
+    /// Evaporation rate, in `(0, 1]` (paper: 0.1).
+    pub rho: f32,
+    /// Pheromone deposit constant (paper: 1).
+    pub q: f32,
+    /// Goal-attraction base `a`, in `(0, 1]` (paper: 0.05).
+    pub a: f32,
+    /// Potential-field gain `xi` (paper: 1).
+    pub xi: f32,
+    /// Initial pheromone on every edge.
+    pub tau0: f32,
+    /// Lower pheromone bound (the paper's `delta = 0.01`).
+    pub tau_min: f32,
+    /// Upper pheromone bound.
+    pub tau_max: f32,
+    /// Stop when the best path has not improved for this many iterations; 0 = never stop early.
+    pub patience: u16,
+    /// Seed of the random generator.
+    pub seed: u64,
+    /// What an ant does at a dead end.
+    pub dead_end: DeadEnd,
+    /// How OHACA smooths the result (the other variants never smooth).
+    pub smoothing: SmoothingKind,
+    /// Straighten each ant's path before the pheromone update ([`crate::colony::tighten`]); not in
+    /// the paper, off for faithful comparisons.
+    pub tighten: bool,
+    /// Prune the cells no shortest path needs before the ants run ([`crate::prune`]); not in the
+    /// paper, off for faithful comparisons.
+    pub prune: bool,
+}
+
+impl Default for Params {
+    fn default() -> Self {
+        Params {
+            algorithm: Algorithm::Ohaca,
+            ants: 50,
+            iterations: 100,
+            alpha: 1.0,
+            beta: 2.0,
+            rho: 0.1,
+            q: 1.0,
+            a: 0.05,
+            xi: 1.0,
+            tau0: 1.0,
+            tau_min: 0.01,
+            tau_max: 100.0,
+            patience: 10,
+            seed: 1,
+            dead_end: DeadEnd::Backtrack,
+            smoothing: SmoothingKind::Shortest,
+            tighten: true,
+            prune: true,
+        }
+    }
+}
+
+impl Params {
+    /// The paper's setting as written: `alpha = 1`, `beta = 2`, `rho = 0.1`, `Q = 1`, `a = 0.05`,
+    /// `xi = 1`, `M = 50` ants, always the full `N = 100` iterations (`patience = 0`), ants that
+    /// die at dead ends, no path tightening, no dead-end pruning and the paper's greedy smoothing
+    /// (section 4.3). The pheromone bounds and the seed are [`Params::default`]'s (the paper gives
+    /// `delta = 0.01` and no initial value). Use it for faithful comparisons; `docs/ALGORITHM.md`
+    /// lists where the default differs and why.
+    pub const fn paper() -> Self {
+        Params {
+            algorithm: Algorithm::Ohaca,
+            ants: 50,
+            iterations: 100,
+            alpha: 1.0,
+            beta: 2.0,
+            rho: 0.1,
+            q: 1.0,
+            a: 0.05,
+            xi: 1.0,
+            tau0: 1.0,
+            tau_min: 0.01,
+            tau_max: 100.0,
+            patience: 0,
+            seed: 1,
+            dead_end: DeadEnd::Die,
+            smoothing: SmoothingKind::Greedy,
+            tighten: false,
+            prune: false,
+        }
+    }
+
+    /// Check every field's range.
+    pub fn validate(&self) -> Result<(), Error> {
+        let bad = |p| Err(Error::BadParam(p));
+        let in_range = |v: f32, lo: f32, hi: f32| v.is_finite() && v >= lo && v <= hi;
+        if self.ants == 0 {
+            return bad(Param::Ants);
+        }
+        if self.iterations == 0 {
+            return bad(Param::Iterations);
+        }
+        if !in_range(self.alpha, 0.0, 16.0) {
+            return bad(Param::Alpha);
+        }
+        if !in_range(self.beta, 0.0, 16.0) {
+            return bad(Param::Beta);
+        }
+        if !(self.rho > 0.0 && self.rho <= 1.0) {
+            return bad(Param::Rho);
+        }
+        if !(self.q.is_finite() && self.q > 0.0) {
+            return bad(Param::Q);
+        }
+        if !(self.a > 0.0 && self.a <= 1.0) {
+            return bad(Param::A);
+        }
+        if !(self.xi.is_finite() && self.xi >= 0.0) {
+            return bad(Param::Xi);
+        }
+        let t_ok = self.tau_min.is_finite()
+            && self.tau_max.is_finite()
+            && self.tau0.is_finite()
+            && self.tau_min > 0.0
+            && self.tau_min <= self.tau0
+            && self.tau0 <= self.tau_max;
+        if !t_ok {
+            return bad(Param::Tau);
+        }
+        Ok(())
+    }
+}
+

@@ -1,0 +1,101 @@
+//! The result of a run: the path ([`Plan`], its cells as a [`RawPath`]) and the convergence curve
+//! ([`CurvePoint`]).
+
+use crate::grid::{neighbour, Dir, Point};
+
+use super::params::Params;
+
+/// One point of the convergence curve.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct CurvePoint {
+    /// Shortest raw path of this iteration (`f32::INFINITY` if no ant arrived).
+    pub best: f32,
+    /// Mean raw path length of the ants that arrived (`f32::INFINITY` if none).
+    pub mean: f32,
+    /// Shortest raw path found so far.
+    pub best_so_far: f32,
+    /// Ants that reached the goal in this iteration (all of them unless they die at dead ends).
+    pub arrived: u16,
+}
+
+/// The result of a run. Borrows the workspace it was computed in.
+#[derive(Clone, Copy, Debug)]
+pub struct Plan<'a> {
+    pub(super) start: Point,
+    pub(super) tour: &'a [Dir],
+    pub(super) waypoints: &'a [Point],
+    /// Length of the raw 8-connected path, in cell units.
+    pub raw_length: f32,
+    /// Length of the output path through [`Plan::waypoints`] (smoothed for OHACA).
+    pub length: f32,
+    /// Turns (inflection points) along the waypoints.
+    pub turns: u32,
+    /// Iterations run.
+    pub iterations: u16,
+    /// Iteration (0-based) in which the best path was first found.
+    pub best_iteration: u16,
+    /// Ant moves made, forward and backtracking, over the whole run.
+    pub moves: u64,
+    /// Cells pruned before the ants ran ([`crate::prune`]).
+    pub pruned: u32,
+    pub(super) curve: &'a [CurvePoint],
+    /// Parameters used.
+    pub params: Params,
+}
+
+impl<'a> Plan<'a> {
+    /// The raw 8-connected path, start to goal.
+    pub fn raw(&self) -> RawPath<'a> {
+        RawPath::new(self.start, self.tour)
+    }
+
+    /// The raw path as directions (one byte per step).
+    pub fn directions(&self) -> &'a [Dir] {
+        self.tour
+    }
+
+    /// Cells in the raw path (steps + 1).
+    pub fn raw_len(&self) -> usize {
+        // A slice is at most `isize::MAX` long, so this does not wrap.
+        self.tour.len().wrapping_add(1)
+    }
+
+    /// The output waypoints: first = start, last = goal, no collinear interior points.
+    pub fn waypoints(&self) -> &'a [Point] {
+        self.waypoints
+    }
+
+    /// Per-iteration best / mean length (as many iterations as the workspace's curve holds).
+    pub fn curve(&self) -> &'a [CurvePoint] {
+        self.curve
+    }
+}
+
+/// Iterator over the cells of a raw path.
+#[derive(Clone, Debug)]
+pub struct RawPath<'a> {
+    next: Option<Point>,
+    dirs: core::slice::Iter<'a, Dir>,
+}
+
+impl<'a> RawPath<'a> {
+    /// The cells of the path that starts at `start` and follows `dirs` (directions as in
+    /// [`crate::grid::DX`]).
+    pub fn new(start: Point, dirs: &'a [Dir]) -> Self {
+        RawPath {
+            next: Some(start),
+            dirs: dirs.iter(),
+        }
+    }
+}
+
+impl Iterator for RawPath<'_> {
+    type Item = Point;
+    fn next(&mut self) -> Option<Point> {
+        let cur = self.next?;
+        self.next = self.dirs.next().map(|&d| neighbour(cur, d));
+        Some(cur)
+    }
+}
+

@@ -1,0 +1,433 @@
+//! A planning run as a state machine: [`Run::new`] validates and prepares, [`Run::step`] runs one
+//! iteration (walk every ant, update the pheromone, record the iteration), [`Run::finish`] turns
+//! the best path into a [`Plan`].
+//!
+//! The firmware yields to its executor between steps, so it can answer other requests and cancel
+//! a plan by dropping (or finishing) the run.
+
+use crate::colony::{tighten, Colony, Lost, Walk};
+use crate::error::{Endpoint, Error};
+use crate::geometry::{polyline_length, steps_length, turns};
+use crate::grid::{Dir, Grid, Moves, Point, Reach};
+use crate::heuristic::Heuristic;
+use crate::pheromone::{Blocks, Table};
+use crate::prune::prune;
+use crate::rng::Xoshiro128pp;
+use crate::route::{self, Route};
+use crate::smoothing::{smooth, SmoothingKind};
+use crate::update::{deposit, wolves};
+
+use super::params::{Algorithm, Params};
+use super::plan::{CurvePoint, Plan, RawPath};
+use super::workspace::Workspace;
+
+/// The best path of an iteration or of the run, as step counts (exact length comparison).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Best {
+    steps: usize,
+    straight: u32,
+    diagonal: u32,
+}
+
+impl Best {
+    fn of(w: &Walk) -> Self {
+        Best {
+            steps: w.steps,
+            straight: w.straight,
+            diagonal: w.diagonal,
+        }
+    }
+    fn length(&self) -> f32 {
+        steps_length(self.straight, self.diagonal)
+    }
+    fn same_length(&self, o: &Best) -> bool {
+        self.straight == o.straight && self.diagonal == o.diagonal
+    }
+}
+
+/// What the ants of one iteration found: the shortest and the longest path (with how many ants
+/// took a path of that length) and the sum of the lengths, for the update and the record.
+#[derive(Clone, Copy, Debug, Default)]
+struct Iteration {
+    best: Option<(Best, u32)>,
+    worst: Option<(Best, u32)>,
+    sum: f32,
+    arrived: u32,
+}
+
+/// A planning run in progress. See the module docs.
+pub struct Run<'g, 'a> {
+    grid: &'g Grid<'g>,
+    start: Point,
+    goal: Point,
+    params: Params,
+    heuristic: Heuristic,
+    blocks: Blocks,
+    guide_blocks: Blocks,
+    rng: Xoshiro128pp,
+    ws: Workspace<'a>,
+    iteration: u16,
+    best: Option<Best>,
+    best_iteration: u16,
+    stale: u16,
+    moves: u64,
+    pruned: u32,
+    routed: bool,
+    no_path: bool,
+    done: bool,
+}
+
+impl<'g, 'a> Run<'g, 'a> {
+    /// Validate everything and prepare a run: fails at once with [`Error::NoPath`] when a flood
+    /// fill finds the goal unreachable; prunes the cells no shortest path needs
+    /// ([`Params::prune`]); sets every pheromone entry to `tau0`.
+    pub fn new(
+        grid: &'g Grid<'g>,
+        start: Point,
+        goal: Point,
+        params: &Params,
+        ws: Workspace<'a>,
+    ) -> Result<Self, Error> {
+        params.validate()?;
+        let cells = grid.cells();
+        let blocks = Blocks::new(grid.width(), grid.height());
+        let ws = ws.fit(cells, blocks)?;
+        for (p, e) in [(start, Endpoint::Start), (goal, Endpoint::Goal)] {
+            if !grid.contains(p) {
+                return Err(Error::OutOfBounds(e));
+            }
+            if !grid.is_free(p) {
+                return Err(Error::Blocked(e));
+            }
+        }
+        Moves::fill(grid, ws.moves);
+        if grid.reachable(start, goal, ws.tabu, ws.links) == Reach::No {
+            return Err(Error::NoPath);
+        }
+        let pruned = if params.prune {
+            let moves = Moves::new(*grid, ws.moves);
+            prune(&moves, start, goal, ws.dead, ws.links)
+        } else {
+            crate::bitmap::clear(ws.dead, cells);
+            0
+        };
+        // Large maps: the potential field pulls along a coarse route (not for ACA, which has no
+        // attraction).
+        let guide_blocks = route::blocks(grid.width(), grid.height());
+        let routed = blocks.shift() > 0 && params.algorithm.attracts() && {
+            let moves = Moves::new(*grid, ws.moves);
+            route::build(&moves, guide_blocks, goal, ws.dead, ws.guide, ws.links)
+        };
+        ws.tau.fill([params.tau0; 4]);
+        ws.delta.fill([0.0; 4]);
+        let heuristic = Heuristic::new(
+            goal,
+            params.algorithm.attracts(),
+            params.a,
+            params.xi,
+            params.beta,
+        );
+        crate::fmt::debug!(
+            "plan: {} cells ({} pruned), ants {}, iterations {}",
+            cells,
+            pruned,
+            params.ants,
+            params.iterations
+        );
+        Ok(Run {
+            grid,
+            start,
+            goal,
+            params: *params,
+            heuristic,
+            blocks,
+            guide_blocks,
+            rng: Xoshiro128pp::from_u64(params.seed),
+            ws,
+            iteration: 0,
+            best: None,
+            best_iteration: 0,
+            stale: 0,
+            moves: 0,
+            pruned,
+            routed,
+            no_path: false,
+            done: false,
+        })
+    }
+
+    /// Ant moves made so far.
+    pub fn moves(&self) -> u64 {
+        self.moves
+    }
+
+    /// Cells pruned before the ants ran.
+    pub fn pruned(&self) -> u32 {
+        self.pruned
+    }
+
+    /// Iteration (0-based) in which the best path so far was found, if any ant has arrived.
+    pub fn best_iteration(&self) -> Option<u16> {
+        self.best.map(|_| self.best_iteration)
+    }
+
+    /// Length of the best raw path found so far.
+    pub fn best_length(&self) -> Option<f32> {
+        self.best.map(|b| b.length())
+    }
+
+    /// Iterations run so far.
+    pub fn iteration(&self) -> u16 {
+        self.iteration
+    }
+
+    /// True once the run has stopped (iteration limit or early stop).
+    pub fn is_done(&self) -> bool {
+        self.done
+    }
+
+    /// Run one iteration (all ants, then the pheromone update). Returns `true` while there is more
+    /// to do.
+    pub fn step(&mut self) -> bool {
+        self.step_observed(|_| {})
+    }
+
+    /// [`Run::step`], calling `on_tour` with the path of every ant that arrived, in ant order,
+    /// as directions from the start: exactly the path the ant deposits on (after tightening).
+    /// With these, the iteration's pheromone update (eq. 11-13) can be recomputed by hand; the
+    /// tests do.
+    pub fn step_observed(&mut self, on_tour: impl FnMut(&[Dir])) -> bool {
+        if self.done {
+            return false;
+        }
+        let it = self.walk_ants(on_tour);
+        self.update(&it);
+        self.record(&it);
+        !self.done
+    }
+
+    /// Every ant walks start -> goal on `tau(t)` and deposits `Q / L` into the increment table;
+    /// the iteration's best and worst paths are kept for the wolves rule.
+    fn walk_ants(&mut self, mut on_tour: impl FnMut(&[Dir])) -> Iteration {
+        let p = self.params;
+        let Workspace {
+            tau,
+            delta,
+            tabu,
+            dead,
+            moves,
+            tour,
+            iter_best,
+            iter_worst,
+            points,
+            links,
+            guide,
+            ..
+        } = &mut self.ws;
+        let moves = Moves::new(*self.grid, moves);
+        let route = Route::new(
+            self.guide_blocks,
+            guide,
+            self.goal,
+            self.grid.width(),
+            self.grid.height(),
+        );
+        let tau = Table::new(self.blocks, tau);
+        let mut delta = Table::new(self.blocks, delta);
+        let colony = Colony {
+            moves: &moves,
+            start: self.start,
+            goal: self.goal,
+            tau: &tau,
+            heuristic: &self.heuristic,
+            alpha: p.alpha,
+            dead_end: p.dead_end,
+            dead,
+            route: self.routed.then_some(&route),
+        };
+        let mut it = Iteration::default();
+        for _ in 0..p.ants {
+            let walk = match colony.walk(&mut self.rng, tabu, tour) {
+                Ok(w) => w,
+                Err(Lost::Exhausted) => {
+                    // Only possible when the flood fill could not decide: now it is decided.
+                    self.no_path = true;
+                    break;
+                }
+                Err(Lost::Died | Lost::Overflow) => continue,
+            };
+            self.moves = self.moves.saturating_add(u64::from(walk.moves));
+            let walk = if p.tighten && walk.may_tighten {
+                tighten(&moves, self.start, walk, tour, points, links)
+            } else {
+                walk
+            };
+            let Some(path) = tour.get(..walk.steps) else {
+                continue;
+            };
+            on_tour(path);
+            let b = Best::of(&walk);
+            let len = b.length();
+            it.sum += len;
+            it.arrived = it.arrived.saturating_add(1);
+            deposit(&mut delta, self.grid, self.start, path, p.q / len);
+            match &mut it.best {
+                Some((cur, n)) if cur.same_length(&b) => *n = n.saturating_add(1),
+                Some((cur, _)) if len >= cur.length() => {}
+                _ => {
+                    copy_tour(iter_best, path);
+                    it.best = Some((b, 1));
+                }
+            }
+            match &mut it.worst {
+                Some((cur, n)) if cur.same_length(&b) => *n = n.saturating_add(1),
+                Some((cur, _)) if len <= cur.length() => {}
+                _ => {
+                    copy_tour(iter_worst, path);
+                    it.worst = Some((b, 1));
+                }
+            }
+        }
+        it
+    }
+
+    /// The wolves rule (HACA, OHACA), then `tau = clamp((1 - rho) tau + delta)`.
+    fn update(&mut self, it: &Iteration) {
+        let p = self.params;
+        let ws = &mut self.ws;
+        let mut tau = Table::new(self.blocks, ws.tau);
+        let mut delta = Table::new(self.blocks, ws.delta);
+        if let (true, Some((b, nb)), Some((w, nw))) = (p.algorithm.wolves(), it.best, it.worst) {
+            if let (Some(bt), Some(wt)) = (ws.iter_best.get(..b.steps), ws.iter_worst.get(..w.steps))
+            {
+                wolves(
+                    &mut delta,
+                    self.grid,
+                    self.start,
+                    p.q,
+                    (bt, b.length(), nb),
+                    (wt, w.length(), nw),
+                );
+            }
+        }
+        tau.evaporate_and_merge(&mut delta, p.rho, p.tau_min, p.tau_max);
+    }
+
+    /// Track the run's best, append to the curve, decide whether to stop.
+    fn record(&mut self, it: &Iteration) {
+        let improved = match (it.best, self.best) {
+            (Some((b, _)), None) => Some(b),
+            (Some((b, _)), Some(g)) if b.length() < g.length() => Some(b),
+            _ => None,
+        };
+        if let Some(b) = improved {
+            if let Some(src) = self.ws.iter_best.get(..b.steps) {
+                copy_tour(self.ws.best, src);
+            }
+            self.best = Some(b);
+            self.best_iteration = self.iteration;
+            self.stale = 0;
+        } else {
+            self.stale = self.stale.saturating_add(1);
+        }
+        let inf = f32::INFINITY;
+        let point = CurvePoint {
+            best: it.best.map_or(inf, |(b, _)| b.length()),
+            mean: if it.arrived > 0 {
+                it.sum / it.arrived as f32
+            } else {
+                inf
+            },
+            best_so_far: self.best.map_or(inf, |b| b.length()),
+            arrived: u16::try_from(it.arrived).unwrap_or(u16::MAX),
+        };
+        if let Some(slot) = self.ws.curve.get_mut(usize::from(self.iteration)) {
+            *slot = point;
+        }
+        self.iteration = self.iteration.saturating_add(1);
+        let p = &self.params;
+        let early = p.patience > 0 && self.best.is_some() && self.stale >= p.patience;
+        self.done = self.no_path || self.iteration >= p.iterations || early;
+    }
+
+    /// Stop now and turn the best path found so far into the result (smoothed for OHACA).
+    /// Fails with [`Error::NoAntArrived`] if no ant has reached the goal (only possible with
+    /// [`crate::DeadEnd::Die`], or before the first iteration), and with [`Error::NoPath`] if an
+    /// ant proved the goal unreachable.
+    pub fn finish(self) -> Result<Plan<'a>, Error> {
+        let Run {
+            grid,
+            start,
+            params,
+            ws,
+            best,
+            best_iteration,
+            iteration,
+            moves,
+            pruned,
+            no_path,
+            ..
+        } = self;
+        if no_path {
+            return Err(Error::NoPath);
+        }
+        let best = best.ok_or(Error::NoAntArrived)?;
+        let Workspace {
+            best: best_tour,
+            points,
+            delta,
+            links,
+            curve,
+            ..
+        } = ws;
+        // The increment table is all zeros between iterations and unused from here on: lend it
+        // to the smoothing as its distance scratch (4 floats per entry).
+        let dist = delta.as_flattened_mut();
+        let tour: &'a [Dir] = best_tour.get(..best.steps).ok_or(Error::NoPath)?;
+        // Expand the tour into cells.
+        let n = best.steps.checked_add(1).ok_or(Error::NoPath)?;
+        let pts = points.get_mut(..n).ok_or(Error::NoPath)?;
+        for (slot, p) in pts.iter_mut().zip(RawPath::new(start, tour)) {
+            *slot = p;
+        }
+        let kind = if params.algorithm == Algorithm::Ohaca {
+            params.smoothing
+        } else {
+            SmoothingKind::None
+        };
+        let k = smooth(grid, kind, pts, n, dist, links);
+        let pts: &'a [Point] = points;
+        let waypoints = pts.get(..k).ok_or(Error::NoPath)?;
+        // Without smoothing the waypoints are the raw path's corners: report the exact step-count
+        // length rather than re-summing it (which can differ in the last bit).
+        let length = if kind == SmoothingKind::None {
+            best.length()
+        } else {
+            polyline_length(waypoints)
+        };
+        let curve: &'a [CurvePoint] = curve;
+        let curve = curve
+            .get(..usize::from(iteration).min(curve.len()))
+            .unwrap_or(&[]);
+        Ok(Plan {
+            start,
+            tour,
+            waypoints,
+            raw_length: best.length(),
+            length,
+            turns: turns(waypoints),
+            iterations: iteration,
+            best_iteration,
+            moves,
+            pruned,
+            curve,
+            params,
+        })
+    }
+}
+
+fn copy_tour(dst: &mut [Dir], src: &[Dir]) {
+    if let Some(d) = dst.get_mut(..src.len()) {
+        d.copy_from_slice(src);
+    }
+}

@@ -1,0 +1,276 @@
+//! Every buffer a run needs, borrowed from the caller ([`Workspace`]) or owned with compile-time
+//! capacities ([`Storage`], for a `static` on the device). Nothing is allocated.
+//!
+//! What scales with what:
+//!
+//! | buffer | entries | bytes | what for |
+//! | --- | --- | --- | --- |
+//! | `tabu`, `dead` | `words(cells)` each | 1 bit a cell each | the ant's tabu list; pruned cells |
+//! | `tau`, `delta` | [`BLOCKS`] (fewer on maps of fewer cells) | 16 each | pheromone and its increment |
+//! | `moves` | `cells`, or none | 1 | allowed-move masks (computed on the fly without it) |
+//! | 4 tours | `steps` each | 1 | the ant's path, the iteration's best and worst, the best so far |
+//! | `points` | `steps + 1` | 4 | the best path as cells, tightening scratch |
+//! | `links` | `cells`, or `>= 2 (steps + 1)` and [`GUIDE_BLOCKS`] | 4 | path positions (tightening), flood-fill ring, pruning stack, route heap, smoothing links |
+//! | `curve` | iterations recorded | 16 | the convergence curve |
+//! | `guide` | [`GUIDE_BLOCKS`] on maps of more than [`BLOCKS`] cells, else none | 4 | the coarse route ([`crate::route`]) |
+//!
+//! So the colony's memory is a fixed budget (pheromone) plus what the longest ant path needs
+//! (`steps`), plus two bits a map cell. The map itself (one bit a cell) is the caller's.
+//! An ant whose path grows beyond `steps` is dropped; `links` shorter than `cells` switches
+//! tightening to a hash table. Neither changes a path that fits.
+
+use crate::bitmap::words;
+use crate::error::Error;
+use crate::grid::{Dir, Point};
+use crate::pheromone::{Blocks, BLOCKS};
+use crate::route::GUIDE_BLOCKS;
+
+use super::plan::CurvePoint;
+
+/// Every buffer a run needs, borrowed from the caller (see the module docs for the sizes).
+#[derive(Debug)]
+pub struct Workspace<'a> {
+    pub(super) tau: &'a mut [[f32; 4]],
+    pub(super) delta: &'a mut [[f32; 4]],
+    pub(super) tabu: &'a mut [u32],
+    pub(super) dead: &'a mut [u32],
+    pub(super) moves: &'a mut [u8],
+    pub(super) tour: &'a mut [Dir],
+    pub(super) iter_best: &'a mut [Dir],
+    pub(super) iter_worst: &'a mut [Dir],
+    pub(super) best: &'a mut [Dir],
+    pub(super) points: &'a mut [Point],
+    pub(super) links: &'a mut [u32],
+    pub(super) curve: &'a mut [CurvePoint],
+    pub(super) guide: &'a mut [u32],
+}
+
+/// The caller's buffers, by name, for [`Workspace::new`].
+#[derive(Debug)]
+pub struct Buffers<'a> {
+    /// Pheromone: [`BLOCKS`] entries (or as many as the largest map's [`Blocks::count`]).
+    pub tau: &'a mut [[f32; 4]],
+    /// Pheromone increments: as many as `tau`.
+    pub delta: &'a mut [[f32; 4]],
+    /// Tabu bit set: [`words`]`(cells)` words.
+    pub tabu: &'a mut [u32],
+    /// Pruned-cell bit set: as many as `tabu`.
+    pub dead: &'a mut [u32],
+    /// Allowed-move masks: `cells` bytes, or empty to compute them on the fly.
+    pub moves: &'a mut [u8],
+    /// The four tours, `steps` entries each (the longest ant path the run keeps).
+    pub tours: [&'a mut [Dir]; 4],
+    /// Path cells: `steps + 1`.
+    pub points: &'a mut [Point],
+    /// Links: `cells`, or at least `2 (steps + 1)` (see the module docs).
+    pub links: &'a mut [u32],
+    /// Convergence curve: one entry per iteration recorded.
+    pub curve: &'a mut [CurvePoint],
+    /// The coarse route on large maps ([`crate::route`]): [`GUIDE_BLOCKS`] entries (none needed on
+    /// maps of at most [`BLOCKS`] cells).
+    pub guide: &'a mut [u32],
+}
+
+impl<'a> Workspace<'a> {
+    /// Bytes a workspace needs for maps of `cells` cells and ant paths of up to `steps` steps, with
+    /// or without the move table and with a curve of `curve` iterations.
+    pub const fn bytes(cells: usize, steps: usize, moves: bool, curve: usize) -> usize {
+        let bits = 2 * 4 * words(cells);
+        let pheromone = 2 * 16 * if cells < BLOCKS { cells } else { BLOCKS };
+        let moves = if moves { cells } else { 0 };
+        let links = 4 * if cells < 2 * (steps + 1) { cells } else { 2 * (steps + 1) };
+        let guide = if cells > BLOCKS { 4 * GUIDE_BLOCKS } else { 0 };
+        bits + pheromone + moves + 4 * steps + 4 * (steps + 1) + links + 16 * curve + guide
+    }
+
+    /// A workspace over the caller's buffers.
+    pub fn new(b: Buffers<'a>) -> Self {
+        let [tour, iter_best, iter_worst, best] = b.tours;
+        Workspace {
+            tau: b.tau,
+            delta: b.delta,
+            tabu: b.tabu,
+            dead: b.dead,
+            moves: b.moves,
+            tour,
+            iter_best,
+            iter_worst,
+            best,
+            points: b.points,
+            links: b.links,
+            curve: b.curve,
+            guide: b.guide,
+        }
+    }
+
+    /// The largest map (in cells) this workspace can plan on.
+    pub fn capacity(&self) -> usize {
+        let bits = self.tabu.len().min(self.dead.len()).saturating_mul(32);
+        let blocks = self.tau.len().min(self.delta.len());
+        // Maps of up to `blocks` cells fit whatever the bits say beyond; larger maps need the
+        // whole pheromone budget.
+        if blocks >= BLOCKS {
+            bits
+        } else {
+            bits.min(blocks)
+        }
+    }
+
+    /// The longest ant path (in steps) this workspace keeps.
+    pub fn steps(&self) -> usize {
+        [
+            self.tour.len(),
+            self.iter_best.len(),
+            self.iter_worst.len(),
+            self.best.len(),
+            self.points.len().saturating_sub(1),
+        ]
+        .into_iter()
+        .min()
+        .unwrap_or(0)
+    }
+
+    /// Cut every buffer to what a `cells`-cell map with pheromone layout `blocks` uses, or fail
+    /// with [`Error::MapTooLarge`].
+    pub(super) fn fit(self, cells: usize, blocks: Blocks) -> Result<Self, Error> {
+        let capacity = self.capacity();
+        let too_large = || Error::MapTooLarge {
+            cells: u32::try_from(cells).unwrap_or(u32::MAX),
+            capacity: u32::try_from(capacity).unwrap_or(u32::MAX),
+        };
+        if cells > capacity || self.steps() == 0 && cells > 1 {
+            return Err(too_large());
+        }
+        let w = words(cells);
+        let n = blocks.count();
+        let steps = self.steps();
+        let moves_len = if self.moves.len() >= cells { cells } else { 0 };
+        let cut = |s: &'a mut [u32], n: usize| s.split_at_mut(n.min(s.len())).0;
+        let Workspace {
+            tau,
+            delta,
+            tabu,
+            dead,
+            moves,
+            tour,
+            iter_best,
+            iter_worst,
+            best,
+            points,
+            links,
+            curve,
+            guide,
+        } = self;
+        let (tau, _) = tau.split_at_mut(n.min(tau.len()));
+        let (delta, _) = delta.split_at_mut(n.min(delta.len()));
+        if tau.len() < n || delta.len() < n {
+            return Err(too_large());
+        }
+        Ok(Workspace {
+            tau,
+            delta,
+            tabu: cut(tabu, w),
+            dead: cut(dead, w),
+            moves: moves.split_at_mut(moves_len).0,
+            tour: tour.split_at_mut(steps).0,
+            iter_best: iter_best.split_at_mut(steps).0,
+            iter_worst: iter_worst.split_at_mut(steps).0,
+            best: best.split_at_mut(steps).0,
+            points: points.split_at_mut(steps.saturating_add(1).min(points.len())).0,
+            links,
+            curve,
+            guide,
+        })
+    }
+
+    /// The pheromone of the last run (`[E, SE, S, SW]` per entry, row-major; see
+    /// [`crate::pheromone::Blocks`] for how a map's cells map onto entries).
+    pub fn pheromone(&self) -> &[[f32; 4]] {
+        self.tau
+    }
+}
+
+/// Fixed-capacity storage for a [`Workspace`]: bit sets of `WORDS` words (maps of up to
+/// `32 * WORDS` cells), ant paths of up to `STEPS - 1` steps, `LINKS` links, a move table for maps
+/// of up to `MOVES` cells (0: none), and a curve of `CURVE` iterations. Put it in a `static` on
+/// the device; its size is [`Storage::BYTES`].
+///
+/// ```
+/// use ohaca::bitmap::words;
+/// use ohaca::planner::Storage;
+/// // The device's: 256 x 256 maps, paths of up to 1023 steps, the move table for small maps.
+/// type Device = Storage<{ words(65536) }, 1024, 4096, 1024>;
+/// assert!(Device::BYTES < 92 * 1024);
+/// ```
+#[derive(Debug)]
+pub struct Storage<
+    const WORDS: usize,
+    const STEPS: usize,
+    const LINKS: usize,
+    const MOVES: usize = 0,
+    const CURVE: usize = 128,
+> {
+    tau: [[f32; 4]; BLOCKS],
+    delta: [[f32; 4]; BLOCKS],
+    tabu: [u32; WORDS],
+    dead: [u32; WORDS],
+    moves: [u8; MOVES],
+    tours: [[Dir; STEPS]; 4],
+    points: [Point; STEPS],
+    links: [u32; LINKS],
+    curve: [CurvePoint; CURVE],
+    guide: [u32; GUIDE_BLOCKS],
+}
+
+impl<const WORDS: usize, const STEPS: usize, const LINKS: usize, const MOVES: usize, const CURVE: usize>
+    Storage<WORDS, STEPS, LINKS, MOVES, CURVE>
+{
+    /// Size in bytes.
+    pub const BYTES: usize = core::mem::size_of::<Self>();
+
+    /// Zeroed storage (a `const fn`, so it can initialise a `static`).
+    pub const fn new() -> Self {
+        Storage {
+            tau: [[0.0; 4]; BLOCKS],
+            delta: [[0.0; 4]; BLOCKS],
+            tabu: [0; WORDS],
+            dead: [0; WORDS],
+            moves: [0; MOVES],
+            tours: [[0; STEPS]; 4],
+            points: [Point::new(0, 0); STEPS],
+            links: [0; LINKS],
+            curve: [CurvePoint {
+                best: 0.0,
+                mean: 0.0,
+                best_so_far: 0.0,
+                arrived: 0,
+            }; CURVE],
+            guide: [0; GUIDE_BLOCKS],
+        }
+    }
+
+    /// Borrow the storage as a [`Workspace`].
+    pub fn workspace(&mut self) -> Workspace<'_> {
+        let [t0, t1, t2, t3] = &mut self.tours;
+        Workspace::new(Buffers {
+            tau: &mut self.tau,
+            delta: &mut self.delta,
+            tabu: &mut self.tabu,
+            dead: &mut self.dead,
+            moves: &mut self.moves,
+            tours: [t0, t1, t2, t3],
+            points: &mut self.points,
+            links: &mut self.links,
+            curve: &mut self.curve,
+            guide: &mut self.guide,
+        })
+    }
+}
+
+impl<const WORDS: usize, const STEPS: usize, const LINKS: usize, const MOVES: usize, const CURVE: usize>
+    Default for Storage<WORDS, STEPS, LINKS, MOVES, CURVE>
+{
+    fn default() -> Self {
+        Self::new()
+    }
+}

@@ -1,0 +1,395 @@
+//! The coarse route on large maps: where the potential field pulls.
+//!
+//! The paper's goal attraction (eqs. 6-10) pulls every ant straight towards the goal. On a small
+//! map that is what makes OHACA fast; on a large one it is the classic weakness of artificial
+//! potential fields: the straight pull leads into every courtyard, dead-end street and U-shaped
+//! wall that faces the goal, and a backtracking ant explores each of them before it finds the way
+//! around (on a 256 x 256 city map an ant made ten times as many moves as its path has steps).
+//!
+//! On maps with more cells than [`crate::pheromone::BLOCKS`], the map is cut into the same
+//! square blocks as the pheromone, and before any ant runs:
+//!
+//! 1. **Connectivity**: block `B` links to a neighbouring block `B'` when some live cell of `B`
+//!    has an allowed move into a live cell of `B'` (pruned cells do not count). This
+//!    over-approximates the map (a block's free cells need not be connected inside it), so a route
+//!    exists on blocks whenever one exists on cells.
+//! 2. **Distances**: Dijkstra from the goal's block over the links, 10 per straight and 14 per
+//!    diagonal block step.
+//! 3. **Sub-goals**: an ant in block `B` is pulled towards the centre of the block [`LOOKAHEAD`]
+//!    links further down the route (or the goal itself once that is closer). The attraction is
+//!    the paper's, unchanged (`a^(xi (d(j, T) - d(i, T)))` with the octile distance), with the
+//!    sub-goal `T` in place of the goal `G`: a potential field that follows the coarse geodesic
+//!    distance, so it has no local minimum larger than a block.
+//!
+//! The ants still walk cells, with their tabu list and backtracking, so a wrong sub-goal (a block
+//! whose free cells do not connect) costs moves, never a path. Memory: one `u32` per block (the
+//! links, the next block and the distance) plus scratch for the heap (two `u32` per block).
+
+use crate::grid::{Dir, Moves, Point, DX, DY};
+use crate::pheromone::Blocks;
+
+/// Most blocks of the route: a map with more cells than this is cut into blocks of `2^k x 2^k`
+/// cells (the smallest `k` that gives at most this many), a smaller one routes on cells.
+pub const GUIDE_BLOCKS: usize = 4096;
+
+/// How many blocks ahead on the route an ant's sub-goal lies.
+pub const LOOKAHEAD: u32 = 2;
+
+/// Per-block word: bits 0-7 links (bit `d`: the neighbour block in direction `d`), bits 8-11 the
+/// next block's direction (`NONE`: the goal's block or no route), bits 12-31 the distance.
+const NONE: u32 = 8;
+const DIST_SHIFT: u32 = 12;
+const UNREACHED: u32 = u32::MAX >> DIST_SHIFT;
+
+/// The coarse route of a run: the per-block words and what reads them.
+#[derive(Clone, Copy, Debug)]
+pub struct Route<'a> {
+    blocks: Blocks,
+    words: &'a [u32],
+    goal: Point,
+    width: u16,
+    height: u16,
+}
+
+impl<'a> Route<'a> {
+    /// A route over the per-block words [`build`] wrote.
+    pub fn new(blocks: Blocks, words: &'a [u32], goal: Point, width: u16, height: u16) -> Self {
+        Route {
+            blocks,
+            words,
+            goal,
+            width,
+            height,
+        }
+    }
+
+    /// The block of cell `p`.
+    #[inline]
+    pub fn block(&self, p: Point) -> usize {
+        self.blocks.block(p)
+    }
+
+    /// The point the potential field pulls towards from cell `p`.
+    #[inline]
+    pub fn target(&self, p: Point) -> Point {
+        let s = self.blocks.shift();
+        let (mut bx, mut by) = (i32::from(p.x >> s), i32::from(p.y >> s));
+        let across = self.blocks.across();
+            for _ in 0..LOOKAHEAD {
+            // Block coordinates are below 2^16: the index fits.
+            let b = (by as usize).wrapping_mul(across).wrapping_add(bx as usize);
+            let next = self.words.get(b).map_or(NONE, |w| (w >> 8) & 15);
+            if next >= NONE {
+                return self.goal;
+            }
+            let d = next as usize & 7;
+            bx = bx.wrapping_add(DX.get(d).copied().unwrap_or(0));
+            by = by.wrapping_add(DY.get(d).copied().unwrap_or(0));
+        }
+        // The centre of that block, on the map (the last block of a row may be cut short).
+        let half = (1i32 << s) >> 1;
+        let cx = (bx << s).wrapping_add(half).min(i32::from(self.width) - 1);
+        let cy = (by << s).wrapping_add(half).min(i32::from(self.height) - 1);
+        Point::new(cx.max(0) as u16, cy.max(0) as u16)
+    }
+}
+
+/// The block layout of the route of a `width x height` map.
+pub fn blocks(width: u16, height: u16) -> Blocks {
+    Blocks::with_budget(width, height, GUIDE_BLOCKS)
+}
+
+/// Build the route to `goal`: links, distances and next blocks, into `words` (one per block of
+/// `blocks`). `dead` marks pruned cells; `heap` is scratch of one word per block. Returns false
+/// (and no route: every ant pulled to the goal) if a buffer is too short.
+pub fn build(
+    moves: &Moves<'_>,
+    blocks: Blocks,
+    goal: Point,
+    dead: &[u32],
+    words: &mut [u32],
+    heap: &mut [u32],
+) -> bool {
+    let n = blocks.count();
+    if n > usize::from(u16::MAX) {
+        return false;
+    }
+    let (Some(words), Some(heap)) = (words.get_mut(..n), heap.get_mut(..n)) else {
+        return false;
+    };
+    links(moves, blocks, dead, words);
+    for w in words.iter_mut() {
+        *w = (*w & 0xFF) | (NONE << 8) | (UNREACHED << DIST_SHIFT);
+    }
+    dijkstra(blocks, blocks.block(goal), words, Heap { w: heap, len: 0 });
+    true
+}
+/// Bits 0-7 of each block's word: the neighbour blocks one allowed move away.
+fn links(moves: &Moves<'_>, blocks: Blocks, dead: &[u32], words: &mut [u32]) {
+    words.fill(0);
+    let grid = *moves.grid();
+    let (w, h) = (grid.width(), grid.height());
+    let s = blocks.shift();
+    let last = (1u16 << s).wrapping_sub(1);
+    let offsets = grid.offsets();
+    for y in 0..h {
+        let border_row = y & last == 0 || y & last == last || y == h.wrapping_sub(1);
+        let mut x = 0u16;
+        while x < w {
+            let p = Point::new(x, y);
+            let ci = grid.index(p);
+            if !crate::bitmap::get(dead, ci) {
+                let mut m = moves.at(ci, p);
+                let b = blocks.block(p);
+                while m != 0 {
+                    let d = m.trailing_zeros() as usize & 7;
+                    m &= m.wrapping_sub(1);
+                    let ni = ci.wrapping_add_signed(offsets.get(d).copied().unwrap_or(0));
+                    if crate::bitmap::get(dead, ni) {
+                        continue;
+                    }
+                    let q = crate::grid::neighbour(p, d as Dir);
+                    let nb = blocks.block(q);
+                    if nb != b {
+                        let dir = block_dir(p, q, s);
+                        if let Some(wd) = words.get_mut(b) {
+                            *wd |= 1 << dir;
+                        }
+                    }
+                }
+            }
+            // Inside a block's rows only its first and last columns can leave it.
+            x = if border_row || x & last == last || x.wrapping_add(1) >= w {
+                x.wrapping_add(1)
+            } else if x & last == 0 {
+                (x | last).min(w.wrapping_sub(1))
+            } else {
+                x.wrapping_add(1)
+            };
+        }
+    }
+}
+
+/// The direction from `p`'s block to `q`'s block (adjacent blocks).
+fn block_dir(p: Point, q: Point, s: u8) -> u32 {
+    let dx = i32::from(q.x >> s) - i32::from(p.x >> s);
+    let dy = i32::from(q.y >> s) - i32::from(p.y >> s);
+    let mut d = 0u32;
+    while d < 8 {
+        if DX.get(d as usize) == Some(&dx) && DY.get(d as usize) == Some(&dy) {
+            return d;
+        }
+        d = d.wrapping_add(1);
+    }
+    0
+}
+
+fn dist(w: u32) -> u32 {
+    w >> DIST_SHIFT
+}
+
+/// An indexed binary min-heap of blocks by distance, in one word per block: the low half of word
+/// `i` is the block in heap slot `i`, the high half of word `b` is block `b`'s slot + 1 (0: not
+/// queued, `u16::MAX`: done). Blocks number at most `u16::MAX - 1`.
+struct Heap<'a> {
+    w: &'a mut [u32],
+    len: usize,
+}
+
+impl Heap<'_> {
+    fn block_at(&self, i: usize) -> usize {
+        self.w.get(i).map_or(0, |&v| (v & 0xFFFF) as usize)
+    }
+    fn set_block_at(&mut self, i: usize, b: usize) {
+        if let Some(v) = self.w.get_mut(i) {
+            *v = (*v & 0xFFFF_0000) | (b as u32 & 0xFFFF);
+        }
+    }
+    fn slot(&self, b: usize) -> u32 {
+        self.w.get(b).map_or(0, |&v| v >> 16)
+    }
+    fn set_slot(&mut self, b: usize, s: u32) {
+        if let Some(v) = self.w.get_mut(b) {
+            *v = (*v & 0xFFFF) | (s << 16);
+        }
+    }
+    /// Put the block of slot `i` there for good: record its slot.
+    fn place(&mut self, i: usize, b: usize) {
+        self.set_block_at(i, b);
+        self.set_slot(b, (i as u32).wrapping_add(1)); // i < blocks < 2^16 - 1
+    }
+
+    /// Insert `b` or move it up after its distance dropped.
+    fn push(&mut self, words: &[u32], b: usize) {
+        let mut i = match self.slot(b) {
+            0 => {
+                let i = self.len;
+                self.len = self.len.wrapping_add(1); // <= blocks
+                i
+            }
+            0xFFFF => return, // done
+            s => s.wrapping_sub(1) as usize,
+        };
+        let kb = key(words, b);
+        // Sift up: move parents down until `b` fits.
+        while i > 0 {
+            let parent = i.wrapping_sub(1) >> 1;
+            let pb = self.block_at(parent);
+            if key(words, pb) <= kb {
+                break;
+            }
+            self.place(i, pb);
+            i = parent;
+        }
+        self.place(i, b);
+    }
+
+    /// Remove and return the block of least distance (`len > 0`).
+    fn pop(&mut self, words: &[u32]) -> usize {
+        let top = self.block_at(0);
+        self.set_slot(top, 0xFFFF);
+        self.len = self.len.wrapping_sub(1);
+        if self.len == 0 {
+            return top;
+        }
+        let last = self.block_at(self.len);
+        let kl = key(words, last);
+        // Sift down from the root with `last`.
+        let mut i = 0usize;
+        loop {
+            let l = i.wrapping_mul(2).wrapping_add(1);
+            if l >= self.len {
+                break;
+            }
+            let r = l.wrapping_add(1);
+            let mut c = l;
+            if r < self.len && key(words, self.block_at(r)) < key(words, self.block_at(l)) {
+                c = r;
+            }
+            let cb = self.block_at(c);
+            if key(words, cb) >= kl {
+                break;
+            }
+            self.place(i, cb);
+            i = c;
+        }
+        self.place(i, last);
+        top
+    }
+}
+
+fn key(words: &[u32], b: usize) -> u32 {
+    words.get(b).map_or(u32::MAX, |&w| dist(w))
+}
+
+/// Dijkstra over blocks from `goal_block`.
+fn dijkstra(blocks: Blocks, goal_block: usize, words: &mut [u32], mut heap: Heap<'_>) {
+    heap.w.fill(0);
+    let across = blocks.across().max(1);
+    let n = words.len();
+    if let Some(w) = words.get_mut(goal_block) {
+        *w &= !(UNREACHED << DIST_SHIFT);
+    }
+    heap.push(words, goal_block);
+    while heap.len > 0 {
+        let b = heap.pop(words);
+        let Some(&wb) = words.get(b) else { break };
+        let db = dist(wb);
+        let (bx, by) = ((b % across) as i32, (b / across) as i32);
+        for d in 0..8usize {
+            let nx = bx.wrapping_add(DX.get(d).copied().unwrap_or(0));
+            let ny = by.wrapping_add(DY.get(d).copied().unwrap_or(0));
+            if nx < 0 || ny < 0 || nx as usize >= across {
+                continue;
+            }
+            let nb = (ny as usize).wrapping_mul(across).wrapping_add(nx as usize);
+            if nb >= n {
+                continue;
+            }
+            let Some(&wn) = words.get(nb) else { continue };
+            // The neighbour reaches `b` in the opposite direction of `d` (links are per
+            // direction of travel).
+            let back = (d as u32).wrapping_add(4) & 7;
+            if (wn >> back) & 1 == 0 {
+                continue;
+            }
+            let nd = db.saturating_add(if d % 2 == 1 { 14 } else { 10 });
+            if nd < dist(wn) {
+                if let Some(w) = words.get_mut(nb) {
+                    *w = (wn & 0xFF) | (back << 8) | (nd << DIST_SHIFT);
+                }
+                heap.push(words, nb);
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::grid::Grid;
+
+    /// A 64 x 64 map (2 x 2 blocks would be 1024: the route uses single cells up to 4096 cells, so
+    /// take 128 x 64 = 8192 cells: 2 x 2 blocks) with a wall between start and goal that has one
+    /// gap at the bottom.
+    fn walled() -> (Vec<u8>, u16, u16) {
+        let (w, h) = (128u16, 64u16);
+        let mut b = vec![0u8; (usize::from(w) * usize::from(h)).div_ceil(8)];
+        for y in 0..h - 4 {
+            let i = usize::from(y) * usize::from(w) + 64;
+            b[i / 8] |= 1 << (i % 8);
+        }
+        (b, w, h)
+    }
+
+    #[test]
+    fn sub_goals_lead_around_the_wall() {
+        let (b, w, h) = walled();
+        let g = Grid::new(w, h, &b).unwrap();
+        let blocks = blocks(w, h);
+        assert_eq!(blocks.shift(), 1);
+        let moves = Moves::new(g, &[]);
+        let dead = vec![0u32; crate::bitmap::words(g.cells())];
+        let mut words = vec![0u32; GUIDE_BLOCKS];
+        let mut heap = vec![0u32; GUIDE_BLOCKS];
+        let goal = Point::new(100, 2);
+        assert!(build(&moves, blocks, goal, &dead, &mut words, &mut heap));
+        let route = Route::new(blocks, &words, goal, w, h);
+        // From the top left the straight pull would hit the wall; the sub-goal leads down.
+        let t = route.target(Point::new(20, 2));
+        assert!(t.y > 2, "{t:?}");
+        // Follow the sub-goals: they reach the goal through the gap.
+        let mut p = Point::new(20, 2);
+        for _ in 0..400 {
+            let t = route.target(p);
+            if t == goal {
+                break;
+            }
+            assert!(t.x != 64 || t.y >= h - 4, "a sub-goal in the wall: {t:?}");
+            p = t;
+        }
+        assert_eq!(route.target(p), goal);
+        // Next to the goal, the goal itself.
+        assert_eq!(route.target(Point::new(101, 3)), goal);
+    }
+
+    #[test]
+    fn distances_are_exact_on_blocks() {
+        // An empty map: the distance of a block is the octile-like 10/14 distance to the goal's.
+        let g = Grid::new(128, 64, &[0u8; 1024]).unwrap();
+        let blocks = blocks(128, 64);
+        let moves = Moves::new(g, &[]);
+        let dead = vec![0u32; crate::bitmap::words(g.cells())];
+        let mut words = vec![0u32; GUIDE_BLOCKS];
+        let mut heap = vec![0u32; GUIDE_BLOCKS];
+        assert!(build(&moves, blocks, Point::new(0, 0), &dead, &mut words, &mut heap));
+        for (b, w) in words.iter().take(blocks.count()).enumerate() {
+            let (bx, by) = ((b % blocks.across()) as u32, (b / blocks.across()) as u32);
+            let (hi, lo) = (bx.max(by), bx.min(by));
+            assert_eq!(dist(*w), 10 * (hi - lo) + 14 * lo, "block {b}");
+        }
+        // Too short a heap: no route.
+        let mut short = vec![0u32; 10];
+        assert!(!build(&moves, blocks, Point::new(0, 0), &dead, &mut words, &mut short));
+    }
+}
