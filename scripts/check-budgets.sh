@@ -11,7 +11,7 @@
 # measured). The stack peak cannot be measured on the STM32 without hardware, so it is measured on
 # the QEMU build of the same firmware (same core, tasks and protocol code; only the board layer
 # differs) under qemu-system-arm: scripts/ohaca_client.py runs `selftest` (every request and
-# error path) and then `stack` (the deepest requests: 26x26 and 32x32 maps, a 681-cell path, every
+# error path) and then `stack` (the deepest requests: 26x26 and 32x32 maps, a 683-cell path, every
 # algorithm and smoothing, full runs without early stop), and the firmware reports its peak in
 # Stats.stack_peak. STACK_MARGIN (512 bytes) covers what only the STM32 build runs: embassy-stm32's
 # init and its USART / timer interrupt handlers instead of QEMU's UART / SysTick ones.

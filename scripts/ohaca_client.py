@@ -477,7 +477,7 @@ def synthetic_maps():
         ("open-32x32", open32, (0, 0), (31, 31)),
         ("snake-32x32", snake, (0, 0), (0, 30)),
         # The longest path that fits 1024 cells and 512 columns: along row 0, down at the
-        # right end, back along row 2 (681 cells).
+        # right end, back along row 2 (683 cells).
         ("zigzag-341x3", ["." * 341, "@" * 340 + ".", "." * 341], (0, 0), (0, 2)),
     ]
 
