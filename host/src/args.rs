@@ -322,6 +322,7 @@ mod tests {
                 dead_end: DeadEnd::Die,
                 smoothing: SmoothingKind::Greedy,
                 tighten: false,
+                prune: true,
             }
         );
     }

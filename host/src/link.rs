@@ -1474,7 +1474,7 @@ mod upload_sizes {
         let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
         let mut maps: Vec<(String, Map)> = vec![];
         let lab = root.join("host/assets/ros/lab.yaml");
-        let (m, _) = crate::input::prepare_map(&lab, Default::default(), Some(0.2), None).unwrap();
+        let (m, _) = crate::map::prepare(&lab, Default::default(), Some(0.2), None).unwrap();
         maps.push(("lab.yaml (5 cm, inflated 0.2 m)".into(), m));
         let large = root.join("../shared/maps/large");
         let mut names: Vec<_> = std::fs::read_dir(&large)

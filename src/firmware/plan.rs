@@ -12,7 +12,7 @@ use embassy_time::Instant;
 use embedded_io_async::Write;
 
 use ohaca::grid::Grid;
-use ohaca::planner::{Run, Storage};
+use ohaca::planner::Run;
 use ohaca::protocol::{ErrorCode, ErrorReply, PathReply, PathStream, Reply, Waypoints};
 
 use super::stack;
