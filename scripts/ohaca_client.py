@@ -150,7 +150,7 @@ PARAM_FIELDS = [
     ("algorithm", "enum"), ("ants", "u"), ("iterations", "u"), ("alpha", "f"), ("beta", "f"),
     ("rho", "f"), ("q", "f"), ("a", "f"), ("xi", "f"), ("tau0", "f"), ("tau_min", "f"),
     ("tau_max", "f"), ("patience", "u"), ("seed", "u"), ("dead_end", "enum"),
-    ("smoothing", "enum"), ("tighten", "bool"),
+    ("smoothing", "enum"), ("tighten", "bool"), ("prune", "bool"),
 ]
 
 

@@ -151,9 +151,9 @@ fn hello() -> HelloReply<'static> {
         firmware_version: "0.1.0",
         board: "qemu-mps2-an386",
         capacity: Capacity {
-            cells: 1024,
-            max_width: 512,
-            max_height: 512,
+            cells: 65536,
+            max_width: 256,
+            max_height: 256,
             max_chunk: MAX_CHUNK as u16,
             max_request: MAX_REQUEST as u16,
             plan_queue: 4,
@@ -942,6 +942,7 @@ fn params_fields(p: &Params) -> Vec<(String, Vec<u8>)> {
             vec![p.smoothing as u8],
         ),
         (format!("  tighten = {}", p.tighten), ser(&p.tighten)),
+        (format!("  prune = {}", p.prune), ser(&p.prune)),
     ]
 }
 
