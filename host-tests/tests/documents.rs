@@ -163,4 +163,5 @@ fn the_parameter_table_is_the_cores() {
     );
     let on = |b: bool| if b { "on" } else { "off" }.to_string();
     assert_eq!(words("tighten"), (on(d.tighten), on(p.tighten)));
+    assert_eq!(words("prune"), (on(d.prune), on(p.prune)));
 }
