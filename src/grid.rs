@@ -264,6 +264,7 @@ impl<'a> Grid<'a> {
         }
         len = len.wrapping_add(1);
         let gi = self.index(goal);
+        let offsets = self.offsets();
         while len > 0 {
             let Some(&i) = queue.get(head) else { break };
             head = head.wrapping_add(1);
@@ -278,10 +279,10 @@ impl<'a> Grid<'a> {
             let p = self.point(i);
             let mut m = self.mask_at(p);
             while m != 0 {
-                let d = m.trailing_zeros() as u8 & 7;
+                let d = m.trailing_zeros() as usize & 7;
                 m &= m.wrapping_sub(1);
-                let Some(n) = self.step(p, d) else { continue };
-                let ni = self.index(n);
+                // An allowed move: the neighbour is on the map, its index `i + offset`.
+                let ni = i.wrapping_add_signed(offsets.get(d).copied().unwrap_or(0));
                 if crate::bitmap::insert(mark, ni) {
                     if len == cap {
                         return Reach::Unknown;

@@ -172,16 +172,15 @@ fn links(moves: &Moves<'_>, blocks: Blocks, dead: &[u32], words: &mut [u32]) {
 
 /// The direction from `p`'s block to `q`'s block (adjacent blocks).
 fn block_dir(p: Point, q: Point, s: u8) -> u32 {
+    // Block offsets are -1, 0 or 1 on each axis: index (dy + 1) * 3 + (dx + 1).
+    const DIR: [u8; 9] = [5, 6, 7, 4, 0, 0, 3, 2, 1];
     let dx = i32::from(q.x >> s) - i32::from(p.x >> s);
     let dy = i32::from(q.y >> s) - i32::from(p.y >> s);
-    let mut d = 0u32;
-    while d < 8 {
-        if DX.get(d as usize) == Some(&dx) && DY.get(d as usize) == Some(&dy) {
-            return d;
-        }
-        d = d.wrapping_add(1);
-    }
-    0
+    let k = dy.wrapping_add(1).wrapping_mul(3).wrapping_add(dx.wrapping_add(1));
+    usize::try_from(k)
+        .ok()
+        .and_then(|k| DIR.get(k))
+        .map_or(0, |&d| u32::from(d))
 }
 
 fn dist(w: u32) -> u32 {
