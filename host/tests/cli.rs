@@ -70,7 +70,7 @@ const FOUND_KEYS: [&str; 11] = [
     "waypoints",
 ];
 
-const PARAM_KEYS: [&str; 17] = [
+const PARAM_KEYS: [&str; 18] = [
     "a",
     "algorithm",
     "alpha",
@@ -79,6 +79,7 @@ const PARAM_KEYS: [&str; 17] = [
     "dead_end",
     "iterations",
     "patience",
+    "prune",
     "q",
     "rho",
     "seed",
