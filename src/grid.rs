@@ -228,10 +228,18 @@ impl<'a> Grid<'a> {
         // Interior: x - 1, y - 1 and the rows above and below exist. Each row's three bits start
         // at bit `(row * w + x - 1)`, which is below `cells`, so nothing here wraps.
         let mut nb = 0usize;
-        let mut row = y.wrapping_sub(1).wrapping_mul(w).wrapping_add(x).wrapping_sub(1);
+        let mut row = y
+            .wrapping_sub(1)
+            .wrapping_mul(w)
+            .wrapping_add(x)
+            .wrapping_sub(1);
         for r in 0..3usize {
             let lo = self.bits.get(row >> 3).copied().unwrap_or(0xFF);
-            let hi = self.bits.get((row >> 3).wrapping_add(1)).copied().unwrap_or(0xFF);
+            let hi = self
+                .bits
+                .get((row >> 3).wrapping_add(1))
+                .copied()
+                .unwrap_or(0xFF);
             let three = ((usize::from(hi) << 8 | usize::from(lo)) >> (row & 7)) & 7;
             nb |= three << r.wrapping_mul(3);
             row = row.wrapping_add(w);
@@ -245,7 +253,13 @@ impl<'a> Grid<'a> {
     /// of cell indices of any length. A breadth-first frontier longer than the ring cannot be
     /// held, and the answer is then [`Reach::Unknown`] (the planner's first backtracking ant
     /// decides instead).
-    pub fn reachable(&self, start: Point, goal: Point, mark: &mut [u32], queue: &mut [u32]) -> Reach {
+    pub fn reachable(
+        &self,
+        start: Point,
+        goal: Point,
+        mark: &mut [u32],
+        queue: &mut [u32],
+    ) -> Reach {
         let cells = self.cells();
         if !self.is_free(start) || !self.is_free(goal) {
             return Reach::No;
@@ -326,7 +340,11 @@ pub struct Moves<'g> {
 impl<'g> Moves<'g> {
     /// Masks of `grid`, from `table` if it holds one entry per cell (else computed).
     pub fn new(grid: Grid<'g>, table: &'g [u8]) -> Self {
-        let table = if table.len() >= grid.cells() { table } else { &[] };
+        let table = if table.len() >= grid.cells() {
+            table
+        } else {
+            &[]
+        };
         Moves { grid, table }
     }
 
@@ -385,9 +403,7 @@ static MASK9: [u8; 512] = {
             while d < 8 {
                 let (dx, dy) = (DX[d], DY[d]);
                 let ok = !blocked(nb, 1 + dx, 1 + dy)
-                    && (dx == 0
-                        || dy == 0
-                        || (!blocked(nb, 1 + dx, 1) && !blocked(nb, 1, 1 + dy)));
+                    && (dx == 0 || dy == 0 || (!blocked(nb, 1 + dx, 1) && !blocked(nb, 1, 1 + dy)));
                 if ok {
                     m |= 1 << d;
                 }
@@ -445,13 +461,22 @@ mod tests {
         let g = Grid::new(w, h, &b).unwrap();
         let mut m = [0u32; 1];
         let mut q = [0u32; 9];
-        assert_eq!(g.reachable(Point::new(0, 0), Point::new(2, 2), &mut m, &mut q), Reach::No);
-        assert_eq!(g.reachable(Point::new(0, 0), Point::new(0, 1), &mut m, &mut q), Reach::Yes);
+        assert_eq!(
+            g.reachable(Point::new(0, 0), Point::new(2, 2), &mut m, &mut q),
+            Reach::No
+        );
+        assert_eq!(
+            g.reachable(Point::new(0, 0), Point::new(0, 1), &mut m, &mut q),
+            Reach::Yes
+        );
         // A ring too short for the frontier cannot decide.
         let open = Grid::new(8, 8, &[0; 8]).unwrap();
         let mut m = [0u32; 2];
         let mut q = [0u32; 2];
-        assert_eq!(open.reachable(Point::new(0, 0), Point::new(7, 7), &mut m, &mut q), Reach::Unknown);
+        assert_eq!(
+            open.reachable(Point::new(0, 0), Point::new(7, 7), &mut m, &mut q),
+            Reach::Unknown
+        );
     }
 
     #[test]

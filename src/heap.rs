@@ -175,11 +175,7 @@ impl HeapStorage {
         for t in self.tau.iter_mut().chain(self.delta.iter_mut()) {
             *t = core::array::from_fn(|_| (next() % 1000) as f32 / 7.0);
         }
-        for b in self
-            .moves
-            .iter_mut()
-            .chain(self.tours.iter_mut().flatten())
-        {
+        for b in self.moves.iter_mut().chain(self.tours.iter_mut().flatten()) {
             *b = next() as u8;
         }
         for p in &mut self.points {

@@ -115,5 +115,7 @@ pub mod update;
 pub use colony::DeadEnd;
 pub use error::Error;
 pub use grid::{Grid, Point};
-pub use planner::{plan, Algorithm, Buffers, CurvePoint, Params, Plan, RawPath, Run, Storage, Workspace};
+pub use planner::{
+    plan, Algorithm, Buffers, CurvePoint, Params, Plan, RawPath, Run, Storage, Workspace,
+};
 pub use smoothing::SmoothingKind;

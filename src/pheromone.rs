@@ -81,12 +81,18 @@ impl Blocks {
     pub fn with_budget(width: u16, height: u16, budget: usize) -> Self {
         let mut shift = 0u8;
         loop {
-            let across = usize::from(width >> shift) + usize::from(width & ((1u16 << shift).wrapping_sub(1)) != 0);
-            let down = usize::from(height >> shift) + usize::from(height & ((1u16 << shift).wrapping_sub(1)) != 0);
+            let across = usize::from(width >> shift)
+                + usize::from(width & ((1u16 << shift).wrapping_sub(1)) != 0);
+            let down = usize::from(height >> shift)
+                + usize::from(height & ((1u16 << shift).wrapping_sub(1)) != 0);
             let count = across.saturating_mul(down);
             // shift 16 leaves one block: a 65535 x 65535 map ends there at the latest.
             if count <= budget || shift >= 16 {
-                return Blocks { shift, across, count };
+                return Blocks {
+                    shift,
+                    across,
+                    count,
+                };
             }
             shift = shift.wrapping_add(1);
         }
@@ -130,7 +136,9 @@ impl Blocks {
             let y = i32::from(p.y).wrapping_add(DY.get(di).copied().unwrap_or(0));
             (Point::new(x as u16, y as u16), d.wrapping_sub(4))
         };
-        self.block(q).wrapping_mul(4).wrapping_add(usize::from(slot))
+        self.block(q)
+            .wrapping_mul(4)
+            .wrapping_add(usize::from(slot))
     }
 }
 
@@ -162,7 +170,10 @@ impl<'a> Table<'a> {
     /// `tau` of the edge from `p` in direction `d`.
     #[inline]
     pub fn get(&self, p: Point, d: Dir) -> f32 {
-        self.flat().get(self.blocks.index(p, d)).copied().unwrap_or(0.0)
+        self.flat()
+            .get(self.blocks.index(p, d))
+            .copied()
+            .unwrap_or(0.0)
     }
 
     /// Add `amount` to the edge from `p` in direction `d`.

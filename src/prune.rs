@@ -59,7 +59,13 @@ static CLIQUE: [u8; 256] = {
 
 /// Mark the prunable cells of `grid` in `dead` (a bit set of at least `words(cells)` words,
 /// cleared first). `stack` is scratch of any length. Returns the number of cells marked.
-pub fn prune(moves: &Moves<'_>, start: Point, goal: Point, dead: &mut [u32], stack: &mut [u32]) -> u32 {
+pub fn prune(
+    moves: &Moves<'_>,
+    start: Point,
+    goal: Point,
+    dead: &mut [u32],
+    stack: &mut [u32],
+) -> u32 {
     let grid = *moves.grid();
     let cells = grid.cells();
     bitmap::clear(dead, cells);
@@ -76,7 +82,7 @@ pub fn prune(moves: &Moves<'_>, start: Point, goal: Point, dead: &mut [u32], sta
                 continue;
             }
             pruned = pruned.wrapping_add(1); // < cells
-            // Depth-first over the neighbours whose neighbourhood just shrank.
+                                             // Depth-first over the neighbours whose neighbourhood just shrank.
             let mut top = 0usize;
             overflow |= push_neighbours(moves, &offsets, ci, stack, &mut top);
             while top > 0 {
@@ -255,7 +261,8 @@ mod tests {
         loop {
             let mut best = None;
             for i in 0..n {
-                if !done[i] && dist[i].is_finite() && best.is_none_or(|b: usize| dist[i] < dist[b]) {
+                if !done[i] && dist[i].is_finite() && best.is_none_or(|b: usize| dist[i] < dist[b])
+                {
                     best = Some(i);
                 }
             }
@@ -268,7 +275,11 @@ mod tests {
             for d in 0..8u8 {
                 if let Some(q) = g.step(p, d) {
                     let j = g.index(q);
-                    let c = if d % 2 == 1 { std::f64::consts::SQRT_2 } else { 1.0 };
+                    let c = if d % 2 == 1 {
+                        std::f64::consts::SQRT_2
+                    } else {
+                        1.0
+                    };
                     if ok(j) && dist[i] + c < dist[j] {
                         dist[j] = dist[i] + c;
                     }
@@ -312,7 +323,9 @@ mod tests {
             let after = distance(&g, s, t, &|j| !bitmap::get(&dead, j));
             match (before, after) {
                 (None, None) => {}
-                (Some(a), Some(b)) => assert!((a - b).abs() < 1e-9, "{a} vs {b} on\n{:?}", (w, h, &b)),
+                (Some(a), Some(b)) => {
+                    assert!((a - b).abs() < 1e-9, "{a} vs {b} on\n{:?}", (w, h, &b))
+                }
                 other => panic!("connectivity changed: {other:?}"),
             }
             assert!(!bitmap::get(&dead, g.index(s)) && !bitmap::get(&dead, g.index(t)));
@@ -333,7 +346,11 @@ mod tests {
         ];
         let a = pruned(&rows, Point::new(0, 0), Point::new(19, 6), 1000);
         for s in [0, 1, 3, 8] {
-            assert_eq!(pruned(&rows, Point::new(0, 0), Point::new(19, 6), s), a, "stack {s}");
+            assert_eq!(
+                pruned(&rows, Point::new(0, 0), Point::new(19, 6), s),
+                a,
+                "stack {s}"
+            );
         }
     }
 

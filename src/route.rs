@@ -75,7 +75,7 @@ impl<'a> Route<'a> {
         let s = self.blocks.shift();
         let (mut bx, mut by) = (i32::from(p.x >> s), i32::from(p.y >> s));
         let across = self.blocks.across();
-            for _ in 0..LOOKAHEAD {
+        for _ in 0..LOOKAHEAD {
             // Block coordinates are below 2^16: the index fits.
             let b = (by as usize).wrapping_mul(across).wrapping_add(bx as usize);
             let next = self.words.get(b).map_or(NONE, |w| (w >> 8) & 15);
@@ -176,7 +176,10 @@ fn block_dir(p: Point, q: Point, s: u8) -> u32 {
     const DIR: [u8; 9] = [5, 6, 7, 4, 0, 0, 3, 2, 1];
     let dx = i32::from(q.x >> s) - i32::from(p.x >> s);
     let dy = i32::from(q.y >> s) - i32::from(p.y >> s);
-    let k = dy.wrapping_add(1).wrapping_mul(3).wrapping_add(dx.wrapping_add(1));
+    let k = dy
+        .wrapping_add(1)
+        .wrapping_mul(3)
+        .wrapping_add(dx.wrapping_add(1));
     usize::try_from(k)
         .ok()
         .and_then(|k| DIR.get(k))
@@ -381,7 +384,14 @@ mod tests {
         let dead = vec![0u32; crate::bitmap::words(g.cells())];
         let mut words = vec![0u32; GUIDE_BLOCKS];
         let mut heap = vec![0u32; GUIDE_BLOCKS];
-        assert!(build(&moves, blocks, Point::new(0, 0), &dead, &mut words, &mut heap));
+        assert!(build(
+            &moves,
+            blocks,
+            Point::new(0, 0),
+            &dead,
+            &mut words,
+            &mut heap
+        ));
         for (b, w) in words.iter().take(blocks.count()).enumerate() {
             let (bx, by) = ((b % blocks.across()) as u32, (b / blocks.across()) as u32);
             let (hi, lo) = (bx.max(by), bx.min(by));
@@ -389,6 +399,13 @@ mod tests {
         }
         // Too short a heap: no route.
         let mut short = vec![0u32; 10];
-        assert!(!build(&moves, blocks, Point::new(0, 0), &dead, &mut words, &mut short));
+        assert!(!build(
+            &moves,
+            blocks,
+            Point::new(0, 0),
+            &dead,
+            &mut words,
+            &mut short
+        ));
     }
 }

@@ -72,7 +72,8 @@ fn bench_large(c: &mut Criterion) {
         let mut summary = String::new();
         for _ in 0..5 {
             let t0 = Instant::now();
-            let p = plan(&grid, case.start, case.goal, &params, storage.workspace()).expect("a path");
+            let p =
+                plan(&grid, case.start, case.goal, &params, storage.workspace()).expect("a path");
             tp += t0.elapsed();
             let t0 = Instant::now();
             let a = astar_cost(&m.map, case.start, case.goal).expect("a path");
@@ -106,7 +107,13 @@ fn bench_large(c: &mut Criterion) {
             })
         });
         group.bench_function(format!("astar/{name}"), |b| {
-            b.iter(|| black_box(astar_cost(&m.map, black_box(case.start), black_box(case.goal))))
+            b.iter(|| {
+                black_box(astar_cost(
+                    &m.map,
+                    black_box(case.start),
+                    black_box(case.goal),
+                ))
+            })
         });
     }
     group.finish();

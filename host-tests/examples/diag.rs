@@ -13,11 +13,24 @@ fn main() {
     let mut st = ohaca_host_tests::heap::storage(m.map.cells());
     let p = Params::default();
     let mut run = Run::new(&grid, case.start, case.goal, &p, st.workspace()).unwrap();
-    println!("{name} #{k}: {:?} -> {:?} opt {:.2}, pruned {}", case.start, case.goal, case.stated_opt8, run.pruned());
+    println!(
+        "{name} #{k}: {:?} -> {:?} opt {:.2}, pruned {}",
+        case.start,
+        case.goal,
+        case.stated_opt8,
+        run.pruned()
+    );
     let mut last = 0;
     while run.step() || run.iteration() > 0 && last == 0 {
-        println!("it {} moves {} best {:?}", run.iteration(), run.moves() - last, run.best_length());
+        println!(
+            "it {} moves {} best {:?}",
+            run.iteration(),
+            run.moves() - last,
+            run.best_length()
+        );
         last = run.moves();
-        if run.is_done() { break; }
+        if run.is_done() {
+            break;
+        }
     }
 }

@@ -123,5 +123,8 @@ fn main() {
             t / a
         );
     }
-    println!("\nmean raw/opt8 over all valid runs: {:.4}", all_raw / all_n.max(1) as f64);
+    println!(
+        "\nmean raw/opt8 over all valid runs: {:.4}",
+        all_raw / all_n.max(1) as f64
+    );
 }

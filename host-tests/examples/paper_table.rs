@@ -20,10 +20,10 @@
 
 use std::time::Duration;
 
-use ohaca::colony::Colony;
-use ohaca::heuristic::Heuristic;
 use ohaca::bitmap::words;
+use ohaca::colony::Colony;
 use ohaca::grid::Moves;
+use ohaca::heuristic::Heuristic;
 use ohaca::pheromone::{Blocks, Table};
 use ohaca::prune::prune;
 use ohaca::rng::Xoshiro128pp;

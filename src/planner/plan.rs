@@ -98,4 +98,3 @@ impl Iterator for RawPath<'_> {
         Some(cur)
     }
 }
-

@@ -298,7 +298,8 @@ impl<'g, 'a> Run<'g, 'a> {
         let mut tau = Table::new(self.blocks, ws.tau);
         let mut delta = Table::new(self.blocks, ws.delta);
         if let (true, Some((b, nb)), Some((w, nw))) = (p.algorithm.wolves(), it.best, it.worst) {
-            if let (Some(bt), Some(wt)) = (ws.iter_best.get(..b.steps), ws.iter_worst.get(..w.steps))
+            if let (Some(bt), Some(wt)) =
+                (ws.iter_best.get(..b.steps), ws.iter_worst.get(..w.steps))
             {
                 wolves(
                     &mut delta,

@@ -147,11 +147,15 @@ fn storage_size_matches_the_formula() {
     type Device = Storage<{ crate::bitmap::words(65536) }, 1024, 4096, 1024>;
     // Pheromone and increments, two bit sets, the move table, four tours, points, links, curve,
     // the coarse route.
-    let want = 2 * 16 * 1024 + 2 * 8192 + 1024 + 4 * 1024 + 4 * 1024 + 4 * 4096 + 16 * 128 + 4 * 4096;
+    let want =
+        2 * 16 * 1024 + 2 * 8192 + 1024 + 4 * 1024 + 4 * 1024 + 4 * 4096 + 16 * 128 + 4 * 4096;
     assert_eq!(Device::BYTES, want);
     // `Workspace::bytes` for the same capacities (2047 steps) gives the same but for the fourth
     // byte of each tour the storage rounds up to.
-    assert_eq!(Workspace::bytes(65536, 1023, false, 128) + 1024 + 4 * (4096 - 2048), want - 4);
+    assert_eq!(
+        Workspace::bytes(65536, 1023, false, 128) + 1024 + 4 * (4096 - 2048),
+        want - 4
+    );
 }
 
 #[test]
@@ -195,4 +199,3 @@ fn deterministic_per_seed() {
         assert_eq!(run(7, alg), run(7, alg));
     }
 }
-

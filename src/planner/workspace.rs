@@ -78,7 +78,11 @@ impl<'a> Workspace<'a> {
         let bits = 2 * 4 * words(cells);
         let pheromone = 2 * 16 * if cells < BLOCKS { cells } else { BLOCKS };
         let moves = if moves { cells } else { 0 };
-        let links = 4 * if cells < 2 * (steps + 1) { cells } else { 2 * (steps + 1) };
+        let links = 4 * if cells < 2 * (steps + 1) {
+            cells
+        } else {
+            2 * (steps + 1)
+        };
         let guide = if cells > BLOCKS { 4 * GUIDE_BLOCKS } else { 0 };
         bits + pheromone + moves + 4 * steps + 4 * (steps + 1) + links + 16 * curve + guide
     }
@@ -176,7 +180,9 @@ impl<'a> Workspace<'a> {
             iter_best: iter_best.split_at_mut(steps).0,
             iter_worst: iter_worst.split_at_mut(steps).0,
             best: best.split_at_mut(steps).0,
-            points: points.split_at_mut(steps.saturating_add(1).min(points.len())).0,
+            points: points
+                .split_at_mut(steps.saturating_add(1).min(points.len()))
+                .0,
             links,
             curve,
             guide,
@@ -222,8 +228,13 @@ pub struct Storage<
     guide: [u32; GUIDE_BLOCKS],
 }
 
-impl<const WORDS: usize, const STEPS: usize, const LINKS: usize, const MOVES: usize, const CURVE: usize>
-    Storage<WORDS, STEPS, LINKS, MOVES, CURVE>
+impl<
+        const WORDS: usize,
+        const STEPS: usize,
+        const LINKS: usize,
+        const MOVES: usize,
+        const CURVE: usize,
+    > Storage<WORDS, STEPS, LINKS, MOVES, CURVE>
 {
     /// Size in bytes.
     pub const BYTES: usize = core::mem::size_of::<Self>();
@@ -267,8 +278,13 @@ impl<const WORDS: usize, const STEPS: usize, const LINKS: usize, const MOVES: us
     }
 }
 
-impl<const WORDS: usize, const STEPS: usize, const LINKS: usize, const MOVES: usize, const CURVE: usize>
-    Default for Storage<WORDS, STEPS, LINKS, MOVES, CURVE>
+impl<
+        const WORDS: usize,
+        const STEPS: usize,
+        const LINKS: usize,
+        const MOVES: usize,
+        const CURVE: usize,
+    > Default for Storage<WORDS, STEPS, LINKS, MOVES, CURVE>
 {
     fn default() -> Self {
         Self::new()
