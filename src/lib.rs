@@ -112,6 +112,9 @@ pub mod route;
 pub mod smoothing;
 pub mod update;
 
+#[cfg(test)]
+mod testutil;
+
 pub use colony::DeadEnd;
 pub use error::Error;
 pub use grid::{Grid, Point};

@@ -121,56 +121,47 @@ pub struct Params {
 
 impl Default for Params {
     fn default() -> Self {
-        Params {
-            algorithm: Algorithm::Ohaca,
-            ants: 50,
-            iterations: 100,
-            alpha: 1.0,
-            beta: 2.0,
-            rho: 0.1,
-            q: 1.0,
-            a: 0.05,
-            xi: 1.0,
-            tau0: 1.0,
-            tau_min: 0.01,
-            tau_max: 100.0,
-            patience: 10,
-            seed: 1,
-            dead_end: DeadEnd::Backtrack,
-            smoothing: SmoothingKind::Shortest,
-            tighten: true,
-            prune: true,
-        }
+        Params::DEFAULT
     }
 }
 
 impl Params {
+    /// This project's setting ([`Params::default`]), as a constant.
+    pub const DEFAULT: Params = Params {
+        algorithm: Algorithm::Ohaca,
+        ants: 50,
+        iterations: 100,
+        alpha: 1.0,
+        beta: 2.0,
+        rho: 0.1,
+        q: 1.0,
+        a: 0.05,
+        xi: 1.0,
+        tau0: 1.0,
+        tau_min: 0.01,
+        tau_max: 100.0,
+        patience: 10,
+        seed: 1,
+        dead_end: DeadEnd::Backtrack,
+        smoothing: SmoothingKind::Shortest,
+        tighten: true,
+        prune: true,
+    };
+
     /// The paper's setting as written: `alpha = 1`, `beta = 2`, `rho = 0.1`, `Q = 1`, `a = 0.05`,
     /// `xi = 1`, `M = 50` ants, always the full `N = 100` iterations (`patience = 0`), ants that
     /// die at dead ends, no path tightening, no dead-end pruning and the paper's greedy smoothing
-    /// (section 4.3). The pheromone bounds and the seed are [`Params::default`]'s (the paper gives
-    /// `delta = 0.01` and no initial value). Use it for faithful comparisons; `docs/ALGORITHM.md`
-    /// lists where the default differs and why.
+    /// (section 4.3). The constants, the pheromone bounds and the seed are [`Params::default`]'s
+    /// (the paper gives `delta = 0.01` and no initial value). Use it for faithful comparisons;
+    /// `docs/ALGORITHM.md` lists where the default differs and why.
     pub const fn paper() -> Self {
         Params {
-            algorithm: Algorithm::Ohaca,
-            ants: 50,
-            iterations: 100,
-            alpha: 1.0,
-            beta: 2.0,
-            rho: 0.1,
-            q: 1.0,
-            a: 0.05,
-            xi: 1.0,
-            tau0: 1.0,
-            tau_min: 0.01,
-            tau_max: 100.0,
             patience: 0,
-            seed: 1,
             dead_end: DeadEnd::Die,
             smoothing: SmoothingKind::Greedy,
             tighten: false,
             prune: false,
+            ..Params::DEFAULT
         }
     }
 
