@@ -333,7 +333,10 @@ pub fn core_plan(
 ) -> Result<CorePath, ErrorReply> {
     let grid = map.grid().map_err(ErrorReply::from)?;
     params.validate().map_err(ErrorReply::from)?;
-    let mut storage = HeapStorage::for_run(map.cells(), params).expect("host storage");
+    // The device's capacities: ant paths of up to 1023 steps (`firmware::state::PLAN_STEPS`).
+    let mut storage =
+        HeapStorage::with_steps(map.cells(), 1023, true, usize::from(params.iterations))
+            .expect("host storage");
     let plan = ohaca::plan(&grid, start, goal, params, storage.workspace())?;
     Ok(CorePath {
         raw_length: plan.raw_length,
