@@ -81,10 +81,11 @@ impl Blocks {
     pub fn with_budget(width: u16, height: u16, budget: usize) -> Self {
         let mut shift = 0u8;
         loop {
+            // At most 65535 + 1: no overflow.
             let across = usize::from(width >> shift)
-                + usize::from(width & ((1u16 << shift).wrapping_sub(1)) != 0);
+                .wrapping_add(usize::from(width & ((1u16 << shift).wrapping_sub(1)) != 0));
             let down = usize::from(height >> shift)
-                + usize::from(height & ((1u16 << shift).wrapping_sub(1)) != 0);
+                .wrapping_add(usize::from(height & ((1u16 << shift).wrapping_sub(1)) != 0));
             let count = across.saturating_mul(down);
             // shift 16 leaves one block: a 65535 x 65535 map ends there at the latest.
             if count <= budget || shift >= 16 {

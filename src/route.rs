@@ -88,8 +88,12 @@ impl<'a> Route<'a> {
         }
         // The centre of that block, on the map (the last block of a row may be cut short).
         let half = (1i32 << s) >> 1;
-        let cx = (bx << s).wrapping_add(half).min(i32::from(self.width) - 1);
-        let cy = (by << s).wrapping_add(half).min(i32::from(self.height) - 1);
+        let cx = (bx << s)
+            .wrapping_add(half)
+            .min(i32::from(self.width).wrapping_sub(1));
+        let cy = (by << s)
+            .wrapping_add(half)
+            .min(i32::from(self.height).wrapping_sub(1));
         Point::new(cx.max(0) as u16, cy.max(0) as u16)
     }
 }
@@ -174,8 +178,9 @@ fn links(moves: &Moves<'_>, blocks: Blocks, dead: &[u32], words: &mut [u32]) {
 fn block_dir(p: Point, q: Point, s: u8) -> u32 {
     // Block offsets are -1, 0 or 1 on each axis: index (dy + 1) * 3 + (dx + 1).
     const DIR: [u8; 9] = [5, 6, 7, 4, 0, 0, 3, 2, 1];
-    let dx = i32::from(q.x >> s) - i32::from(p.x >> s);
-    let dy = i32::from(q.y >> s) - i32::from(p.y >> s);
+    // Differences of u16 values: no overflow.
+    let dx = i32::from(q.x >> s).wrapping_sub(i32::from(p.x >> s));
+    let dy = i32::from(q.y >> s).wrapping_sub(i32::from(p.y >> s));
     let k = dy
         .wrapping_add(1)
         .wrapping_mul(3)
@@ -297,7 +302,9 @@ fn dijkstra(blocks: Blocks, goal_block: usize, words: &mut [u32], mut heap: Heap
         let b = heap.pop(words);
         let Some(&wb) = words.get(b) else { break };
         let db = dist(wb);
-        let (bx, by) = ((b % across) as i32, (b / across) as i32);
+        // `across >= 1`: the checked forms never fail.
+        let bx = b.checked_rem(across).unwrap_or(0) as i32;
+        let by = b.checked_div(across).unwrap_or(0) as i32;
         for d in 0..8usize {
             let nx = bx.wrapping_add(DX.get(d).copied().unwrap_or(0));
             let ny = by.wrapping_add(DY.get(d).copied().unwrap_or(0));

@@ -73,8 +73,12 @@ pub struct Buffers<'a> {
 
 impl<'a> Workspace<'a> {
     /// Bytes a workspace needs for maps of `cells` cells and ant paths of up to `steps` steps, with
-    /// or without the move table and with a curve of `curve` iterations.
+    /// or without the move table and with a curve of `curve` iterations (saturating).
+    #[allow(clippy::arithmetic_side_effects)] // saturating below; const fn cannot use the methods' closures
     pub const fn bytes(cells: usize, steps: usize, moves: bool, curve: usize) -> usize {
+        if cells > usize::MAX / 64 || steps > usize::MAX / 64 || curve > usize::MAX / 64 {
+            return usize::MAX;
+        }
         let bits = 2 * 4 * words(cells);
         let pheromone = 2 * 16 * if cells < BLOCKS { cells } else { BLOCKS };
         let moves = if moves { cells } else { 0 };
