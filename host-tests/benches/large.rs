@@ -35,14 +35,15 @@ fn astar_cost(map: &Map, start: Point, goal: Point) -> Option<u32> {
     let r = astar(
         &start,
         |&p| {
-            MOVES.iter().filter_map(move |&(dx, dy, c)| {
-                step_allowed(map, p, dx, dy).then(|| {
+            MOVES
+                .iter()
+                .filter(move |&&(dx, dy, _)| step_allowed(map, p, dx, dy))
+                .map(move |&(dx, dy, c)| {
                     (
                         Point::new((i64::from(p.x) + dx) as u16, (i64::from(p.y) + dy) as u16),
                         c,
                     )
                 })
-            })
         },
         |&p| {
             let dx = u32::from(p.x.abs_diff(goal.x));
