@@ -7,10 +7,13 @@
 # exit, whatever happens. Needs no input.
 #
 #   scripts/demo.sh [--map FILE --start X,Y --goal X,Y] [planner flags, e.g. --seed 5]
+#   scripts/demo.sh --map host/assets/ros/lab.yaml --start-m -1.2,-0.8 --goal-m 7.25,3.7 --inflate 0.2
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 map=maps/complex-26.map
+sflag=--start
+gflag=--goal
 start=0,0
 goal=25,25
 extra=()
@@ -19,6 +22,8 @@ while [ $# -gt 0 ]; do
     --map) map="$2"; shift 2 ;;
     --start) start="$2"; shift 2 ;;
     --goal) goal="$2"; shift 2 ;;
+    --start-m) start="$2"; sflag=--start-m; shift 2 ;;
+    --goal-m) goal="$2"; gflag=--goal-m; shift 2 ;;
     -h|--help) sed -n '2,9p' "$0"; exit 0 ;;
     *) extra+=("$1"); shift ;;
   esac
@@ -81,9 +86,9 @@ if [ -z "$port" ]; then
 fi
 echo "firmware running, UART0 on 127.0.0.1:$port (qemu pid $qemu_pid)" >&2
 
-step "plan on the device: ohaca send --tcp 127.0.0.1:$port --map $map --start $start --goal $goal ${extra[*]:-}"
+step "plan on the device: ohaca send --tcp 127.0.0.1:$port --map $map $sflag $start $gflag $goal ${extra[*]:-}"
 status=0
-"$ohaca" send --tcp "127.0.0.1:$port" --map "$map" --start "$start" --goal "$goal" \
+"$ohaca" send --tcp "127.0.0.1:$port" --map "$map" "$sflag" "$start" "$gflag" "$goal" \
   "${extra[@]}" </dev/null || status=$?
 if [ "$status" -gt 1 ]; then
   echo "error: ohaca send failed (exit $status)" >&2
@@ -91,9 +96,9 @@ if [ "$status" -gt 1 ]; then
 fi
 
 step "check: the device's path against the host's (same planner, same seed)"
-"$ohaca" send --tcp "127.0.0.1:$port" --map "$map" --start "$start" --goal "$goal" \
+"$ohaca" send --tcp "127.0.0.1:$port" --map "$map" "$sflag" "$start" "$gflag" "$goal" \
   "${extra[@]}" --json </dev/null >"$tmp/device.json" || true
-"$ohaca" plan --map "$map" --start "$start" --goal "$goal" "${extra[@]}" --json \
+"$ohaca" plan --map "$map" "$sflag" "$start" "$gflag" "$goal" "${extra[@]}" --json \
   </dev/null >"$tmp/host.json" || true
 # Everything but the timings and the device's extra keys must be equal, f32 digits included.
 strip() { sed -E 's/"elapsed_us":[0-9]+,//; s/,"ticks":[0-9]+//; s/,"device":"[^"]*"//' "$1"; }
@@ -108,11 +113,11 @@ fi
 if "$ohaca" render --help >"$tmp/render.help" 2>/dev/null; then
   if grep -q -- '--report' "$tmp/render.help"; then
     step "draw: demo-path.png (the device's path)"
-    "$ohaca" render --map "$map" --start "$start" --goal "$goal" "${extra[@]}" \
+    "$ohaca" render --map "$map" "$sflag" "$start" "$gflag" "$goal" "${extra[@]}" \
       --report "$tmp/device.json" --out demo-path.png </dev/null
   else
     step "draw: demo-path.png (the host's plan, identical to the device's)"
-    "$ohaca" render --map "$map" --start "$start" --goal "$goal" "${extra[@]}" \
+    "$ohaca" render --map "$map" "$sflag" "$start" "$gflag" "$goal" "${extra[@]}" \
       --out demo-path.png </dev/null
   fi
   echo "wrote demo-path.png"
