@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Memory budgets of the release firmware for the real board (STM32F411CE: 128 KiB RAM, 512 KiB
-# flash; issue 10: RAM <= 112 KiB, flash <= 256 KiB, maps up to 512x512 held at one bit a cell):
+# flash; issue 10: RAM <= 112 KiB, flash <= 256 KiB, maps up to 256x256 held at one bit a cell and planned at full resolution):
 #
 #   flash      = .vector_table + .text + .rodata + .data (its load image)    <= FLASH_BUDGET (262144)
 #   static RAM = .data + .bss + .uninit
@@ -11,7 +11,7 @@
 # measured). The stack peak cannot be measured on the STM32 without hardware, so it is measured on
 # the QEMU build of the same firmware (same core, tasks and protocol code; only the board layer
 # differs) under qemu-system-arm: scripts/ohaca_client.py runs `selftest` (every request and
-# error path) and then `stack` (the deepest requests: 26x26 and 32x32 maps, a 683-cell path, every
+# error path) and then `stack` (the deepest requests: 26x26 and 32x32 maps, a 770-cell path, every
 # algorithm and smoothing, full runs without early stop), and the firmware reports its peak in
 # Stats.stack_peak. STACK_MARGIN (512 bytes) covers what only the STM32 build runs: embassy-stm32's
 # init and its USART / timer interrupt handlers instead of QEMU's UART / SysTick ones.
@@ -112,7 +112,7 @@ ram_ok=$(verdict "$ram" "$RAM_BUDGET")
 [ "$flash_ok" = ok ] || status=1
 [ "$ram_ok" = ok ] || status=1
 echo
-echo "== budgets: STM32F411 release firmware, maps up to 512x512, 50 ants"
+echo "== budgets: STM32F411 release firmware, maps up to 256x256 planned at full resolution, 50 ants"
 printf '| %-58s | %8s | %8s | %-11s |\n' "item" "bytes" "budget" "verdict"
 printf '| %-58s | %8s | %8s | %-11s |\n' "---" "---" "---" "---"
 printf '| %-58s | %8d | %8d | %-11s |\n' "flash (.vector_table + .text + .rodata + .data)" "$flash" "$FLASH_BUDGET" "$flash_ok"

@@ -476,9 +476,10 @@ def synthetic_maps():
     return [
         ("open-32x32", open32, (0, 0), (31, 31)),
         ("snake-32x32", snake, (0, 0), (0, 30)),
-        # The longest path that fits 1024 cells and 512 columns: along row 0, down at the
-        # right end, back along row 2 (683 cells).
-        ("zigzag-341x3", ["." * 341, "@" * 340 + ".", "." * 341], (0, 0), (0, 2)),
+        # A long path within the device's 256 columns and 1,023-step ant paths: along row 0,
+        # down at the right end, back along row 2, down at the left, along row 4 (772 cells).
+        ("zigzag-256x5", ["." * 256, "@" * 255 + ".", "." * 256, "." + "@" * 255, "." * 256],
+         (0, 0), (255, 4)),
     ]
 
 
@@ -517,7 +518,8 @@ def stack_probe(dev, map_path):
     for name, rows, start, goal in synthetic_maps():
         maps.append((name, *rows_to_bits(rows), start, goal))
     for name, w, h, bits, start, goal in maps:
-        if w * h > hello["capacity"]["cells"]:
+        cap = hello["capacity"]
+        if w * h > cap["cells"] or w > cap["max_width"] or h > cap["max_height"]:
             continue
         expect(dev.set_map(w, h, bits), "Ack")
         for label, params in stack_cases(defaults):
