@@ -396,7 +396,10 @@ impl Upload {
                     o.received,
                     o.total_len,
                 ))?;
-                slot.copy_from_slice(new);
+                // Same length by construction; a zip has no length check that could panic.
+                for (d, b) in slot.iter_mut().zip(new) {
+                    *d = *b;
+                }
             }
             Encoding::Rle => {
                 if let Err(RleError::Overrun { at }) = o.rle.feed(new, bits) {
