@@ -12,7 +12,7 @@ pub mod maps;
 use arbitrary::{Arbitrary, Unstructured};
 use ohaca::geometry::{polyline_length, segment_clear, steps_length};
 use ohaca::grid::{is_diagonal, Grid, Point};
-use ohaca::planner::{CurvePoint, Workspace};
+use ohaca::planner::{Buffers, CurvePoint, Workspace};
 use ohaca::{plan, Algorithm, DeadEnd, Error, Params, SmoothingKind};
 
 /// A planner input: a small map, endpoints and parameters including extremes.
@@ -78,6 +78,7 @@ impl<'a> Arbitrary<'a> for PlannerInput {
                 SmoothingKind::None,
             ])?,
             tighten: bool::arbitrary(u)?,
+            prune: bool::arbitrary(u)?,
         };
         Ok(PlannerInput {
             width,
@@ -96,27 +97,33 @@ pub fn check_planner(input: &PlannerInput) {
         return;
     };
     let cells = grid.cells();
-    let mut tau = vec![[0f32; 4]; cells];
-    let mut delta = vec![[0f32; 4]; cells];
-    let mut visited = vec![0u8; cells];
+    let blocks = cells.min(ohaca::pheromone::BLOCKS);
+    let guide = ohaca::route::GUIDE_BLOCKS;
+    let mut tau = vec![[0f32; 4]; blocks];
+    let mut delta = vec![[0f32; 4]; blocks];
+    let mut tabu = vec![0u32; ohaca::bitmap::words(cells)];
+    let mut dead = vec![0u32; ohaca::bitmap::words(cells)];
     let mut moves = vec![0u8; cells];
     let mut tours: Vec<Vec<u8>> = (0..4).map(|_| vec![0u8; cells]).collect();
-    let mut points = vec![Point::default(); cells];
-    let mut prev = vec![0u32; cells];
+    let mut points = vec![Point::default(); cells + 1];
+    let mut links = vec![0u32; cells.max(guide)];
     let mut curve = vec![CurvePoint::default(); 16];
+    let mut guide_words = vec![0u32; guide];
     let [t0, t1, t2, t3] = &mut tours[..] else {
         return;
     };
-    let ws = Workspace::from_slices(
-        &mut tau,
-        &mut delta,
-        &mut visited,
-        &mut moves,
-        [t0, t1, t2, t3],
-        &mut points,
-        &mut prev,
-        &mut curve,
-    );
+    let ws = Workspace::new(Buffers {
+        tau: &mut tau,
+        delta: &mut delta,
+        tabu: &mut tabu,
+        dead: &mut dead,
+        moves: &mut moves,
+        tours: [t0, t1, t2, t3],
+        points: &mut points,
+        links: &mut links,
+        curve: &mut curve,
+        guide: &mut guide_words,
+    });
     let p = &input.params;
     match plan(&grid, input.start, input.goal, p, ws) {
         Ok(plan) => {
@@ -171,9 +178,10 @@ pub fn check_planner(input: &PlannerInput) {
         }
         Err(Error::BadParam(_)) => assert!(p.validate().is_err()),
         Err(e @ (Error::NoPath | Error::NoAntArrived)) => {
-            let mut m = vec![0u8; cells];
+            let mut m = vec![0u32; ohaca::bitmap::words(cells)];
             let mut q = vec![0u32; cells];
-            let reachable = grid.reachable(input.start, input.goal, &mut m, &mut q);
+            let reachable =
+                grid.reachable(input.start, input.goal, &mut m, &mut q) == ohaca::grid::Reach::Yes;
             if e == Error::NoPath {
                 assert!(!reachable, "NoPath on a reachable goal");
             } else {
