@@ -6,8 +6,8 @@
 //!   decoders.
 //! * [`maps::fuzz_map_parsers`] — the `map_parsers` target: the host tool's map readers.
 
-pub mod wire_frame;
 pub mod maps;
+pub mod wire_frame;
 
 use arbitrary::{Arbitrary, Unstructured};
 use ohaca::geometry::{polyline_length, segment_clear, steps_length};

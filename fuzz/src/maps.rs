@@ -22,8 +22,8 @@
 use std::path::Path;
 
 use ohaca::Point;
-use ohaca_host::map::{Format, Map};
 use ohaca_host::map::{decode_image, image_map, ros_map, Mode, RosMeta, Unknown};
+use ohaca_host::map::{Format, Map};
 
 /// The lines a map file consists of: byte-order mark skipped, `\n` or `\r\n` endings, blank lines
 /// at the end ignored (the documented rules, read independently of the parser).

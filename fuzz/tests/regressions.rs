@@ -30,7 +30,10 @@ fn replay(dir: &str, check: fn(&[u8])) -> usize {
 
 #[test]
 fn frame_inputs() {
-    replay("regressions/wire_frame", ohaca_fuzz::wire_frame::fuzz_wire_frame);
+    replay(
+        "regressions/wire_frame",
+        ohaca_fuzz::wire_frame::fuzz_wire_frame,
+    );
     assert!(
         replay("seeds/wire_frame", ohaca_fuzz::wire_frame::fuzz_wire_frame) > 0,
         "no wire_frame seeds"
