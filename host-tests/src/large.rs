@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use crate::maps::{load_scen, maps_dir, Case, Map};
+use crate::maps::{load_scen, longest, maps_dir, Case, Map};
 
 /// A large map and its longest scenarios.
 #[derive(Clone, Debug)]
@@ -48,20 +48,10 @@ pub fn load_large(dir: &Path, name: &str, scenarios: usize) -> LargeMap {
     } else {
         dir.join(format!("{name}.map.scen"))
     };
-    let mut entries = load_scen(&scen).unwrap_or_else(|e| panic!("{e}"));
-    entries.sort_by(|a, b| b.optimal.total_cmp(&a.optimal));
-    entries.truncate(scenarios);
+    let entries = load_scen(&scen).unwrap_or_else(|e| panic!("{e}"));
     LargeMap {
         name: name.to_string(),
         map,
-        cases: entries
-            .into_iter()
-            .map(|e| Case {
-                start: e.start,
-                goal: e.goal,
-                stated_opt8: e.optimal,
-                stated_any_angle: None,
-            })
-            .collect(),
+        cases: longest(entries, scenarios),
     }
 }

@@ -330,6 +330,22 @@ pub struct MapScenarios {
     pub cases: Vec<Case>,
 }
 
+/// The `n` scenarios of largest `optimal` (a stable sort: equal `optimal` keep file order) as
+/// cases with their stated 8-connected optimum.
+pub fn longest(mut entries: Vec<ScenEntry>, n: usize) -> Vec<Case> {
+    entries.sort_by(|a, b| b.optimal.total_cmp(&a.optimal));
+    entries.truncate(n);
+    entries
+        .into_iter()
+        .map(|e| Case {
+            start: e.start,
+            goal: e.goal,
+            stated_opt8: e.optimal,
+            stated_any_angle: None,
+        })
+        .collect()
+}
+
 /// How many `.scen` scenarios [`scenarios`] takes from each Moving AI map.
 pub const SCEN_PER_MAP: usize = 20;
 
@@ -375,26 +391,15 @@ pub fn scenarios() -> Vec<MapScenarios> {
     for (name, scen) in MOVINGAI {
         let map =
             Map::load(dir.join(format!("movingai/{name}.map"))).unwrap_or_else(|e| panic!("{e}"));
-        let mut entries = load_scen(dir.join(scen)).unwrap_or_else(|e| panic!("{e}"));
+        let entries = load_scen(dir.join(scen)).unwrap_or_else(|e| panic!("{e}"));
         for e in &entries {
             assert_eq!(e.map, format!("{name}.map"), "scenario for another map");
             assert_eq!((e.width, e.height), (map.width(), map.height()));
         }
-        // Stable sort: equal `optimal` keep file order.
-        entries.sort_by(|a, b| b.optimal.total_cmp(&a.optimal));
-        entries.truncate(SCEN_PER_MAP);
         out.push(MapScenarios {
             name: name.to_string(),
             map,
-            cases: entries
-                .into_iter()
-                .map(|e| Case {
-                    start: e.start,
-                    goal: e.goal,
-                    stated_opt8: e.optimal,
-                    stated_any_angle: None,
-                })
-                .collect(),
+            cases: longest(entries, SCEN_PER_MAP),
         });
     }
     out
