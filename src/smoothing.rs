@@ -95,6 +95,17 @@ fn collinear_between(a: Point, b: Point, c: Point) -> bool {
 /// new length. (A point on a straight segment between two kept points adds nothing, and the
 /// segment it belongs to was already checked clear, so the merged segment is clear too.)
 pub fn drop_collinear(pts: &mut [Point], n: usize) -> usize {
+    drop_middles(pts, n, collinear_between)
+}
+
+/// Keep `pts[0]` and the last point of `pts[..n]`; drop each interior point `b` for which
+/// `needless(a, b, c)` holds, with `a` the last kept point and `c` the next one. In place; returns
+/// the new length. The one filter behind [`drop_collinear`] and the greedy merge.
+fn drop_middles(
+    pts: &mut [Point],
+    n: usize,
+    needless: impl Fn(Point, Point, Point) -> bool,
+) -> usize {
     let n = n.min(pts.len());
     if n < 3 {
         return n;
@@ -110,7 +121,7 @@ pub fn drop_collinear(pts: &mut [Point], n: usize) -> usize {
         ) else {
             break;
         };
-        if !collinear_between(a, b, c) {
+        if !needless(a, b, c) {
             if let Some(slot) = pts.get_mut(k) {
                 *slot = b;
             }
@@ -320,33 +331,7 @@ fn shortest(
 /// new count. Cost: one segment test per waypoint, from the last kept one; only a stretch that
 /// collapses to one long segment makes these tests grow, to `O(n^2 / K)` cells for `n` raw cells.
 fn merge(grid: &Grid<'_>, pts: &mut [Point], k: usize) -> usize {
-    let k = k.min(pts.len());
-    if k < 3 {
-        return k;
-    }
-    // Bounds: 1 <= out <= i < k - 1 < pts.len(), so no `wrapping_` here wraps.
-    let last = k.wrapping_sub(1);
-    let mut out = 1usize;
-    for i in 1..last {
-        let (Some(&a), Some(&b), Some(&c)) = (
-            pts.get(out.wrapping_sub(1)),
-            pts.get(i),
-            pts.get(i.wrapping_add(1)),
-        ) else {
-            break;
-        };
-        if !segment_clear(grid, a, c) {
-            if let Some(slot) = pts.get_mut(out) {
-                *slot = b;
-            }
-            out = out.wrapping_add(1);
-        }
-    }
-    let end = pts.get(last).copied();
-    if let (Some(end), Some(slot)) = (end, pts.get_mut(out)) {
-        *slot = end;
-    }
-    out.wrapping_add(1)
+    drop_middles(pts, k, |a, _, c| segment_clear(grid, a, c))
 }
 
 #[cfg(test)]
