@@ -136,7 +136,7 @@ def unframe(wire):
 
 # ---- messages --------------------------------------------------------------------------------
 
-PROTOCOL_VERSION = 3
+PROTOCOL_VERSION = 4
 ALGORITHMS = ["aca", "paca", "haca", "ohaca"]
 DEAD_ENDS = ["backtrack", "die"]
 SMOOTHING = ["none", "greedy", "shortest"]
@@ -149,7 +149,7 @@ ERRORS = {
 PARAM_FIELDS = [
     ("algorithm", "enum"), ("ants", "u"), ("iterations", "u"), ("alpha", "f"), ("beta", "f"),
     ("rho", "f"), ("q", "f"), ("a", "f"), ("xi", "f"), ("tau0", "f"), ("tau_min", "f"),
-    ("tau_max", "f"), ("patience", "u"), ("seed", "u"), ("dead_end", "enum"),
+    ("tau_max", "f"), ("patience", "u"), ("warm_patience", "u"), ("seed", "u"), ("dead_end", "enum"),
     ("smoothing", "enum"), ("tighten", "bool"), ("prune", "bool"),
 ]
 
@@ -226,7 +226,7 @@ def dec_reply(body):
     elif tag == 2:
         out = {"kind": "Path", "raw_length": r.f32(), "length": r.f32(), "turns": r.varint(),
                "iterations": r.varint(), "best_iteration": r.varint(), "moves": r.varint(),
-               "ticks": r.varint(), "raw_cells": r.varint()}
+               "ticks": r.varint(), "raw_cells": r.varint(), "warm": r.byte() != 0}
         w = r.bytes()
         out["waypoints"] = [struct.unpack_from("<HH", w, i) for i in range(0, len(w), 4)]
         out["directions"] = list(r.bytes())

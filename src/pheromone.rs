@@ -205,6 +205,45 @@ impl<'a> Table<'a> {
         }
     }
 
+    /// Clamp every entry into `[lo, hi]` (a NaN lands on `lo`).
+    pub fn clamp(&mut self, lo: f32, hi: f32) {
+        for v in self.tau.as_flattened_mut() {
+            // Comparisons, as in `evaporate_and_merge`.
+            *v = if *v > hi {
+                hi
+            } else if *v >= lo {
+                *v
+            } else {
+                lo
+            };
+        }
+    }
+
+    /// Set the entries of every block that holds a cell of the rectangle `min..=max` (clipped to
+    /// the map) to `value`. Returns how many entries were set.
+    pub fn fill_area(&mut self, min: Point, max: Point, value: f32) -> u32 {
+        let b = self.blocks;
+        let across = b.across();
+        // `count / across` block rows (across > 0 for every map, see `Blocks::with_budget`).
+        let down = b.count().checked_div(across).unwrap_or(0);
+        let x0 = usize::from(min.x >> b.shift());
+        let y0 = usize::from(min.y >> b.shift());
+        let x1 = usize::from(max.x >> b.shift()).min(across.saturating_sub(1));
+        let y1 = usize::from(max.y >> b.shift()).min(down.saturating_sub(1));
+        let mut n = 0u32;
+        for by in y0..=y1 {
+            // Below `count <= BLOCKS` entries: no overflow.
+            let row = by.wrapping_mul(across);
+            for bx in x0..=x1 {
+                if let Some(e) = self.tau.get_mut(row.wrapping_add(bx)) {
+                    *e = [value; 4];
+                    n = n.saturating_add(1);
+                }
+            }
+        }
+        n
+    }
+
     /// The entries as one flat slice (`4 * block + slot`).
     #[inline]
     pub fn flat(&self) -> &[f32] {

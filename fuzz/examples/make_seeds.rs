@@ -219,6 +219,7 @@ fn wire_frame_seeds(root: &Path) -> Result<Vec<(String, Vec<u8>)>> {
         moves: 4200,
         ticks: 1689,
         raw_cells: 41,
+        warm: true,
         waypoints: Waypoints::Points(&points),
         directions: &directions,
     };

@@ -66,6 +66,7 @@ impl<'a> Arbitrary<'a> for PlannerInput {
             tau_min: pick_f32(u, &[0.01, 1e-30, 1.0])?,
             tau_max: pick_f32(u, &[100.0, 1e30, 1.0])?,
             patience: *u.choose(&[0u16, 1, 20])?,
+            warm_patience: *u.choose(&[0u16, 1, 3])?,
             seed: u64::arbitrary(u)?,
             dead_end: if bool::arbitrary(u)? {
                 DeadEnd::Backtrack

@@ -191,6 +191,10 @@ pub struct ParamArgs {
     #[arg(long, value_name = "N", allow_negative_numbers = true,
           help = preset_help("Stop after this many iterations without improvement; 0 = never stop early", |p| p.patience.to_string()))]
     pub patience: Option<u16>,
+    /// The patience of a warm replan (PlanWarm / `ohaca replan`); 0 = the same as --patience
+    #[arg(long, value_name = "N", allow_negative_numbers = true,
+          help = preset_help("The patience of a warm replan (PlanWarm / `ohaca replan`); 0 = the same as --patience", |p| p.warm_patience.to_string()))]
+    pub warm_patience: Option<u16>,
     /// What an ant does at a dead end: backtrack or die (the paper)
     #[arg(long, value_name = "RULE", value_parser = parse_name::<DeadEnd>,
           help = preset_help("What an ant does at a dead end: backtrack or die (the paper)", |p| p.dead_end.name().to_string()))]
@@ -229,6 +233,7 @@ impl ParamArgs {
             tau_min: self.tau_min.unwrap_or(base.tau_min),
             tau_max: self.tau_max.unwrap_or(base.tau_max),
             patience: self.patience.unwrap_or(base.patience),
+            warm_patience: self.warm_patience.unwrap_or(base.warm_patience),
             dead_end: self.dead_end.unwrap_or(base.dead_end),
             smoothing: self.smoothing.unwrap_or(base.smoothing),
             tighten: self.tighten.unwrap_or(base.tighten),
@@ -294,6 +299,8 @@ mod tests {
             "10",
             "--patience",
             "0",
+            "--warm-patience",
+            "5",
             "--dead-end",
             "die",
             "--smoothing",
@@ -318,6 +325,7 @@ mod tests {
                 tau_min: 0.5,
                 tau_max: 10.0,
                 patience: 0,
+                warm_patience: 5,
                 seed: u64::MAX,
                 dead_end: DeadEnd::Die,
                 smoothing: SmoothingKind::Greedy,

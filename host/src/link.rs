@@ -204,6 +204,8 @@ pub struct DevicePath {
     pub ticks: u64,
     /// Cells of the raw path.
     pub raw_cells: u32,
+    /// The device kept its previous colony (`PlanWarm` planned warm).
+    pub warm: bool,
     /// Waypoints, start first.
     pub waypoints: Vec<Point>,
     /// The raw path as directions from the start (`0..8` = E, SE, S, SW, W, NW, N, NE).
@@ -221,6 +223,7 @@ impl From<&PathReply<'_>> for DevicePath {
             moves: p.moves,
             ticks: p.ticks,
             raw_cells: p.raw_cells,
+            warm: p.warm,
             waypoints: p.waypoints.iter().collect(),
             directions: p.directions.to_vec(),
         }
@@ -1036,6 +1039,7 @@ mod tests {
                     moves: pts.moves,
                     ticks: pts.ticks,
                     raw_cells: pts.raw_cells,
+                    warm: pts.warm,
                     waypoints: Waypoints::Points(&pts.waypoints),
                     directions: &pts.directions,
                 })
@@ -1126,6 +1130,7 @@ mod tests {
             moves: seed,
             ticks: 5,
             raw_cells: 2,
+            warm: false,
             waypoints: vec![Point::new(0, 0), Point::new(1, 0)],
             directions: vec![0],
         }

@@ -70,7 +70,7 @@ const FOUND_KEYS: [&str; 11] = [
     "waypoints",
 ];
 
-const PARAM_KEYS: [&str; 18] = [
+const PARAM_KEYS: [&str; 19] = [
     "a",
     "algorithm",
     "alpha",
@@ -88,6 +88,7 @@ const PARAM_KEYS: [&str; 18] = [
     "tau_max",
     "tau_min",
     "tighten",
+    "warm_patience",
     "xi",
 ];
 

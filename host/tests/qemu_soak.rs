@@ -571,6 +571,7 @@ impl Soak {
             tau_min: 0.01,
             tau_max: 100.0,
             patience: r.range(0, 4) as u16,
+            warm_patience: r.range(0, 3) as u16,
             seed: r.next(),
             dead_end: if r.chance(0.2) {
                 DeadEnd::Die

@@ -66,11 +66,26 @@ async fn plan(
     }
     let (width, height) = state::map_size().ok_or(ErrorReply::new(ErrorCode::NoMap))?;
     let grid = Grid::new(width, height, &map[..])?;
-    if job.warm {
-        defmt::debug!("plan {}: warm start asked, planned cold", job.id);
-    }
     let t0 = Instant::now();
-    let mut run = Run::new(&grid, job.start, job.goal, &job.params, storage.workspace())?;
+    // A cold plan forgets the colony; a warm one keeps it if it is for this map and goal. Both
+    // record theirs for the next `PlanWarm` (only once the run started: a refused plan leaves the
+    // pheromone as it was). The memory is read and written under the map's lock.
+    let mut memory = state::colony();
+    if !job.warm {
+        memory.forget();
+    }
+    let mut run = Run::warm(
+        &grid,
+        job.start,
+        job.goal,
+        &job.params,
+        storage.workspace(),
+        &mut memory,
+    )?;
+    state::set_colony(memory);
+    if job.warm {
+        defmt::info!("plan {}: warm start asked, warm {}", job.id, run.is_warm());
+    }
     let t_new = Instant::now();
     // Ticks spent inside `Run::step`, without the yields between iterations.
     let mut in_steps = 0u64;
@@ -117,6 +132,7 @@ async fn plan(
         moves: plan.moves,
         ticks,
         raw_cells: u32::try_from(plan.raw_len()).unwrap_or(u32::MAX),
+        warm: plan.warm,
         waypoints: Waypoints::Points(plan.waypoints()),
         directions: plan.directions(),
     };

@@ -9,7 +9,7 @@ use embassy_sync::channel::TrySendError;
 use embedded_io_async::Read;
 
 use ohaca::grid::Point;
-use ohaca::planner::Params;
+use ohaca::planner::{Area, Params};
 use ohaca::protocol::{
     check_cells, check_rect, decode_request, set_cells, set_rect, Capacity, Encoding, ErrorCode,
     ErrorReply, HelloReply, MapChunk, Reply, Request, RequestReader, Upload, Waypoints, MAX_CHUNK,
@@ -219,6 +219,10 @@ impl Session {
             state::set_map_size(None);
         }
         let mut map = MAP.lock().await;
+        if starts {
+            // The pheromone in the planner's storage is for the old map.
+            state::set_colony(ohaca::planner::Memory::new());
+        }
         match self.upload.write(c, &mut map[..]) {
             Ok(Some((w, h))) => {
                 state::set_map_size(Some((w, h)));
@@ -246,8 +250,18 @@ async fn update(u: Update<'_>, blocked: bool) -> Reply<'static> {
     state::cancel_all();
     let mut map = MAP.lock().await;
     let done = match u {
-        Update::Rect(x, y, w, h) => set_rect(size, &mut map[..], (x, y, w, h), blocked),
-        Update::Cells(c) => set_cells(size, &mut map[..], &c, blocked),
+        Update::Rect(x, y, w, h) => {
+            if let Some(a) = Area::rect(x, y, w, h) {
+                state::colony_changed(a);
+            }
+            set_rect(size, &mut map[..], (x, y, w, h), blocked)
+        }
+        Update::Cells(c) => {
+            for p in c.iter() {
+                state::colony_changed(Area::cell(p));
+            }
+            set_cells(size, &mut map[..], &c, blocked)
+        }
     };
     match done {
         Ok(()) => Reply::Ack,

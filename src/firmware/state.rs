@@ -17,7 +17,7 @@ use embassy_sync::channel::Channel;
 use embassy_sync::mutex::Mutex;
 
 use ohaca::grid::Point;
-use ohaca::planner::Params;
+use ohaca::planner::{Area, Memory, Params};
 use ohaca::protocol::{MapLimits, Reply, StatsReply};
 
 use super::board::{self, Board};
@@ -62,8 +62,8 @@ pub struct Job {
     pub params: Params,
     /// [`GENERATION`] when it was received; a different value now means cancelled.
     pub generation: u32,
-    /// `PlanWarm`: keep the previous plan's colony if it was to the same goal (planned cold
-    /// until the core can).
+    /// `PlanWarm`: keep the previous plan's colony if it was to the same goal on this map
+    /// ([`COLONY`]).
     pub warm: bool,
 }
 
@@ -80,6 +80,11 @@ pub static MAP: Mutex<Raw, [u8; MAP_BYTES]> = Mutex::new([0; MAP_BYTES]);
 /// Width and height of the complete map in [`MAP`]; `None`: no map (none yet, an upload in
 /// progress, or a failed one).
 static MAP_SIZE: BlockingMutex<Raw, Cell<Option<(u16, u16)>>> = BlockingMutex::new(Cell::new(None));
+/// What the pheromone in the planner's storage belongs to, and the cells changed since
+/// (`ohaca::planner::Memory`). Read and written only while holding [`MAP`]'s lock: by the
+/// planner around `Run::warm`, by the receiver when it writes the map, so a change can never slip
+/// between a plan's start and its record.
+static COLONY: BlockingMutex<Raw, Cell<Memory>> = BlockingMutex::new(Cell::new(Memory::new()));
 /// Bumped by `Cancel`, by every map upload and by every cell update: plans received under an
 /// older value are cancelled.
 pub static GENERATION: AtomicU32 = AtomicU32::new(0);
@@ -137,6 +142,25 @@ pub fn map_size() -> Option<(u16, u16)> {
 /// Record what [`MAP`] holds.
 pub fn set_map_size(size: Option<(u16, u16)>) {
     MAP_SIZE.lock(|c| c.set(size));
+}
+
+/// The colony memory (call with [`MAP`]'s lock held).
+pub fn colony() -> Memory {
+    COLONY.lock(Cell::get)
+}
+
+/// Replace the colony memory (call with [`MAP`]'s lock held).
+pub fn set_colony(m: Memory) {
+    COLONY.lock(|c| c.set(m));
+}
+
+/// Record a change of the cells in `area` for the next warm start (call with [`MAP`]'s lock held).
+pub fn colony_changed(area: Area) {
+    COLONY.lock(|c| {
+        let mut m = c.get();
+        m.changed(area);
+        c.set(m);
+    });
 }
 
 /// True if plans received under `generation` are cancelled.

@@ -5,7 +5,7 @@
 //! validate parameters, map size, start and goal
 //! flood fill: goal unreachable -> Err(NoPath) at once
 //! prune the cells no shortest path needs                 (prune)
-//! tau = tau0 everywhere
+//! tau = tau0 everywhere (a warm start keeps the previous run's tau, reset near map changes: warm)
 //! repeat `iterations` times (or until the best has not improved for `patience` iterations):
 //!     each of `ants` ants walks start -> goal            (colony)
 //!     each ant that arrived deposits Q / L on its path    (update)
@@ -20,6 +20,7 @@
 //! | `workspace` | [`Workspace`], [`Buffers`], [`Storage`]: every buffer, one layout |
 //! | `run` | [`Run`]: the loop as a state machine (walk, update, record) |
 //! | `plan` | [`Plan`], [`RawPath`], [`CurvePoint`]: the result |
+//! | `warm` | [`Memory`], [`Area`]: warm starts after map changes, and the pheromone repair |
 //!
 //! [`Run::step`] does one iteration, so the firmware can yield to its executor between iterations
 //! and cancel a plan by dropping (or finishing) the run. [`plan`] runs it to the end.
@@ -27,11 +28,13 @@
 mod params;
 mod plan;
 mod run;
+mod warm;
 mod workspace;
 
 pub use params::{Algorithm, Params};
 pub use plan::{CurvePoint, Plan, RawPath};
 pub use run::Run;
+pub use warm::{Area, Memory, REPAIR_RADIUS};
 pub use workspace::{Buffers, Storage, Workspace};
 
 use crate::error::Error;

@@ -105,6 +105,9 @@ pub struct Params {
     pub tau_max: f32,
     /// Stop when the best path has not improved for this many iterations; 0 = never stop early.
     pub patience: u16,
+    /// [`Params::patience`] for a warm start ([`crate::planner::Run::warm`]), whose colony
+    /// already holds the previous plan's trail; 0 = the same as `patience`.
+    pub warm_patience: u16,
     /// Seed of the random generator.
     pub seed: u64,
     /// What an ant does at a dead end.
@@ -141,6 +144,7 @@ impl Params {
         tau_min: 0.01,
         tau_max: 100.0,
         patience: 10,
+        warm_patience: 3,
         seed: 1,
         dead_end: DeadEnd::Backtrack,
         smoothing: SmoothingKind::Shortest,
@@ -157,6 +161,7 @@ impl Params {
     pub const fn paper() -> Self {
         Params {
             patience: 0,
+            warm_patience: 0,
             dead_end: DeadEnd::Die,
             smoothing: SmoothingKind::Greedy,
             tighten: false,

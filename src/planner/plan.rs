@@ -39,6 +39,8 @@ pub struct Plan<'a> {
     pub moves: u64,
     /// Cells pruned before the ants ran ([`crate::prune`]).
     pub pruned: u32,
+    /// True if the run kept the previous run's colony ([`super::Run::warm`]).
+    pub warm: bool,
     pub(super) curve: &'a [CurvePoint],
     /// Parameters used.
     pub params: Params,

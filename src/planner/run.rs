@@ -19,6 +19,7 @@ use crate::update::{deposit, wolves};
 
 use super::params::{Algorithm, Params};
 use super::plan::{CurvePoint, Plan, RawPath};
+use super::warm::{self, Area, Memory};
 use super::workspace::Workspace;
 
 /// The best path of an iteration or of the run, as step counts (exact length comparison).
@@ -73,6 +74,7 @@ pub struct Run<'g, 'a> {
     moves: u64,
     pruned: u32,
     routed: bool,
+    warm: bool,
     no_path: bool,
     done: bool,
 }
@@ -87,6 +89,42 @@ impl<'g, 'a> Run<'g, 'a> {
         goal: Point,
         params: &Params,
         ws: Workspace<'a>,
+    ) -> Result<Self, Error> {
+        Self::prepare(grid, start, goal, params, ws, None)
+    }
+
+    /// [`Run::new`], keeping the colony of the previous run to the same goal when `memory` says
+    /// the workspace holds it (same map size and goal): its pheromone is kept, reset to `tau0` near
+    /// the cells changed since ([`crate::planner::REPAIR_RADIUS`]), and the run stops after
+    /// [`Params::warm_patience`] stale iterations. Otherwise this is exactly [`Run::new`] (a cold
+    /// start). On success `memory` records this run; on failure nothing changed.
+    ///
+    /// The caller keeps `memory` beside the storage, calls [`Memory::changed`] for every map
+    /// update and [`Memory::forget`] for a new map. See [`crate::planner`]'s `warm` module docs.
+    pub fn warm(
+        grid: &'g Grid<'g>,
+        start: Point,
+        goal: Point,
+        params: &Params,
+        ws: Workspace<'a>,
+        memory: &mut Memory,
+    ) -> Result<Self, Error> {
+        let warm = memory
+            .is_warm_for(grid.width(), grid.height(), goal)
+            .then(|| memory.changes());
+        let run = Self::prepare(grid, start, goal, params, ws, warm)?;
+        memory.planned(grid.width(), grid.height(), goal);
+        Ok(run)
+    }
+
+    /// [`Run::new`] (`warm` = `None`) and [`Run::warm`] (`Some(changes since)`).
+    fn prepare(
+        grid: &'g Grid<'g>,
+        start: Point,
+        goal: Point,
+        params: &Params,
+        ws: Workspace<'a>,
+        warm: Option<Option<Area>>,
     ) -> Result<Self, Error> {
         params.validate()?;
         let cells = grid.cells();
@@ -118,7 +156,20 @@ impl<'g, 'a> Run<'g, 'a> {
             let moves = Moves::new(*grid, ws.moves);
             route::build(&moves, guide_blocks, goal, ws.dead, ws.guide, ws.links)
         };
-        ws.tau.fill([params.tau0; 4]);
+        match warm {
+            None => ws.tau.fill([params.tau0; 4]),
+            Some(changes) => {
+                let mut tau = Table::new(blocks, ws.tau);
+                let _reset = warm::repair(
+                    &mut tau,
+                    changes,
+                    params.tau0,
+                    params.tau_min,
+                    params.tau_max,
+                );
+                crate::fmt::debug!("plan: warm start, {} pheromone entries reset", _reset);
+            }
+        }
         ws.delta.fill([0.0; 4]);
         let heuristic = Heuristic::new(
             goal,
@@ -151,6 +202,7 @@ impl<'g, 'a> Run<'g, 'a> {
             moves: 0,
             pruned,
             routed,
+            warm: warm.is_some(),
             no_path: false,
             done: false,
         })
@@ -174,6 +226,11 @@ impl<'g, 'a> Run<'g, 'a> {
     /// Length of the best raw path found so far.
     pub fn best_length(&self) -> Option<f32> {
         self.best.map(|b| b.length())
+    }
+
+    /// True if this run kept the previous run's colony ([`Run::warm`]).
+    pub fn is_warm(&self) -> bool {
+        self.warm
     }
 
     /// Iterations run so far.
@@ -347,7 +404,12 @@ impl<'g, 'a> Run<'g, 'a> {
         }
         self.iteration = self.iteration.saturating_add(1);
         let p = &self.params;
-        let early = p.patience > 0 && self.best.is_some() && self.stale >= p.patience;
+        let patience = if self.warm && p.warm_patience > 0 {
+            p.warm_patience
+        } else {
+            p.patience
+        };
+        let early = patience > 0 && self.best.is_some() && self.stale >= patience;
         self.done = self.no_path || self.iteration >= p.iterations || early;
     }
 
@@ -366,6 +428,7 @@ impl<'g, 'a> Run<'g, 'a> {
             iteration,
             moves,
             pruned,
+            warm,
             no_path,
             ..
         } = self;
@@ -421,6 +484,7 @@ impl<'g, 'a> Run<'g, 'a> {
             best_iteration,
             moves,
             pruned,
+            warm,
             curve,
             params,
         })

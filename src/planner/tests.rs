@@ -159,6 +159,7 @@ fn paper_preset_differs_from_default_only_where_documented() {
             smoothing: crate::SmoothingKind::Greedy,
             tighten: false,
             prune: false,
+            warm_patience: 0,
             ..d
         }
     );

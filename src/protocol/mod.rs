@@ -52,7 +52,7 @@ pub use wire::{Waypoints, WAYPOINT_BYTES};
 /// Protocol version, reported in [`HelloReply::protocol_version`]. Bumped on any change to the
 /// bytes or meaning of a message (2: [`StatsReply::stack_peak`]; 3: run-length uploads, cell
 /// updates, warm plans, [`Capacity`]'s sides are the largest map held).
-pub const VERSION: u16 = 3;
+pub const VERSION: u16 = 4;
 
 /// The id of replies to frames whose request id could not be read. Hosts should not use it.
 pub const UNKNOWN_ID: u32 = 0;
@@ -253,6 +253,8 @@ pub struct PathReply<'a> {
     pub ticks: u64,
     /// Cells of the raw path (`directions.len() + 1` unless the directions were cut short).
     pub raw_cells: u32,
+    /// True if the run kept the colony of the previous plan (a `PlanWarm` planned warm).
+    pub warm: bool,
     /// Waypoints, start first, goal last.
     #[serde(borrow)]
     pub waypoints: Waypoints<'a>,

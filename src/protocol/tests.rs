@@ -76,6 +76,7 @@ fn params() -> Params {
         tau_min: 0.01,
         tau_max: 1e30,
         patience: 0,
+        warm_patience: 7,
         seed: u64::MAX,
         dead_end: DeadEnd::Die,
         smoothing: SmoothingKind::Greedy,
@@ -173,6 +174,7 @@ fn path() -> PathReply<'static> {
         moves: 4200,
         ticks: 123_456,
         raw_cells: 5,
+        warm: true,
         waypoints: Waypoints::Points(&WPTS),
         directions: &DIRS,
     }
@@ -334,6 +336,7 @@ fn largest_messages_fit_their_limits() {
         moves: u64::MAX,
         ticks: u64::MAX,
         raw_cells: u32::MAX,
+        warm: true,
         waypoints: Waypoints::Points(&wp),
         directions: &dirs,
     });
@@ -762,6 +765,7 @@ fn example_path() -> PathReply<'static> {
         moves: 2200,
         ticks: EXAMPLE_TICKS,
         raw_cells: 5,
+        warm: false,
         waypoints: Waypoints::Points(&EXAMPLE_WAYPOINTS),
         directions: &EXAMPLE_DIRECTIONS,
     }
@@ -1052,6 +1056,7 @@ fn reply_fields(id: u32, r: &Reply<'_>) -> Vec<(String, Vec<u8>)> {
             v.push((format!("  moves = {}", p.moves), ser(&p.moves)));
             v.push((format!("  ticks = {}", p.ticks), ser(&p.ticks)));
             v.push((format!("  raw_cells = {}", p.raw_cells), ser(&p.raw_cells)));
+            v.push((format!("  warm = {}", p.warm), ser(&p.warm)));
             let pts: Vec<String> = p
                 .waypoints
                 .iter()

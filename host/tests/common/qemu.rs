@@ -319,6 +319,7 @@ pub struct CorePath {
     pub best_iteration: u16,
     pub moves: u64,
     pub raw_cells: u32,
+    pub warm: bool,
     pub waypoints: Vec<Point>,
     pub directions: Vec<u8>,
 }
@@ -346,6 +347,7 @@ pub fn core_plan(
         best_iteration: plan.best_iteration,
         moves: plan.moves,
         raw_cells: u32::try_from(plan.raw_len()).expect("raw cells"),
+        warm: plan.warm,
         waypoints: plan.waypoints().to_vec(),
         directions: plan.directions().to_vec(),
     })
@@ -362,6 +364,7 @@ pub fn assert_core_path(what: &str, core: &CorePath, dev: &DevicePath) {
         best_iteration: dev.best_iteration,
         moves: dev.moves,
         raw_cells: dev.raw_cells,
+        warm: dev.warm,
         waypoints: dev.waypoints.clone(),
         directions: dev.directions.clone(),
     };

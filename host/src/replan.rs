@@ -1,0 +1,575 @@
+//! Replanning scenarios: a robot follows its path while cells of its map change, and replans
+//! from the cell it has reached, warm (keeping the colony, [`ohaca::planner::Run::warm`] /
+//! `PlanWarm`) or cold. The same scenario drives the host core or a device over its link, so the
+//! two can be compared plan by plan.
+//!
+//! A scenario file is JSON:
+//!
+//! ```json
+//! {
+//!   "start": [0, 0],
+//!   "goal": [25, 25],
+//!   "initial": [ { "rect": [10, 10, 3, 1], "blocked": true } ],
+//!   "events": [
+//!     { "at": 0.33, "wall_ahead": { "cells": 5, "ahead": 6 } },
+//!     { "at": 0.5, "rect": [10, 10, 3, 1], "blocked": false }
+//!   ]
+//! }
+//! ```
+//!
+//! - `initial`: changes made before the first plan (e.g. a closed door);
+//! - each event happens when the robot has travelled the fraction `at` of the path it is
+//!   following (its raw 8-connected path); the robot then replans from its cell to the goal;
+//! - a change is a rectangle `[x, y, width, height]`, a list of `cells` (`[[x, y], ...]`), or
+//!   `wall_ahead`: `cells` cells across the robot's path, centred `ahead` path cells in front of it
+//!   (never on the robot's cell or the goal); `blocked` defaults to true.
+//!
+//! Every plan is checked (every step an allowed move on the map of its time) and measured against
+//! the exact shortest 8-connected path on that map ([`shortest`]).
+
+use std::collections::BinaryHeap;
+
+use serde::Deserialize;
+
+use ohaca::heap::HeapStorage;
+use ohaca::planner::{Area, Memory, Run};
+use ohaca::{Grid, Params, Point};
+
+use crate::link::{DevicePath, Link, LinkError, Transport};
+use crate::map::Map;
+
+/// A replanning scenario (see the module docs for the file format).
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scenario {
+    /// The robot's first cell.
+    pub start: [u16; 2],
+    /// The goal cell (the same for every plan).
+    pub goal: [u16; 2],
+    /// Changes before the first plan.
+    #[serde(default)]
+    pub initial: Vec<Change>,
+    /// Changes while the robot drives, in order.
+    #[serde(default)]
+    pub events: Vec<Event>,
+}
+
+/// A change at a point of the robot's drive.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Event {
+    /// Fraction of its current path the robot has travelled, `0..=1`.
+    pub at: f64,
+    /// What changes.
+    #[serde(flatten)]
+    pub change: Change,
+}
+
+/// Cells that become blocked (or free).
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Change {
+    /// `[x, y, width, height]`.
+    #[serde(default)]
+    pub rect: Option<[u16; 4]>,
+    /// Single cells.
+    #[serde(default)]
+    pub cells: Option<Vec<[u16; 2]>>,
+    /// A wall across the robot's path.
+    #[serde(default)]
+    pub wall_ahead: Option<WallAhead>,
+    /// Blocked (default) or cleared.
+    #[serde(default = "yes")]
+    pub blocked: bool,
+}
+
+fn yes() -> bool {
+    true
+}
+
+/// `cells` cells across the path, centred `ahead` path cells in front of the robot.
+#[derive(Clone, Copy, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WallAhead {
+    /// Cells in the wall.
+    pub cells: u16,
+    /// Path cells between the robot and the wall's centre.
+    pub ahead: u16,
+}
+
+impl Scenario {
+    /// Parse a scenario file's text.
+    pub fn parse(text: &str) -> Result<Scenario, String> {
+        let s: Scenario = serde_json::from_str(text).map_err(|e| e.to_string())?;
+        for (i, e) in s.events.iter().enumerate() {
+            if !(0.0..=1.0).contains(&e.at) {
+                return Err(format!("event {i}: `at` must be in 0..=1, not {}", e.at));
+            }
+        }
+        for c in s.initial.iter().chain(s.events.iter().map(|e| &e.change)) {
+            let n = [c.rect.is_some(), c.cells.is_some(), c.wall_ahead.is_some()]
+                .iter()
+                .filter(|&&b| b)
+                .count();
+            if n != 1 {
+                return Err("each change needs exactly one of rect, cells, wall_ahead".into());
+            }
+        }
+        Ok(s)
+    }
+}
+
+/// A plan as the scenario sees it, from the core or a device.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Planned {
+    /// Every cell of the raw path, start first.
+    pub raw: Vec<Point>,
+    /// The smoothed waypoints.
+    pub waypoints: Vec<Point>,
+    /// Raw path length (cells).
+    pub raw_length: f32,
+    /// Length through the waypoints.
+    pub length: f32,
+    /// Iterations run.
+    pub iterations: u16,
+    /// Ant moves over the run.
+    pub moves: u64,
+    /// Device ticks (`None` on the host).
+    pub ticks: Option<u64>,
+    /// The run kept the previous colony.
+    pub warm: bool,
+}
+
+/// Something that plans: the host core or a device.
+pub trait Planner {
+    /// Make the map the active map.
+    fn set_map(&mut self, map: &Map) -> Result<(), String>;
+    /// Block or clear `cells` (every one on the map).
+    fn change(&mut self, cells: &[Point], blocked: bool) -> Result<(), String>;
+    /// Plan from `start` to `goal`, warm or cold.
+    fn plan(&mut self, start: Point, goal: Point, warm: bool) -> Result<Planned, String>;
+}
+
+/// The host core, planning as the device does (its 1,023-step path bound and move table), so
+/// its paths are the device's bit for bit.
+pub struct HostPlanner {
+    map: Map,
+    params: Params,
+    storage: HeapStorage,
+    memory: Memory,
+}
+
+/// The device's longest ant path (`firmware::state::PLAN_STEPS`).
+pub const DEVICE_STEPS: usize = 1023;
+
+impl HostPlanner {
+    /// A planner with `params` and no map yet.
+    pub fn new(params: Params) -> Self {
+        HostPlanner {
+            map: Map::from_fn(0, 0, |_, _| false),
+            params,
+            storage: HeapStorage::default(),
+            memory: Memory::new(),
+        }
+    }
+}
+
+impl Planner for HostPlanner {
+    fn set_map(&mut self, map: &Map) -> Result<(), String> {
+        self.map = map.clone();
+        self.storage = HeapStorage::with_steps(
+            map.cells(),
+            DEVICE_STEPS,
+            true,
+            usize::from(self.params.iterations),
+        )
+        .map_err(|e| e.to_string())?;
+        self.memory.forget();
+        Ok(())
+    }
+
+    fn change(&mut self, cells: &[Point], blocked: bool) -> Result<(), String> {
+        for &p in cells {
+            set_cell(&mut self.map, p, blocked)?;
+            self.memory.changed(Area::cell(p));
+        }
+        Ok(())
+    }
+
+    fn plan(&mut self, start: Point, goal: Point, warm: bool) -> Result<Planned, String> {
+        let grid = self.map.grid().map_err(|e| e.to_string())?;
+        if !warm {
+            self.memory.forget();
+        }
+        let mut run = Run::warm(
+            &grid,
+            start,
+            goal,
+            &self.params,
+            self.storage.workspace(),
+            &mut self.memory,
+        )
+        .map_err(|e| e.to_string())?;
+        while run.step() {}
+        let plan = run.finish().map_err(|e| e.to_string())?;
+        Ok(Planned {
+            raw: plan.raw().collect(),
+            waypoints: plan.waypoints().to_vec(),
+            raw_length: plan.raw_length,
+            length: plan.length,
+            iterations: plan.iterations,
+            moves: plan.moves,
+            ticks: None,
+            warm: plan.warm,
+        })
+    }
+}
+
+/// A device over its link (`SetMap`, `SetCells`, `Plan` / `PlanWarm`).
+pub struct DevicePlanner<T: Transport> {
+    /// The link.
+    pub link: Link<T>,
+}
+
+impl<T: Transport> Planner for DevicePlanner<T> {
+    fn set_map(&mut self, map: &Map) -> Result<(), String> {
+        self.link.set_map(map).map_err(|e| e.to_string())
+    }
+
+    fn change(&mut self, cells: &[Point], blocked: bool) -> Result<(), String> {
+        self.link
+            .set_cells(cells, blocked)
+            .map_err(|e| e.to_string())
+    }
+
+    fn plan(&mut self, start: Point, goal: Point, warm: bool) -> Result<Planned, String> {
+        let r: Result<DevicePath, LinkError> = if warm {
+            self.link.plan_warm(start, goal, None)
+        } else {
+            self.link.plan(start, goal, None)
+        };
+        let p = r.map_err(|e| e.to_string())?;
+        Ok(Planned {
+            raw: p.raw(start).map_err(|e| e.to_string())?,
+            waypoints: p.waypoints.clone(),
+            raw_length: p.raw_length,
+            length: p.length,
+            iterations: p.iterations,
+            moves: p.moves,
+            ticks: Some(p.ticks),
+            warm: p.warm,
+        })
+    }
+}
+
+fn set_cell(map: &mut Map, p: Point, blocked: bool) -> Result<(), String> {
+    if p.x >= map.width || p.y >= map.height {
+        return Err(format!("cell ({}, {}) is outside the map", p.x, p.y));
+    }
+    let i = usize::from(p.y) * usize::from(map.width) + usize::from(p.x);
+    let b = map
+        .bits
+        .get_mut(i / 8)
+        .ok_or_else(|| "map bits too short".to_string())?;
+    if blocked {
+        *b |= 1 << (i % 8);
+    } else {
+        *b &= !(1 << (i % 8));
+    }
+    Ok(())
+}
+
+/// One plan of a scenario run.
+#[derive(Clone, Debug)]
+pub struct Step {
+    /// The robot's cell when it planned.
+    pub robot: Point,
+    /// Cells changed just before this plan (empty for the first plan without `initial`).
+    pub changed: Vec<Point>,
+    /// Blocked (true) or cleared.
+    pub blocked: bool,
+    /// The map this plan saw.
+    pub map: Map,
+    /// The plan.
+    pub plan: Planned,
+    /// Exact shortest 8-connected length from the robot's cell on this map.
+    pub optimum: Option<f64>,
+}
+
+/// A scenario run: every plan, and the cells the robot drove through.
+#[derive(Clone, Debug)]
+pub struct Drive {
+    /// The plans, first one first.
+    pub steps: Vec<Step>,
+    /// The robot's cells, start to goal.
+    pub trail: Vec<Point>,
+}
+
+/// Run `scenario` on `map` with `planner`; replans are warm when `warm`. The map is uploaded first.
+pub fn drive(
+    scenario: &Scenario,
+    map: &Map,
+    planner: &mut dyn Planner,
+    warm: bool,
+) -> Result<Drive, String> {
+    let mut map = map.clone();
+    let start = Point::new(scenario.start[0], scenario.start[1]);
+    let goal = Point::new(scenario.goal[0], scenario.goal[1]);
+    let mut changed = Vec::new();
+    let mut blocked = true;
+    for c in &scenario.initial {
+        let cells = resolve(c, &map, &[], 0, goal)?;
+        for &p in &cells {
+            set_cell(&mut map, p, c.blocked)?;
+        }
+        blocked = c.blocked;
+        changed.extend(cells);
+    }
+    planner.set_map(&map)?;
+    let mut robot = start;
+    let mut trail = vec![start];
+    let mut steps: Vec<Step> = Vec::new();
+    steps.push(plan_step(planner, robot, goal, &map, changed, blocked, false)?);
+    for (i, e) in scenario.events.iter().enumerate() {
+        let path = steps.last().map(|s| s.plan.raw.clone()).unwrap_or_default();
+        // The robot drives `at` of its path (its last cell is the goal: stop one short).
+        let to = ((e.at * (path.len().saturating_sub(1)) as f64).round() as usize)
+            .min(path.len().saturating_sub(2));
+        trail.extend(path.iter().skip(1).take(to));
+        robot = path.get(to).copied().unwrap_or(robot);
+        let cells = resolve(&e.change, &map, &path, to, goal)?;
+        let cells: Vec<Point> = cells.into_iter().filter(|&p| p != robot).collect();
+        for &p in &cells {
+            set_cell(&mut map, p, e.change.blocked)?;
+        }
+        planner
+            .change(&cells, e.change.blocked)
+            .map_err(|m| format!("event {i}: {m}"))?;
+        let step = plan_step(planner, robot, goal, &map, cells, e.change.blocked, warm)
+            .map_err(|m| format!("event {i}: {m}"))?;
+        steps.push(step);
+    }
+    if let Some(last) = steps.last() {
+        trail.extend(last.plan.raw.iter().skip(1));
+    }
+    Ok(Drive { steps, trail })
+}
+
+/// Plan from the robot's cell, check the plan and measure the optimum.
+fn plan_step(
+    planner: &mut dyn Planner,
+    robot: Point,
+    goal: Point,
+    map: &Map,
+    changed: Vec<Point>,
+    blocked: bool,
+    warm: bool,
+) -> Result<Step, String> {
+    let plan = planner.plan(robot, goal, warm)?;
+    check(map, robot, goal, &plan.raw)?;
+    Ok(Step {
+        robot,
+        changed,
+        blocked,
+        map: map.clone(),
+        optimum: shortest(map, robot, goal),
+        plan,
+    })
+}
+
+/// The cells of a change, given the robot's path and its position on it.
+fn resolve(
+    c: &Change,
+    map: &Map,
+    path: &[Point],
+    at: usize,
+    goal: Point,
+) -> Result<Vec<Point>, String> {
+    let on_map = |x: i64, y: i64| {
+        (x >= 0 && y >= 0 && x < i64::from(map.width) && y < i64::from(map.height))
+            .then(|| Point::new(x as u16, y as u16))
+    };
+    if let Some([x, y, w, h]) = c.rect {
+        let mut out = Vec::new();
+        for yy in u32::from(y)..u32::from(y) + u32::from(h) {
+            for xx in u32::from(x)..u32::from(x) + u32::from(w) {
+                out.push(
+                    on_map(i64::from(xx), i64::from(yy))
+                        .ok_or_else(|| format!("rect cell ({xx}, {yy}) is outside the map"))?,
+                );
+            }
+        }
+        return Ok(out);
+    }
+    if let Some(cells) = &c.cells {
+        return cells
+            .iter()
+            .map(|&[x, y]| {
+                on_map(i64::from(x), i64::from(y))
+                    .ok_or_else(|| format!("cell ({x}, {y}) is outside the map"))
+            })
+            .collect();
+    }
+    let Some(w) = c.wall_ahead else {
+        return Ok(Vec::new());
+    };
+    if path.len() < 3 {
+        return Err("wall_ahead: the robot's path is too short".into());
+    }
+    // The wall's centre stays off the goal (the path's last cell) and has a next cell.
+    let centre = (at + usize::from(w.ahead)).min(path.len() - 2).max(at + 1);
+    let (Some(&c0), Some(&c1)) = (path.get(centre), path.get(centre + 1)) else {
+        return Err("wall_ahead: no path cell there".into());
+    };
+    let (dx, dy) = (
+        i64::from(c1.x) - i64::from(c0.x),
+        i64::from(c1.y) - i64::from(c0.y),
+    );
+    // Across the path: the direction turned by 90 degrees.
+    let (px, py) = (-dy, dx);
+    let n = i64::from(w.cells);
+    let mut out = Vec::new();
+    for k in -(n / 2)..(n - n / 2) {
+        if let Some(p) = on_map(i64::from(c0.x) + k * px, i64::from(c0.y) + k * py) {
+            if p != goal && p != path.get(at).copied().unwrap_or(goal) {
+                out.push(p);
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// Check that `raw` goes from `start` to `goal` by allowed moves on `map`.
+pub fn check(map: &Map, start: Point, goal: Point, raw: &[Point]) -> Result<(), String> {
+    let grid = map.grid().map_err(|e| e.to_string())?;
+    if raw.first() != Some(&start) || raw.last() != Some(&goal) {
+        return Err("the path does not join start and goal".into());
+    }
+    for w in raw.windows(2) {
+        let (a, b) = (w[0], w[1]);
+        let ok = (0..8u8).any(|d| grid.step(a, d) == Some(b));
+        if !ok {
+            return Err(format!(
+                "step ({}, {}) -> ({}, {}) is not an allowed move",
+                a.x, a.y, b.x, b.y
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Exact shortest 8-connected path length (no corner cutting) from `start` to `goal`, by
+/// Dijkstra; `None` if unreachable.
+pub fn shortest(map: &Map, start: Point, goal: Point) -> Option<f64> {
+    let grid: Grid<'_> = map.grid().ok()?;
+    let mut dist = vec![f64::INFINITY; grid.cells()];
+    #[derive(PartialEq)]
+    struct Item(f64, usize);
+    impl Eq for Item {}
+    impl PartialOrd for Item {
+        fn partial_cmp(&self, o: &Self) -> Option<std::cmp::Ordering> {
+            Some(self.cmp(o))
+        }
+    }
+    impl Ord for Item {
+        fn cmp(&self, o: &Self) -> std::cmp::Ordering {
+            o.0.total_cmp(&self.0)
+        }
+    }
+    let mut heap = BinaryHeap::new();
+    *dist.get_mut(grid.index(start))? = 0.0;
+    heap.push(Item(0.0, grid.index(start)));
+    let goal_i = grid.index(goal);
+    while let Some(Item(d, i)) = heap.pop() {
+        if i == goal_i {
+            return Some(d);
+        }
+        if d > dist.get(i).copied().unwrap_or(0.0) {
+            continue;
+        }
+        let p = grid.point(i);
+        for dir in 0..8u8 {
+            if let Some(q) = grid.step(p, dir) {
+                let nd = d + if dir & 1 == 1 {
+                    std::f64::consts::SQRT_2
+                } else {
+                    1.0
+                };
+                let qi = grid.index(q);
+                if let Some(slot) = dist.get_mut(qi) {
+                    if nd < *slot {
+                        *slot = nd;
+                        heap.push(Item(nd, qi));
+                    }
+                }
+            }
+        }
+    }
+    None
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn open(w: u16, h: u16) -> Map {
+        Map::from_fn(w, h, |_, _| false)
+    }
+
+    #[test]
+    fn a_wall_ahead_makes_the_robot_replan_around_it() {
+        let map = open(24, 24);
+        let sc = Scenario::parse(
+            r#"{"start":[1,12],"goal":[22,12],
+                "events":[{"at":0.3,"wall_ahead":{"cells":7,"ahead":4}}]}"#,
+        )
+        .unwrap();
+        for warm in [false, true] {
+            let mut p = HostPlanner::new(Params::default());
+            let d = drive(&sc, &map, &mut p, warm).unwrap();
+            assert_eq!(d.steps.len(), 2);
+            let s = &d.steps[1];
+            assert_eq!(s.changed.len(), 7);
+            assert!(s.changed.iter().all(|&c| s.map.is_blocked(c)));
+            // The replan saw the wall: it is valid on the changed map and no ant crossed it.
+            check(&s.map, s.robot, Point::new(22, 12), &s.plan.raw).unwrap();
+            assert_eq!(s.plan.warm, warm);
+            assert!(s.optimum.unwrap() > f64::from(22 - s.robot.x));
+            assert_eq!(d.trail.first(), Some(&Point::new(1, 12)));
+            assert_eq!(d.trail.last(), Some(&Point::new(22, 12)));
+        }
+    }
+
+    #[test]
+    fn warm_and_cold_replans_differ_only_after_the_change() {
+        let map = open(20, 20);
+        let sc = Scenario::parse(
+            r#"{"start":[0,0],"goal":[19,19],"initial":[{"rect":[5,5,6,6]}],
+                "events":[{"at":0.4,"rect":[5,5,6,6],"blocked":false}]}"#,
+        )
+        .unwrap();
+        let cold = drive(&sc, &map, &mut HostPlanner::new(Params::default()), false).unwrap();
+        let warm = drive(&sc, &map, &mut HostPlanner::new(Params::default()), true).unwrap();
+        assert_eq!(cold.steps[0].plan, warm.steps[0].plan);
+        assert!(!cold.steps[1].plan.warm && warm.steps[1].plan.warm);
+        assert_eq!(cold.steps[1].changed.len(), 36);
+        assert!(!cold.steps[1].blocked);
+    }
+
+    #[test]
+    fn bad_scenarios_are_refused() {
+        assert!(Scenario::parse(r#"{"start":[0,0],"goal":[1,1],"events":[{"at":2,"rect":[0,0,1,1]}]}"#).is_err());
+        assert!(Scenario::parse(r#"{"start":[0,0],"goal":[1,1],"events":[{"at":0.5}]}"#).is_err());
+        assert!(Scenario::parse(r#"{"start":[0,0],"goal":[1,1],"oops":1}"#).is_err());
+        let sc = Scenario::parse(r#"{"start":[0,0],"goal":[3,0],"initial":[{"rect":[2,0,9,1]}]}"#).unwrap();
+        assert!(drive(&sc, &open(4, 1), &mut HostPlanner::new(Params::default()), true).is_err());
+    }
+
+    #[test]
+    fn shortest_is_octile_on_an_open_map() {
+        let d = shortest(&open(10, 10), Point::new(0, 0), Point::new(9, 4)).unwrap();
+        assert!((d - (5.0 + 4.0 * std::f64::consts::SQRT_2)).abs() < 1e-9);
+        let wall = Map::from_fn(5, 5, |x, _| x == 2);
+        assert_eq!(shortest(&wall, Point::new(0, 0), Point::new(4, 4)), None);
+    }
+}

@@ -1,0 +1,242 @@
+//! Warm starts: replanning to the same goal after the map changed, on the colony that the previous
+//! plan left in the workspace.
+//!
+//! A robot replans when a person steps into its path or a door opens. A cold plan forgets what the
+//! colony learnt; a warm one keeps its pheromone, which still marks the good corridors towards the
+//! goal on most of the map, and repairs it only where the map changed:
+//!
+//! | colony state | on a warm start |
+//! | --- | --- |
+//! | pheromone, away from the changes | kept, clamped into the current `[tau_min, tau_max]` |
+//! | pheromone within [`REPAIR_RADIUS`] cells of a change | set back to `tau0`, as in a cold start |
+//! | pheromone on edges into new obstacles | kept: ants are never offered a blocked move, so it is inert |
+//! | reachability, pruned cells, the coarse route | rebuilt from scratch: they depend on the start, which moved |
+//! | the early stop | after [`Params::warm_patience`] stale iterations instead of [`Params::patience`] |
+//!
+//! The local reset is Guntsch and Middendorf's "tau-strategy" for dynamic ant colony problems
+//! ("Pheromone modification strategies for ant algorithms applied to dynamic TSP", 2001): forget
+//! near the change, keep far from it. Without it, a colony whose trail leads into a new wall keeps
+//! pushing its ants at the wall, and a newly opened gap beside the trail stays at `tau_min` (the
+//! colony's memory says "nothing good here") where a cold colony would have tried it. With it, the
+//! ants explore around the change as a fresh colony would, and follow the old trail everywhere
+//! else.
+//!
+//! [`Memory`] is the bookkeeping: which map size and goal the workspace's pheromone belongs to and
+//! the bounding box of the cells changed since. The caller keeps one beside the storage, reports
+//! map changes to it and passes it to [`super::Run::warm`]; a warm start whose memory does not
+//! match (another goal, another map, no previous run) is a cold start. Host and device use the same
+//! code, so a sequence of warm plans gives the same paths on both.
+
+use crate::grid::Point;
+use crate::pheromone::Table;
+
+/// Pheromone within this many cells (Chebyshev distance) of a changed cell is reset to `tau0` on
+/// a warm start. Chosen by measurement (`BENCHMARKS.md`, replanning): a wall across the path needs
+/// the ants to leave the old trail a few cells before it, and a gap beside the trail must be
+/// reachable from the trail's reset part.
+pub const REPAIR_RADIUS: u16 = 6;
+
+/// A rectangle of cells, corners included.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Area {
+    /// Top-left corner.
+    pub min: Point,
+    /// Bottom-right corner (`>= min` on both axes).
+    pub max: Point,
+}
+
+impl Area {
+    /// The single cell `p`.
+    pub const fn cell(p: Point) -> Self {
+        Area { min: p, max: p }
+    }
+
+    /// The `width x height` cells from `(x, y)` (clamped at the coordinate range); `None` when a
+    /// side is zero.
+    pub fn rect(x: u16, y: u16, width: u16, height: u16) -> Option<Self> {
+        if width == 0 || height == 0 {
+            return None;
+        }
+        Some(Area {
+            min: Point::new(x, y),
+            // width >= 1, so `width - 1` does not wrap.
+            max: Point::new(
+                x.saturating_add(width.wrapping_sub(1)),
+                y.saturating_add(height.wrapping_sub(1)),
+            ),
+        })
+    }
+
+    /// The smallest area holding both.
+    pub fn union(self, o: Area) -> Area {
+        Area {
+            min: Point::new(self.min.x.min(o.min.x), self.min.y.min(o.min.y)),
+            max: Point::new(self.max.x.max(o.max.x), self.max.y.max(o.max.y)),
+        }
+    }
+
+    /// True if `p` lies inside.
+    pub fn contains(&self, p: Point) -> bool {
+        (self.min.x..=self.max.x).contains(&p.x) && (self.min.y..=self.max.y).contains(&p.y)
+    }
+
+    /// This area grown by `r` cells on every side (clamped at the coordinate range).
+    pub fn grown(self, r: u16) -> Area {
+        Area {
+            min: Point::new(self.min.x.saturating_sub(r), self.min.y.saturating_sub(r)),
+            max: Point::new(self.max.x.saturating_add(r), self.max.y.saturating_add(r)),
+        }
+    }
+}
+
+/// What the pheromone in a workspace belongs to, and the map changes since. See the module docs.
+///
+/// ```
+/// use ohaca::grid::Point;
+/// use ohaca::planner::{Area, Memory};
+/// let mut memory = Memory::new();
+/// assert!(!memory.is_warm_for(64, 64, Point::new(60, 60))); // nothing planned yet
+/// memory.planned(64, 64, Point::new(60, 60));
+/// memory.changed(Area::cell(Point::new(10, 12)));
+/// assert!(memory.is_warm_for(64, 64, Point::new(60, 60)));
+/// assert!(!memory.is_warm_for(64, 64, Point::new(1, 1))); // another goal: cold
+/// assert_eq!(memory.changes(), Some(Area::cell(Point::new(10, 12))));
+/// memory.forget(); // a new map
+/// assert!(!memory.is_warm_for(64, 64, Point::new(60, 60)));
+/// ```
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Memory {
+    /// Map width, height and goal of the last run that set the pheromone.
+    owner: Option<(u16, u16, Point)>,
+    /// Bounding box of every cell changed since that run started.
+    changes: Option<Area>,
+}
+
+impl Memory {
+    /// No colony yet: the next run is cold.
+    pub const fn new() -> Self {
+        Memory {
+            owner: None,
+            changes: None,
+        }
+    }
+
+    /// The map was replaced (or the pheromone overwritten some other way): the next run is cold.
+    pub fn forget(&mut self) {
+        *self = Memory::new();
+    }
+
+    /// Cells in `area` changed (blocked or cleared).
+    pub fn changed(&mut self, area: Area) {
+        self.changes = Some(match self.changes {
+            Some(a) => a.union(area),
+            None => area,
+        });
+    }
+
+    /// A run on a `width x height` map to `goal` set the pheromone (called by
+    /// [`super::Run::warm`]; no changes since).
+    pub fn planned(&mut self, width: u16, height: u16, goal: Point) {
+        self.owner = Some((width, height, goal));
+        self.changes = None;
+    }
+
+    /// True if a run on a `width x height` map to `goal` can start warm.
+    pub fn is_warm_for(&self, width: u16, height: u16, goal: Point) -> bool {
+        self.owner == Some((width, height, goal))
+    }
+
+    /// Bounding box of the cells changed since the last run, if any.
+    pub fn changes(&self) -> Option<Area> {
+        self.changes
+    }
+}
+
+/// Prepare a kept pheromone table for a warm start: clamp every entry into `[tau_min, tau_max]`
+/// (the bounds may have changed since), then set every entry of an edge with an end within
+/// [`REPAIR_RADIUS`] cells of `changes` to `tau0`. Returns the entries reset.
+pub(super) fn repair(
+    tau: &mut Table<'_>,
+    changes: Option<Area>,
+    tau0: f32,
+    tau_min: f32,
+    tau_max: f32,
+) -> u32 {
+    tau.clamp(tau_min, tau_max);
+    let Some(area) = changes else { return 0 };
+    // An edge belongs to the entry of its west/north end ([`crate::pheromone`]), so growing the
+    // area by one more cell reaches the entries of edges that enter it from the west or north.
+    let area = area.grown(REPAIR_RADIUS.saturating_add(1));
+    tau.fill_area(area.min, area.max, tau0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::pheromone::Blocks;
+
+    #[test]
+    fn areas_grow_and_join() {
+        let a = Area::rect(2, 3, 4, 1).unwrap();
+        assert_eq!(a.max, Point::new(5, 3));
+        assert!(a.contains(Point::new(5, 3)) && !a.contains(Point::new(6, 3)));
+        assert_eq!(Area::rect(1, 1, 0, 5), None);
+        let u = a.union(Area::cell(Point::new(0, 9)));
+        assert_eq!((u.min, u.max), (Point::new(0, 3), Point::new(5, 9)));
+        let g = Area::cell(Point::new(1, 65534)).grown(3);
+        assert_eq!((g.min, g.max), (Point::new(0, 65531), Point::new(4, 65535)));
+    }
+
+    #[test]
+    fn memory_matches_size_and_goal_only() {
+        let mut m = Memory::new();
+        let g = Point::new(3, 4);
+        assert!(!m.is_warm_for(8, 8, g));
+        m.planned(8, 8, g);
+        assert!(m.is_warm_for(8, 8, g));
+        assert!(!m.is_warm_for(8, 9, g));
+        assert!(!m.is_warm_for(8, 8, Point::new(4, 4)));
+        m.changed(Area::cell(Point::new(1, 1)));
+        m.changed(Area::cell(Point::new(5, 0)));
+        assert_eq!(m.changes(), Area::rect(1, 0, 5, 2));
+        m.planned(8, 8, g);
+        assert_eq!(m.changes(), None);
+    }
+
+    #[test]
+    fn repair_resets_near_the_change_and_clamps_elsewhere() {
+        // 64 x 64 cells: one entry a 2 x 2 block (32 x 32 = 1024 entries).
+        let blocks = Blocks::new(64, 64);
+        assert_eq!(blocks.shift(), 1);
+        let mut buf = [[50.0f32; 4]; 1024];
+        buf[0] = [500.0, 0.001, 7.0, 7.0];
+        let mut tau = Table::new(blocks, &mut buf);
+        let change = Area::cell(Point::new(40, 40));
+        let reset = repair(&mut tau, Some(change), 1.0, 0.01, 100.0);
+        let r = REPAIR_RADIUS + 1;
+        // Cells 40-r ..= 40+r on both axes, in 2 x 2 blocks.
+        let lo = (40 - r) / 2;
+        let hi = (40 + r) / 2;
+        let side = u32::from(hi - lo + 1);
+        assert_eq!(reset, side * side);
+        for by in 0..32u16 {
+            for bx in 0..32u16 {
+                let e = tau.entries()[usize::from(by) * 32 + usize::from(bx)];
+                let near = (lo..=hi).contains(&bx) && (lo..=hi).contains(&by);
+                let want = if near { [1.0; 4] } else if (bx, by) == (0, 0) {
+                    [100.0, 0.01, 7.0, 7.0]
+                } else {
+                    [50.0; 4]
+                };
+                assert_eq!(e, want, "block ({bx}, {by})");
+            }
+        }
+        // No changes: only the clamp.
+        let mut buf = [[500.0f32; 4]; 16];
+        let mut tau = Table::new(Blocks::new(4, 4), &mut buf);
+        assert_eq!(repair(&mut tau, None, 1.0, 0.01, 100.0), 0);
+        assert!(tau.entries().iter().all(|e| *e == [100.0; 4]));
+    }
+}
