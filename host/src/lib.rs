@@ -20,6 +20,7 @@
 //! | [`draw`] | pictures: the map with paths (and pheromone), the convergence chart; SVG or PNG |
 //! | [`experiment`] | the paper's experiments: many seeds per algorithm, CSV, summary, pictures |
 //! | [`link`] | the firmware link: a blocking protocol client over TCP or a serial port |
+//! | [`strip`] | pictures of a replanning drive: a PNG strip, an animated GIF |
 //! | [`replan`] | replanning scenarios: a robot driving while cells change, warm or cold replans on the core or a device |
 //!
 //! ## Panic freedom
@@ -56,6 +57,7 @@ pub mod map;
 pub mod output;
 pub mod plan_map;
 pub mod replan;
+pub mod strip;
 pub mod trace;
 
 pub use args::{parse_point, ParamArgs, Preset};

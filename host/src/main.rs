@@ -40,6 +40,8 @@ enum Command {
     Experiment(cmd::experiment::Args),
     /// Plan on the firmware over TCP (QEMU) or a serial port; prints what `plan` prints
     Send(cmd::send::Args),
+    /// Drive a robot through map changes and replan warm or cold (host core or a device)
+    Replan(cmd::replan::Args),
 }
 
 fn main() -> ExitCode {
@@ -52,6 +54,7 @@ fn main() -> ExitCode {
         Command::Render(args) => cmd::render::run(&args),
         Command::Experiment(args) => cmd::experiment::run(&args),
         Command::Send(args) => cmd::send::run(&args),
+        Command::Replan(args) => cmd::replan::run(&args),
     };
     ExitCode::from(code)
 }

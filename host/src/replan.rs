@@ -3,12 +3,11 @@
 //! `PlanWarm`) or cold. The same scenario drives the host core or a device over its link, so the
 //! two can be compared plan by plan.
 //!
-//! A scenario file is JSON:
+//! The robot's start and goal come with the map (`ohaca replan --map ... --start ... --goal ...`);
+//! what changes is a JSON file:
 //!
 //! ```json
 //! {
-//!   "start": [0, 0],
-//!   "goal": [25, 25],
 //!   "initial": [ { "rect": [10, 10, 3, 1], "blocked": true } ],
 //!   "events": [
 //!     { "at": 0.33, "wall_ahead": { "cells": 5, "ahead": 6 } },
@@ -38,14 +37,10 @@ use ohaca::{Grid, Params, Point};
 use crate::link::{DevicePath, Link, LinkError, Transport};
 use crate::map::Map;
 
-/// A replanning scenario (see the module docs for the file format).
+/// What changes in a replanning scenario (see the module docs for the file format).
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Scenario {
-    /// The robot's first cell.
-    pub start: [u16; 2],
-    /// The goal cell (the same for every plan).
-    pub goal: [u16; 2],
     /// Changes before the first plan.
     #[serde(default)]
     pub initial: Vec<Change>,
@@ -305,16 +300,16 @@ pub struct Drive {
     pub trail: Vec<Point>,
 }
 
-/// Run `scenario` on `map` with `planner`; replans are warm when `warm`. The map is uploaded first.
+/// Run `scenario` on `map` from `start` to `goal` with `planner`; replans are warm when `warm`.
+/// The map (with the initial changes) is uploaded first.
 pub fn drive(
     scenario: &Scenario,
     map: &Map,
+    (start, goal): (Point, Point),
     planner: &mut dyn Planner,
     warm: bool,
 ) -> Result<Drive, String> {
     let mut map = map.clone();
-    let start = Point::new(scenario.start[0], scenario.start[1]);
-    let goal = Point::new(scenario.goal[0], scenario.goal[1]);
     let mut changed = Vec::new();
     let mut blocked = true;
     for c in &scenario.initial {
@@ -520,13 +515,13 @@ mod tests {
     fn a_wall_ahead_makes_the_robot_replan_around_it() {
         let map = open(24, 24);
         let sc = Scenario::parse(
-            r#"{"start":[1,12],"goal":[22,12],
-                "events":[{"at":0.3,"wall_ahead":{"cells":7,"ahead":4}}]}"#,
+            r#"{"events":[{"at":0.3,"wall_ahead":{"cells":7,"ahead":4}}]}"#,
         )
         .unwrap();
         for warm in [false, true] {
             let mut p = HostPlanner::new(Params::default());
-            let d = drive(&sc, &map, &mut p, warm).unwrap();
+            let ends = (Point::new(1, 12), Point::new(22, 12));
+            let d = drive(&sc, &map, ends, &mut p, warm).unwrap();
             assert_eq!(d.steps.len(), 2);
             let s = &d.steps[1];
             assert_eq!(s.changed.len(), 7);
@@ -544,12 +539,14 @@ mod tests {
     fn warm_and_cold_replans_differ_only_after_the_change() {
         let map = open(20, 20);
         let sc = Scenario::parse(
-            r#"{"start":[0,0],"goal":[19,19],"initial":[{"rect":[5,5,6,6]}],
+            r#"{"initial":[{"rect":[5,5,6,6]}],
                 "events":[{"at":0.4,"rect":[5,5,6,6],"blocked":false}]}"#,
         )
         .unwrap();
-        let cold = drive(&sc, &map, &mut HostPlanner::new(Params::default()), false).unwrap();
-        let warm = drive(&sc, &map, &mut HostPlanner::new(Params::default()), true).unwrap();
+        let ends = (Point::new(0, 0), Point::new(19, 19));
+        let mut host = || HostPlanner::new(Params::default());
+        let cold = drive(&sc, &map, ends, &mut host(), false).unwrap();
+        let warm = drive(&sc, &map, ends, &mut host(), true).unwrap();
         assert_eq!(cold.steps[0].plan, warm.steps[0].plan);
         assert!(!cold.steps[1].plan.warm && warm.steps[1].plan.warm);
         assert_eq!(cold.steps[1].changed.len(), 36);
@@ -558,11 +555,13 @@ mod tests {
 
     #[test]
     fn bad_scenarios_are_refused() {
-        assert!(Scenario::parse(r#"{"start":[0,0],"goal":[1,1],"events":[{"at":2,"rect":[0,0,1,1]}]}"#).is_err());
-        assert!(Scenario::parse(r#"{"start":[0,0],"goal":[1,1],"events":[{"at":0.5}]}"#).is_err());
-        assert!(Scenario::parse(r#"{"start":[0,0],"goal":[1,1],"oops":1}"#).is_err());
-        let sc = Scenario::parse(r#"{"start":[0,0],"goal":[3,0],"initial":[{"rect":[2,0,9,1]}]}"#).unwrap();
-        assert!(drive(&sc, &open(4, 1), &mut HostPlanner::new(Params::default()), true).is_err());
+        assert!(Scenario::parse(r#"{"events":[{"at":2,"rect":[0,0,1,1]}]}"#).is_err());
+        assert!(Scenario::parse(r#"{"events":[{"at":0.5}]}"#).is_err());
+        assert!(Scenario::parse(r#"{"oops":1}"#).is_err());
+        let sc = Scenario::parse(r#"{"initial":[{"rect":[2,0,9,1]}]}"#).unwrap();
+        let ends = (Point::new(0, 0), Point::new(3, 0));
+        let mut host = HostPlanner::new(Params::default());
+        assert!(drive(&sc, &open(4, 1), ends, &mut host, true).is_err());
     }
 
     #[test]

@@ -3,6 +3,7 @@
 pub mod experiment;
 pub mod plan;
 pub mod render;
+pub mod replan;
 pub mod send;
 
 use std::io::Write;

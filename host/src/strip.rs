@@ -1,0 +1,206 @@
+//! Pictures of a replanning drive ([`crate::replan::Drive`]): a strip of PNG panels, one per plan,
+//! and an animated GIF of the robot driving.
+//!
+//! Colours: free cells white, obstacles dark grey, cells blocked by a change red, cells cleared
+//! by one green; the robot's trail blue, the plan it follows orange (raw path light, smoothed
+//! waypoints dark), the plan it dropped light grey; the robot a blue square, the goal a black one.
+
+use std::path::Path;
+
+use image::codecs::gif::{GifEncoder, Repeat};
+use image::{Delay, Frame, Rgb, RgbImage, RgbaImage};
+
+use crate::map::Map;
+use crate::replan::Drive;
+use ohaca::Point;
+
+const FREE: Rgb<u8> = Rgb([255, 255, 255]);
+const WALL: Rgb<u8> = Rgb([60, 60, 60]);
+const ADDED: Rgb<u8> = Rgb([220, 30, 30]);
+const CLEARED: Rgb<u8> = Rgb([40, 180, 60]);
+const TRAIL: Rgb<u8> = Rgb([30, 90, 220]);
+const RAW: Rgb<u8> = Rgb([250, 190, 120]);
+const SMOOTH: Rgb<u8> = Rgb([230, 110, 0]);
+const OLD: Rgb<u8> = Rgb([190, 190, 190]);
+const GOAL: Rgb<u8> = Rgb([0, 0, 0]);
+const GAP: u32 = 8;
+
+/// Pixels per cell: the map fills about 512 pixels on its longer side.
+fn scale(map: &Map) -> u32 {
+    (512 / u32::from(map.width.max(map.height)).max(1)).clamp(1, 24)
+}
+
+struct Canvas {
+    img: RgbImage,
+    s: u32,
+    x0: u32,
+}
+
+impl Canvas {
+    fn cell(&mut self, p: Point, c: Rgb<u8>) {
+        for dy in 0..self.s {
+            for dx in 0..self.s {
+                let (x, y) = (self.x0 + u32::from(p.x) * self.s + dx, u32::from(p.y) * self.s + dy);
+                if x < self.img.width() && y < self.img.height() {
+                    self.img.put_pixel(x, y, c);
+                }
+            }
+        }
+    }
+
+    /// A dot of `r` pixels around the centre of cell `p`.
+    fn dot(&mut self, p: Point, r: i64, c: Rgb<u8>) {
+        let (cx, cy) = self.centre(p);
+        for y in cy - r..=cy + r {
+            for x in cx - r..=cx + r {
+                self.pixel(x, y, c);
+            }
+        }
+    }
+
+    fn centre(&self, p: Point) -> (i64, i64) {
+        let s = i64::from(self.s);
+        (
+            i64::from(self.x0) + i64::from(p.x) * s + s / 2,
+            i64::from(p.y) * s + s / 2,
+        )
+    }
+
+    fn pixel(&mut self, x: i64, y: i64, c: Rgb<u8>) {
+        if x >= i64::from(self.x0) && y >= 0 {
+            let (x, y) = (x as u32, y as u32);
+            if x < self.img.width() && y < self.img.height() {
+                self.img.put_pixel(x, y, c);
+            }
+        }
+    }
+
+    /// A polyline through cell centres, `w` pixels wide.
+    fn line(&mut self, pts: &[Point], w: i64, c: Rgb<u8>) {
+        for seg in pts.windows(2) {
+            let (a, b) = (self.centre(seg[0]), self.centre(seg[1]));
+            let n = (b.0 - a.0).abs().max((b.1 - a.1).abs()).max(1);
+            for i in 0..=n {
+                let x = a.0 + (b.0 - a.0) * i / n;
+                let y = a.1 + (b.1 - a.1) * i / n;
+                for oy in -(w / 2)..=(w - 1) / 2 {
+                    for ox in -(w / 2)..=(w - 1) / 2 {
+                        self.pixel(x + ox, y + oy, c);
+                    }
+                }
+            }
+        }
+    }
+
+    fn map(&mut self, map: &Map) {
+        for y in 0..map.height {
+            for x in 0..map.width {
+                let p = Point::new(x, y);
+                self.cell(p, if map.is_blocked(p) { WALL } else { FREE });
+            }
+        }
+    }
+}
+
+/// Where the robot is on the drive's trail at each plan (the trail index it planned from).
+fn plan_positions(drive: &Drive) -> Vec<usize> {
+    let mut at = Vec::with_capacity(drive.steps.len());
+    let mut i = 0usize;
+    for s in &drive.steps {
+        while drive.trail.get(i).is_some_and(|&p| p != s.robot) {
+            i += 1;
+        }
+        at.push(i.min(drive.trail.len().saturating_sub(1)));
+    }
+    at
+}
+
+/// Draw the picture of the drive at trail index `t` (plan `k` active) onto `c`.
+fn scene(c: &mut Canvas, drive: &Drive, at: &[usize], k: usize, t: usize, goal: Point) {
+    let Some(step) = drive.steps.get(k) else {
+        return;
+    };
+    c.map(&step.map);
+    let w = i64::from((c.s / 3).max(1));
+    for s in drive.steps.iter().take(k + 1) {
+        for &p in &s.changed {
+            c.cell(p, if s.blocked { ADDED } else { CLEARED });
+        }
+    }
+    if t == at[k] && k > 0 {
+        // The moment of the replan: the plan it drops.
+        if let Some(prev) = drive.steps.get(k - 1) {
+            let from = t - at[k - 1];
+            c.line(prev.plan.raw.get(from..).unwrap_or(&[]), w, OLD);
+        }
+    }
+    let from = t - at[k];
+    c.line(step.plan.raw.get(from..).unwrap_or(&[]), w, RAW);
+    if from == 0 {
+        c.line(&step.plan.waypoints, w + 1, SMOOTH);
+    }
+    c.line(drive.trail.get(..=t).unwrap_or(&[]), w + 1, TRAIL);
+    let r = i64::from((c.s / 2).max(2));
+    c.dot(goal, r, GOAL);
+    if let Some(&p) = drive.trail.get(t) {
+        c.dot(p, r, TRAIL);
+    }
+}
+
+/// A strip of panels, one per plan, at the moment the robot planned it.
+pub fn strip(drive: &Drive, goal: Point) -> Result<RgbImage, String> {
+    let first = drive.steps.first().ok_or("no plans to draw")?;
+    let s = scale(&first.map);
+    let (pw, ph) = (u32::from(first.map.width) * s, u32::from(first.map.height) * s);
+    let n = drive.steps.len() as u32;
+    let mut c = Canvas {
+        img: RgbImage::from_pixel(n * pw + (n - 1) * GAP, ph, Rgb([255, 255, 255])),
+        s,
+        x0: 0,
+    };
+    let at = plan_positions(drive);
+    for k in 0..drive.steps.len() {
+        c.x0 = k as u32 * (pw + GAP);
+        scene(&mut c, drive, &at, k, at[k], goal);
+    }
+    Ok(c.img)
+}
+
+/// Save [`strip`] as a PNG.
+pub fn save_strip(drive: &Drive, goal: Point, path: &Path) -> Result<(), String> {
+    strip(drive, goal)?
+        .save(path)
+        .map_err(|e| format!("{}: {e}", path.display()))
+}
+
+/// An animated GIF of the robot driving: about 60 frames, a pause at every replan.
+pub fn save_gif(drive: &Drive, goal: Point, path: &Path) -> Result<(), String> {
+    let first = drive.steps.first().ok_or("no plans to draw")?;
+    let s = scale(&first.map).min(4);
+    let (pw, ph) = (u32::from(first.map.width) * s, u32::from(first.map.height) * s);
+    let at = plan_positions(drive);
+    let stride = (drive.trail.len() / 60).max(1);
+    let mut times: Vec<usize> = (0..drive.trail.len()).step_by(stride).collect();
+    times.extend(at.iter().copied());
+    times.push(drive.trail.len().saturating_sub(1));
+    times.sort_unstable();
+    times.dedup();
+    let file = std::fs::File::create(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let mut enc = GifEncoder::new_with_speed(std::io::BufWriter::new(file), 20);
+    enc.set_repeat(Repeat::Infinite)
+        .map_err(|e| e.to_string())?;
+    for &t in &times {
+        let k = at.iter().rposition(|&a| a <= t).unwrap_or(0);
+        let mut c = Canvas {
+            img: RgbImage::from_pixel(pw, ph, FREE),
+            s,
+            x0: 0,
+        };
+        scene(&mut c, drive, &at, k, t, goal);
+        let pause = if at.contains(&t) || t + 1 == drive.trail.len() { 900 } else { 80 };
+        let rgba: RgbaImage = image::DynamicImage::ImageRgb8(c.img).to_rgba8();
+        enc.encode_frame(Frame::from_parts(rgba, 0, 0, Delay::from_numer_denom_ms(pause, 1)))
+            .map_err(|e| e.to_string())?;
+    }
+    Ok(())
+}
