@@ -144,7 +144,7 @@ impl Params {
         tau_min: 0.01,
         tau_max: 100.0,
         patience: 10,
-        warm_patience: 3,
+        warm_patience: 2,
         seed: 1,
         dead_end: DeadEnd::Backtrack,
         smoothing: SmoothingKind::Shortest,

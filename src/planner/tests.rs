@@ -190,3 +190,119 @@ fn deterministic_per_seed() {
         assert_eq!(run(7, alg), run(7, alg));
     }
 }
+
+/// Run to the end; the plan's raw path and the final pheromone.
+fn run_to_end(run: Run<'_, '_>) -> (Vec<Point>, bool, u16) {
+    let mut run = run;
+    while run.step() {}
+    let p = run.finish().unwrap();
+    (p.raw().collect(), p.warm, p.iterations)
+}
+
+#[test]
+fn a_warm_start_without_memory_is_the_cold_plan() {
+    let (b, w, h) = grid(&ROWS);
+    let g = Grid::new(w, h, &b).unwrap();
+    let (s, goal) = (Point::new(0, 0), Point::new(7, 5));
+    let p = Params::default();
+    let mut st: S64 = Storage::new();
+    let cold = run_to_end(Run::new(&g, s, goal, &p, st.workspace()).unwrap());
+    let cold_tau = st.workspace().pheromone().to_vec();
+    let mut st: S64 = Storage::new();
+    let mut memory = Memory::new();
+    let warm = run_to_end(Run::warm(&g, s, goal, &p, st.workspace(), &mut memory).unwrap());
+    assert_eq!(cold, warm);
+    assert!(!warm.1);
+    assert_eq!(st.workspace().pheromone(), &cold_tau[..]);
+    assert!(memory.is_warm_for(w, h, goal));
+}
+
+#[test]
+fn a_warm_start_keeps_the_pheromone_away_from_changes_and_resets_it_near_them() {
+    // 32 x 32 open map: one pheromone entry per cell.
+    let rows: Vec<String> = (0..32).map(|_| ".".repeat(32)).collect();
+    let rows: Vec<&str> = rows.iter().map(String::as_str).collect();
+    let (mut bits, w, h) = grid(&rows);
+    let goal = Point::new(31, 31);
+    let p = Params::default();
+    let mut st: Storage<{ crate::bitmap::words(1024) }, 1024, 2048, 1024> = Storage::new();
+    let mut memory = Memory::new();
+    {
+        let g = Grid::new(w, h, &bits).unwrap();
+        run_to_end(Run::warm(&g, Point::new(0, 0), goal, &p, st.workspace(), &mut memory).unwrap());
+    }
+    let before = st.workspace().pheromone().to_vec();
+    // Block (20, 3): entries within REPAIR_RADIUS + 1 of it go back to tau0, the rest stay.
+    let c = Point::new(20, 3);
+    let i = usize::from(c.y) * 32 + usize::from(c.x);
+    bits[i / 8] |= 1 << (i % 8);
+    memory.changed(Area::cell(c));
+    let g = Grid::new(w, h, &bits).unwrap();
+    let run = Run::warm(&g, Point::new(5, 5), goal, &p, st.workspace(), &mut memory).unwrap();
+    assert!(run.is_warm());
+    drop(run);
+    let after = st.workspace().pheromone().to_vec();
+    let r = i32::from(REPAIR_RADIUS) + 1;
+    let mut kept = 0;
+    for (k, (a, b)) in after.iter().zip(&before).enumerate() {
+        let (x, y) = ((k % 32) as i32, (k / 32) as i32);
+        let near = (x - 20).abs() <= r && (y - 3).abs() <= r;
+        if near {
+            assert_eq!(*a, [p.tau0; 4], "entry ({x}, {y})");
+        } else {
+            assert_eq!(a, b, "entry ({x}, {y})");
+            kept += usize::from(*a != [p.tau0; 4]);
+        }
+    }
+    // The previous run left a trail: most of what was kept is not tau0.
+    assert!(kept > 500, "{kept}");
+    assert_eq!(memory.changes(), None);
+}
+
+#[test]
+fn warm_runs_stop_after_the_warm_patience_and_stay_valid() {
+    let (b, w, h) = grid(&ROWS);
+    let g = Grid::new(w, h, &b).unwrap();
+    let goal = Point::new(7, 5);
+    for warm_patience in [1u16, 2, 5] {
+        let p = Params {
+            warm_patience,
+            ..Params::default()
+        };
+        let mut st: S64 = Storage::new();
+        let mut memory = Memory::new();
+        let first = Run::warm(&g, Point::new(0, 0), goal, &p, st.workspace(), &mut memory).unwrap();
+        let (_, warm, _) = run_to_end(first);
+        assert!(!warm);
+        let mut run = Run::warm(&g, Point::new(0, 5), goal, &p, st.workspace(), &mut memory).unwrap();
+        assert!(run.is_warm());
+        while run.step() {}
+        let best = run.best_iteration().unwrap();
+        let plan = run.finish().unwrap();
+        assert!(plan.warm);
+        assert_eq!(plan.iterations, best + warm_patience + 1);
+        assert_eq!(plan.raw().last(), Some(goal));
+        // Another goal: cold, with the cold patience.
+        let run = Run::warm(&g, Point::new(0, 5), Point::new(7, 0), &p, st.workspace(), &mut memory);
+        assert!(!run.unwrap().is_warm());
+    }
+}
+
+#[test]
+fn a_refused_warm_start_leaves_the_memory_alone() {
+    let (b, w, h) = grid(&ROWS);
+    let g = Grid::new(w, h, &b).unwrap();
+    let goal = Point::new(7, 5);
+    let p = Params::default();
+    let mut st: S64 = Storage::new();
+    let mut memory = Memory::new();
+    run_to_end(Run::warm(&g, Point::new(0, 0), goal, &p, st.workspace(), &mut memory).unwrap());
+    let before = st.workspace().pheromone().to_vec();
+    memory.changed(Area::cell(Point::new(3, 3)));
+    let kept = memory;
+    // The start is on an obstacle.
+    let e = Run::warm(&g, Point::new(1, 1), goal, &p, st.workspace(), &mut memory);
+    assert_eq!(e.err(), Some(Error::Blocked(Endpoint::Start)));
+    assert_eq!(memory, kept);
+    assert_eq!(st.workspace().pheromone(), &before[..]);
+}
