@@ -321,6 +321,7 @@ fn largest_messages_fit_their_limits() {
         ants: u16::MAX,
         iterations: u16::MAX,
         patience: u16::MAX,
+        warm_patience: u16::MAX,
         ..Params::default()
     };
     encode_request(u32::MAX, &Request::SetParams(p), &mut buf).unwrap();
@@ -936,6 +937,10 @@ fn params_fields(p: &Params) -> Vec<(String, Vec<u8>)> {
         (format!("  tau_min = {}", p.tau_min), ser(&p.tau_min)),
         (format!("  tau_max = {}", p.tau_max), ser(&p.tau_max)),
         (format!("  patience = {}", p.patience), ser(&p.patience)),
+        (
+            format!("  warm_patience = {}", p.warm_patience),
+            ser(&p.warm_patience),
+        ),
         (format!("  seed = {}", p.seed), ser(&p.seed)),
         (
             format!("  dead_end = {:?}", p.dead_end),
