@@ -193,17 +193,12 @@ impl Planner for HostPlanner {
 
     fn plan(&mut self, start: Point, goal: Point, warm: bool) -> Result<Planned, String> {
         let grid = self.map.grid().map_err(|e| e.to_string())?;
-        if !warm {
-            self.memory.forget();
+        let ws = self.storage.workspace();
+        let mut run = if warm {
+            Run::warm(&grid, start, goal, &self.params, ws, &mut self.memory)
+        } else {
+            Run::cold(&grid, start, goal, &self.params, ws, &mut self.memory)
         }
-        let mut run = Run::warm(
-            &grid,
-            start,
-            goal,
-            &self.params,
-            self.storage.workspace(),
-            &mut self.memory,
-        )
         .map_err(|e| e.to_string())?;
         while run.step() {}
         let plan = run.finish().map_err(|e| e.to_string())?;

@@ -67,21 +67,16 @@ async fn plan(
     let (width, height) = state::map_size().ok_or(ErrorReply::new(ErrorCode::NoMap))?;
     let grid = Grid::new(width, height, &map[..])?;
     let t0 = Instant::now();
-    // A cold plan forgets the colony; a warm one keeps it if it is for this map and goal. Both
-    // record theirs for the next `PlanWarm` (only once the run started: a refused plan leaves the
-    // pheromone as it was). The memory is read and written under the map's lock.
+    // A warm plan keeps the colony if it is for this map and goal; both kinds record theirs for
+    // the next `PlanWarm` once the run started (a refused plan leaves the pheromone as it was).
+    // The memory is read and written under the map's lock.
     let mut memory = state::colony();
-    if !job.warm {
-        memory.forget();
-    }
-    let mut run = Run::warm(
-        &grid,
-        job.start,
-        job.goal,
-        &job.params,
-        storage.workspace(),
-        &mut memory,
-    )?;
+    let (start, goal, params, ws) = (job.start, job.goal, &job.params, storage.workspace());
+    let mut run = if job.warm {
+        Run::warm(&grid, start, goal, params, ws, &mut memory)
+    } else {
+        Run::cold(&grid, start, goal, params, ws, &mut memory)
+    }?;
     state::set_colony(memory);
     if job.warm {
         defmt::info!("plan {}: warm start asked, warm {}", job.id, run.is_warm());

@@ -109,8 +109,32 @@ impl<'g, 'a> Run<'g, 'a> {
         ws: Workspace<'a>,
         memory: &mut Memory,
     ) -> Result<Self, Error> {
-        let warm = memory
-            .is_warm_for(grid.width(), grid.height(), goal)
+        Self::remembered(grid, (start, goal), params, ws, memory, true)
+    }
+
+    /// [`Run::new`] (a cold start, always) that records itself in `memory` on success, so a
+    /// later [`Run::warm`] to the same goal can keep its colony. On failure nothing changed.
+    pub fn cold(
+        grid: &'g Grid<'g>,
+        start: Point,
+        goal: Point,
+        params: &Params,
+        ws: Workspace<'a>,
+        memory: &mut Memory,
+    ) -> Result<Self, Error> {
+        Self::remembered(grid, (start, goal), params, ws, memory, false)
+    }
+
+    /// [`Run::warm`] (`warm`) or [`Run::cold`].
+    fn remembered(
+        grid: &'g Grid<'g>,
+        (start, goal): (Point, Point),
+        params: &Params,
+        ws: Workspace<'a>,
+        memory: &mut Memory,
+        warm: bool,
+    ) -> Result<Self, Error> {
+        let warm = (warm && memory.is_warm_for(grid.width(), grid.height(), goal))
             .then(|| memory.changes());
         let run = Self::prepare(grid, start, goal, params, ws, warm)?;
         memory.planned(grid.width(), grid.height(), goal);

@@ -215,6 +215,11 @@ fn a_warm_start_without_memory_is_the_cold_plan() {
     assert!(!warm.1);
     assert_eq!(st.workspace().pheromone(), &cold_tau[..]);
     assert!(memory.is_warm_for(w, h, goal));
+    // `Run::cold` never keeps the colony, and records its own.
+    let mut st: S64 = Storage::new();
+    let again = run_to_end(Run::cold(&g, s, goal, &p, st.workspace(), &mut memory).unwrap());
+    assert_eq!(again, cold);
+    assert!(memory.is_warm_for(w, h, goal));
 }
 
 #[test]
