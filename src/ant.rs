@@ -19,7 +19,7 @@
 
 use crate::bitmap;
 use crate::grid::{is_diagonal, neighbour, opposite, Dir, Moves, Point};
-use crate::heuristic::Heuristic;
+use crate::heuristic::{Attraction, Heuristic};
 use crate::pheromone::{slot_offsets, Table};
 use crate::rng::Xoshiro128pp;
 use crate::route::Route;
@@ -95,7 +95,7 @@ pub enum Lost {
 }
 
 /// Everything an ant reads; borrowed for one iteration.
-pub struct Colony<'g, 't, 'h> {
+pub struct Ant<'g, 't, 'h> {
     /// The map's allowed moves.
     pub moves: &'g Moves<'g>,
     /// Start cell.
@@ -130,7 +130,7 @@ fn pow_alpha(tau: f32, alpha: f32) -> f32 {
     }
 }
 
-impl Colony<'_, '_, '_> {
+impl Ant<'_, '_, '_> {
     /// Walk one ant. `tabu` is a bit set of at least `words(cells)` words (its content is
     /// replaced: it starts as the dead cells); `tour` receives the directions and bounds the path's
     /// length.
@@ -484,10 +484,10 @@ mod tests {
         let g = Grid::new(w, h, &b).unwrap();
         let mut tau_buf = vec![[1.0f32; 4]; g.cells()];
         let tau = Table::new(Blocks::new(w, h), &mut tau_buf);
-        let heur = Heuristic::new(goal, true, a, 1.0, 2.0);
+        let heur = Heuristic::new(goal, Some(Attraction { a, xi: 1.0 }), 2.0);
         let moves = Moves::new(g, &[]);
         let dead = vec![0u32; bitmap::words(g.cells())];
-        let c = Colony {
+        let c = Ant {
             moves: &moves,
             start,
             goal,

@@ -7,7 +7,7 @@
 //! prune the cells no shortest path needs                 (prune)
 //! tau = tau0 everywhere
 //! repeat `iterations` times (or until the best has not improved for `patience` iterations):
-//!     each of `ants` ants walks start -> goal            (colony)
+//!     each of `ants` ants walks start -> goal            (ant)
 //!     each ant that arrived deposits Q / L on its path    (update)
 //!     HACA/OHACA: reward the iteration's best, punish its worst (update, wolves rule)
 //!     tau = clamp((1 - rho) tau + deposits, tau_min, tau_max)

@@ -1,8 +1,9 @@
 //! The planner's parameters: which variant runs ([`Algorithm`]) and every tunable ([`Params`]),
 //! with their valid ranges ([`Params::validate`]).
 
-use crate::colony::DeadEnd;
+use crate::ant::DeadEnd;
 use crate::error::{Error, Param};
+use crate::heuristic::Attraction;
 use crate::smoothing::SmoothingKind;
 
 /// The four variants the paper compares.
@@ -111,7 +112,7 @@ pub struct Params {
     pub dead_end: DeadEnd,
     /// How OHACA smooths the result (the other variants never smooth).
     pub smoothing: SmoothingKind,
-    /// Straighten each ant's path before the pheromone update ([`crate::colony::tighten`]); not in
+    /// Straighten each ant's path before the pheromone update ([`crate::ant::tighten`]); not in
     /// the paper, off for faithful comparisons.
     pub tighten: bool,
     /// Prune the cells no shortest path needs before the ants run ([`crate::prune`]); not in the
@@ -162,6 +163,19 @@ impl Params {
             tighten: false,
             prune: false,
             ..Params::DEFAULT
+        }
+    }
+
+    /// The goal attraction of the heuristic: `a` and `xi` for the variants that attract
+    /// ([`Algorithm::attracts`]), `None` for plain ACA.
+    pub const fn attraction(&self) -> Option<Attraction> {
+        if self.algorithm.attracts() {
+            Some(Attraction {
+                a: self.a,
+                xi: self.xi,
+            })
+        } else {
+            None
         }
     }
 

@@ -1,6 +1,6 @@
 use super::frame::{cobs_decode_in_place, cobs_encode_in_place};
 use super::*;
-use crate::colony::DeadEnd;
+use crate::ant::DeadEnd;
 use crate::error::Param;
 use crate::planner::Algorithm;
 use crate::smoothing::SmoothingKind;
