@@ -19,7 +19,7 @@
 
 use crate::bitmap;
 use crate::grid::{is_diagonal, neighbour, opposite, Dir, Moves, Point};
-use crate::heuristic::{Attraction, Heuristic};
+use crate::heuristic::Heuristic;
 use crate::pheromone::{slot_offsets, Table};
 use crate::rng::Xoshiro128pp;
 use crate::route::Route;
@@ -455,6 +455,7 @@ impl<'a> PathIndex<'a> {
 mod tests {
     use super::*;
     use crate::grid::Grid;
+    use crate::heuristic::Attraction;
     use crate::pheromone::Blocks;
 
     fn setup(rows: &[&str]) -> (Vec<u8>, u16, u16) {
