@@ -26,6 +26,18 @@
 //! let n = encode_reply(7, &Reply::Ack, &mut buf).unwrap();
 //! assert_eq!(decode_reply(&mut buf[..n - 1]).unwrap(), (7, Reply::Ack));
 //! ```
+//!
+//! This module owns the limits and turning a message into a frame and back ([`encode_request`],
+//! [`decode_reply`], ...); the rest lives in one file a concept:
+//!
+//! | file | owns |
+//! | --- | --- |
+//! | `message` | [`Request`], [`Reply`] and the reply bodies |
+//! | `error_reply` | [`ErrorReply`], [`ErrorCode`] and their mapping to the planner's errors |
+//! | `frame` | CRC-32, COBS and the byte-at-a-time [`FrameReader`] |
+//! | `wire` | serde glue: points on the wire, the packed [`Waypoints`] |
+//! | `stream` | [`PathStream`]: a path reply encoded piece by piece |
+//! | `map` | map uploads (raw and run-length) and cell updates as the device applies them |
 
 use core::fmt;
 
