@@ -32,6 +32,8 @@ mod workspace;
 pub use params::{Algorithm, Params};
 pub use plan::{CurvePoint, Plan, RawPath};
 pub use run::Run;
+#[cfg(any(feature = "alloc", test))]
+pub(crate) use workspace::OwnedBuffers;
 pub use workspace::{Buffers, Storage, Workspace};
 
 use crate::error::Error;
