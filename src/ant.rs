@@ -20,6 +20,7 @@
 use crate::bitmap;
 use crate::grid::{is_diagonal, neighbour, opposite, Dir, Moves, Point};
 use crate::heuristic::Heuristic;
+use crate::named::named;
 use crate::pheromone::{slot_offsets, Table};
 use crate::rng::Xoshiro128pp;
 use crate::route::Route;
@@ -40,31 +41,7 @@ pub enum DeadEnd {
     Die,
 }
 
-impl DeadEnd {
-    /// Both, default first.
-    pub const ALL: [DeadEnd; 2] = [DeadEnd::Backtrack, DeadEnd::Die];
-
-    /// Lower-case name (`"backtrack"`, `"die"`).
-    pub const fn name(self) -> &'static str {
-        match self {
-            DeadEnd::Backtrack => "backtrack",
-            DeadEnd::Die => "die",
-        }
-    }
-
-    /// Parse a name (case-insensitive).
-    pub fn from_name(s: &str) -> Option<Self> {
-        Self::ALL
-            .into_iter()
-            .find(|d| d.name().eq_ignore_ascii_case(s))
-    }
-}
-
-impl core::fmt::Display for DeadEnd {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        f.write_str(self.name())
-    }
-}
+named!(DeadEnd, "Both, default first.", [Backtrack => "backtrack", Die => "die"]);
 
 /// A finished walk.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -92,6 +92,7 @@
 extern crate alloc;
 
 pub(crate) mod fmt;
+mod named;
 
 pub mod ant;
 pub mod bitmap;

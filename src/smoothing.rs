@@ -26,6 +26,7 @@
 
 use crate::geometry::{distance, segment_clear};
 use crate::grid::{Grid, Point};
+use crate::named::named;
 
 /// How to post-process the raw path.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
@@ -45,36 +46,11 @@ pub enum SmoothingKind {
     Shortest,
 }
 
-impl SmoothingKind {
-    /// All three, default first.
-    pub const ALL: [SmoothingKind; 3] = [
-        SmoothingKind::Shortest,
-        SmoothingKind::Greedy,
-        SmoothingKind::None,
-    ];
-
-    /// Lower-case name (`"shortest"`, `"greedy"`, `"none"`).
-    pub const fn name(self) -> &'static str {
-        match self {
-            SmoothingKind::None => "none",
-            SmoothingKind::Greedy => "greedy",
-            SmoothingKind::Shortest => "shortest",
-        }
-    }
-
-    /// Parse a name (case-insensitive).
-    pub fn from_name(s: &str) -> Option<Self> {
-        Self::ALL
-            .into_iter()
-            .find(|k| k.name().eq_ignore_ascii_case(s))
-    }
-}
-
-impl core::fmt::Display for SmoothingKind {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        f.write_str(self.name())
-    }
-}
+named!(
+    SmoothingKind,
+    "All three, default first.",
+    [Shortest => "shortest", Greedy => "greedy", None => "none"]
+);
 
 /// True if `b` lies on the straight line from `a` to `c`, between them.
 fn collinear_between(a: Point, b: Point, c: Point) -> bool {

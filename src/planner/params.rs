@@ -4,6 +4,7 @@
 use crate::ant::DeadEnd;
 use crate::error::{Error, Param};
 use crate::heuristic::Attraction;
+use crate::named::named;
 use crate::smoothing::SmoothingKind;
 
 /// The four variants the paper compares.
@@ -26,38 +27,13 @@ pub enum Algorithm {
     Ohaca,
 }
 
-impl core::fmt::Display for Algorithm {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        f.write_str(self.name())
-    }
-}
+named!(
+    Algorithm,
+    "All four, in the paper's order.",
+    [Aca => "aca", Paca => "paca", Haca => "haca", Ohaca => "ohaca"]
+);
 
 impl Algorithm {
-    /// All four, in the paper's order.
-    pub const ALL: [Algorithm; 4] = [
-        Algorithm::Aca,
-        Algorithm::Paca,
-        Algorithm::Haca,
-        Algorithm::Ohaca,
-    ];
-
-    /// Lower-case name (`"aca"`, ...).
-    pub const fn name(self) -> &'static str {
-        match self {
-            Algorithm::Aca => "aca",
-            Algorithm::Paca => "paca",
-            Algorithm::Haca => "haca",
-            Algorithm::Ohaca => "ohaca",
-        }
-    }
-
-    /// Parse a lower-case name.
-    pub fn from_name(s: &str) -> Option<Self> {
-        Self::ALL
-            .into_iter()
-            .find(|a| a.name().eq_ignore_ascii_case(s))
-    }
-
     /// Uses the goal attraction in the heuristic.
     pub const fn attracts(self) -> bool {
         !matches!(self, Algorithm::Aca)
