@@ -102,23 +102,31 @@ pub fn polyline_length(points: &[Point]) -> f32 {
         .sum()
 }
 
+/// The bend at `b` of the polyline `a, b, c`: the cross and dot products of `b - a` and `c - b`.
+/// Cross 0 and dot > 0: straight on; cross 0 and dot 0: a repeated point.
+pub fn bend(a: Point, b: Point, c: Point) -> (i64, i64) {
+    // Differences of u16 values and their products (< 2^33) cannot wrap in i64.
+    let (ux, uy) = (
+        i64::from(b.x).wrapping_sub(i64::from(a.x)),
+        i64::from(b.y).wrapping_sub(i64::from(a.y)),
+    );
+    let (vx, vy) = (
+        i64::from(c.x).wrapping_sub(i64::from(b.x)),
+        i64::from(c.y).wrapping_sub(i64::from(b.y)),
+    );
+    (
+        ux.wrapping_mul(vy).wrapping_sub(uy.wrapping_mul(vx)),
+        ux.wrapping_mul(vx).wrapping_add(uy.wrapping_mul(vy)),
+    )
+}
+
 /// Number of turns (direction changes) along a polyline: points where the incoming and outgoing
 /// segments are not collinear-and-forward.
 pub fn turns(points: &[Point]) -> u32 {
     let mut n = 0u32;
     for w in points.windows(3) {
         if let [a, b, c] = w {
-            // Differences of u16 values and their products (< 2^33) cannot wrap in i64.
-            let (ux, uy) = (
-                i64::from(b.x).wrapping_sub(i64::from(a.x)),
-                i64::from(b.y).wrapping_sub(i64::from(a.y)),
-            );
-            let (vx, vy) = (
-                i64::from(c.x).wrapping_sub(i64::from(b.x)),
-                i64::from(c.y).wrapping_sub(i64::from(b.y)),
-            );
-            let cross = ux.wrapping_mul(vy).wrapping_sub(uy.wrapping_mul(vx));
-            let dot = ux.wrapping_mul(vx).wrapping_add(uy.wrapping_mul(vy));
+            let (cross, dot) = bend(*a, *b, *c);
             if cross != 0 || dot <= 0 {
                 n = n.saturating_add(1);
             }

@@ -2,11 +2,12 @@
 //! [`crate::Storage`], but as `Vec`s sized at run time instead of a compile-time capacity (a
 //! `Storage` for a 512x512 map would be 14 MiB on the stack).
 //!
-//! [`HeapStorage`] owns the buffers and lends them to a run with [`Workspace::new`]; it is only
-//! that wrapper, so it follows whatever buffers the workspace takes. It gives ant paths room for
-//! every cell and the move table, so nothing is ever cut short (the device's [`crate::Storage`]
-//! bounds the paths; [`HeapStorage::with_steps`] gives the same bound on the host). It can be reused for
-//! many runs and grows on demand ([`HeapStorage::ensure`], never shrinking). Allocation uses
+//! [`HeapStorage`] holds the buffers in the same `OwnedBuffers` as [`crate::Storage`] (`Vec`s
+//! where that has arrays), which lends them to a run as a [`Workspace`]; so it follows whatever
+//! buffers the workspace takes. It gives ant paths room for every cell and the move table, so
+//! nothing is ever cut short (the device's [`crate::Storage`] bounds the paths;
+//! [`HeapStorage::with_steps`] gives the same bound on the host). It can be reused for many runs
+//! and grows on demand ([`HeapStorage::ensure`], never shrinking). Allocation uses
 //! `try_reserve`, so a map too large for the machine's memory is an [`AllocError`], not an abort.
 
 use alloc::collections::TryReserveError;
@@ -16,23 +17,26 @@ use core::fmt;
 use crate::bitmap::words;
 use crate::grid::{Dir, Point};
 use crate::pheromone::BLOCKS;
-use crate::planner::{Buffers, CurvePoint, Params, Workspace};
+use crate::planner::{CurvePoint, OwnedBuffers, Params, Workspace};
 use crate::route::GUIDE_BLOCKS;
+
+/// The buffers, each a `Vec`.
+type Vecs = OwnedBuffers<
+    Vec<[f32; 4]>,
+    Vec<u32>,
+    Vec<u8>,
+    Vec<Dir>,
+    Vec<Point>,
+    Vec<u32>,
+    Vec<CurvePoint>,
+    Vec<u32>,
+>;
 
 /// The planner's buffers, on the heap. See the module docs.
 #[derive(Clone, Debug, Default)]
 pub struct HeapStorage {
     cells: usize,
-    tau: Vec<[f32; 4]>,
-    delta: Vec<[f32; 4]>,
-    tabu: Vec<u32>,
-    dead: Vec<u32>,
-    moves: Vec<u8>,
-    tours: [Vec<Dir>; 4],
-    points: Vec<Point>,
-    links: Vec<u32>,
-    curve: Vec<CurvePoint>,
-    guide: Vec<u32>,
+    buffers: Vecs,
 }
 
 /// The buffers could not be allocated.
@@ -100,10 +104,10 @@ impl HeapStorage {
     ) -> Result<Self, AllocError> {
         let mut s = HeapStorage::new(cells, iterations)?;
         let steps = steps.max(1);
-        for t in &mut s.tours {
+        for t in &mut s.buffers.tours {
             t.truncate(steps);
         }
-        s.points.truncate(steps.saturating_add(1));
+        s.buffers.points.truncate(steps.saturating_add(1));
         if cells > steps.saturating_add(1).saturating_mul(2) {
             let links = steps
                 .saturating_add(1)
@@ -111,10 +115,10 @@ impl HeapStorage {
                 .checked_next_power_of_two()
                 .unwrap_or(usize::MAX)
                 .max(GUIDE_BLOCKS);
-            s.links.truncate(links);
+            s.buffers.links.truncate(links);
         }
         if !moves {
-            s.moves.clear();
+            s.buffers.moves.clear();
         }
         Ok(s)
     }
@@ -133,20 +137,21 @@ impl HeapStorage {
         let e = |_: TryReserveError| err(());
         self.cells = self.cells.max(cells);
         let cells = self.cells;
-        grow(&mut self.tau, cells.min(BLOCKS), [0.0; 4]).map_err(e)?;
-        grow(&mut self.delta, cells.min(BLOCKS), [0.0; 4]).map_err(e)?;
-        grow(&mut self.tabu, words(cells), 0).map_err(e)?;
-        grow(&mut self.dead, words(cells), 0).map_err(e)?;
-        grow(&mut self.moves, cells, 0).map_err(e)?;
+        let b = &mut self.buffers;
+        grow(&mut b.tau, cells.min(BLOCKS), [0.0; 4]).map_err(e)?;
+        grow(&mut b.delta, cells.min(BLOCKS), [0.0; 4]).map_err(e)?;
+        grow(&mut b.tabu, words(cells), 0).map_err(e)?;
+        grow(&mut b.dead, words(cells), 0).map_err(e)?;
+        grow(&mut b.moves, cells, 0).map_err(e)?;
         let steps = cells.max(1);
-        for t in &mut self.tours {
+        for t in &mut b.tours {
             grow(t, steps, 0).map_err(e)?;
         }
-        grow(&mut self.points, steps.saturating_add(1), Point::default()).map_err(e)?;
-        grow(&mut self.links, cells.max(GUIDE_BLOCKS), 0).map_err(e)?;
-        grow(&mut self.curve, iterations, CurvePoint::default()).map_err(e)?;
+        grow(&mut b.points, steps.saturating_add(1), Point::default()).map_err(e)?;
+        grow(&mut b.links, cells.max(GUIDE_BLOCKS), 0).map_err(e)?;
+        grow(&mut b.curve, iterations, CurvePoint::default()).map_err(e)?;
         if cells > BLOCKS {
-            grow(&mut self.guide, GUIDE_BLOCKS, 0).map_err(e)?;
+            grow(&mut b.guide, GUIDE_BLOCKS, 0).map_err(e)?;
         }
         Ok(())
     }
@@ -158,7 +163,7 @@ impl HeapStorage {
 
     /// Curve entries (iterations recorded by [`crate::Plan::curve`]).
     pub fn curve_len(&self) -> usize {
-        self.curve.len()
+        self.buffers.curve.len()
     }
 
     /// Fill every buffer with arbitrary values derived from `salt` (xorshift32), so a test can
@@ -171,22 +176,23 @@ impl HeapStorage {
             x ^= x << 5;
             x
         };
+        let b = &mut self.buffers;
         // Pheromone-like values in [0, 143): whole numbers / 7.
-        for t in self.tau.iter_mut().chain(self.delta.iter_mut()) {
+        for t in b.tau.iter_mut().chain(b.delta.iter_mut()) {
             *t = core::array::from_fn(|_| (next() % 1000) as f32 / 7.0);
         }
-        for b in self.moves.iter_mut().chain(self.tours.iter_mut().flatten()) {
-            *b = next() as u8;
+        for byte in b.moves.iter_mut().chain(b.tours.iter_mut().flatten()) {
+            *byte = next() as u8;
         }
-        for p in &mut self.points {
+        for p in &mut b.points {
             *p = Point::new(next() as u16, next() as u16);
         }
-        for w in self
+        for w in b
             .tabu
             .iter_mut()
-            .chain(self.dead.iter_mut())
-            .chain(self.links.iter_mut())
-            .chain(self.guide.iter_mut())
+            .chain(b.dead.iter_mut())
+            .chain(b.links.iter_mut())
+            .chain(b.guide.iter_mut())
         {
             *w = next();
         }
@@ -194,19 +200,7 @@ impl HeapStorage {
 
     /// Borrow the buffers as a workspace for one run.
     pub fn workspace(&mut self) -> Workspace<'_> {
-        let [t0, t1, t2, t3] = &mut self.tours;
-        Workspace::new(Buffers {
-            tau: &mut self.tau,
-            delta: &mut self.delta,
-            tabu: &mut self.tabu,
-            dead: &mut self.dead,
-            moves: &mut self.moves,
-            tours: [t0, t1, t2, t3],
-            points: &mut self.points,
-            links: &mut self.links,
-            curve: &mut self.curve,
-            guide: &mut self.guide,
-        })
+        self.buffers.workspace()
     }
 }
 

@@ -149,6 +149,16 @@ pub struct Heuristic {
     weights: [f32; WEIGHTS],
 }
 
+/// The goal attraction of the potential field (paper eqs. 6-10): a move is weighted by
+/// `a^(xi * change of octile distance)`. Absent for plain ACA.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Attraction {
+    /// Attraction base `a`, in `(0, 1]` (paper: 0.05); smaller pulls harder.
+    pub a: f32,
+    /// Potential-field gain `xi`, finite and `>= 0` (paper: 1).
+    pub xi: f32,
+}
+
 /// The 8 candidate weights of one cell (see [`Heuristic::row`]).
 #[derive(Clone, Copy, Debug)]
 pub struct Row<'h> {
@@ -170,14 +180,17 @@ impl Row<'_> {
 }
 
 impl Heuristic {
-    /// The weights for goal `goal`. With `attract = false` (plain ACA) only the step distance
-    /// counts; otherwise the goal attraction `a^(xi * change of octile distance)` multiplies it.
-    /// Everything is raised to `beta`. Inputs are assumed validated (`0 < a <= 1`, finite
-    /// `xi >= 0`, `0 <= beta <= 16`).
-    pub fn new(goal: Point, attract: bool, a: f32, xi: f32, beta: f32) -> Self {
+    /// The weights for goal `goal`. Without an [`Attraction`] (plain ACA) only the step distance
+    /// counts; with one, `a^(xi * change of octile distance)` multiplies it. Everything is raised
+    /// to `beta`. Inputs are assumed validated (`0 < a <= 1`, finite `xi >= 0`,
+    /// `0 <= beta <= 16`).
+    pub fn new(goal: Point, attraction: Option<Attraction>, beta: f32) -> Self {
         // Every weight as a natural log: beta * (xi * change * ln a - ln step). Computed in logs
         // so no intermediate over- or underflows before the table is scaled.
-        let ln_a = if attract { libm::logf(a) } else { 0.0 };
+        let (ln_a, xi) = match attraction {
+            Some(Attraction { a, xi }) => (libm::logf(a), xi),
+            None => (0.0, 0.0),
+        };
         let mut logs = [0.0f32; WEIGHTS];
         for (i, l) in logs.iter_mut().enumerate().take(30) {
             let change = ((i % 15) / 3) as f32 - 2.0 + ((i % 3) as f32 - 1.0) * SQRT_2;
@@ -290,6 +303,10 @@ const fn octile_offset(dx: i32, dy: i32) -> (i32, i32) {
 mod tests {
     use super::*;
 
+    fn attract(a: f32, xi: f32) -> Option<Attraction> {
+        Some(Attraction { a, xi })
+    }
+
     /// The weight computed from scratch, as the module docs define it (before normalisation).
     fn direct(p: Point, g: Point, d: Dir, a: f32, xi: f32, beta: f32) -> f32 {
         let (ex, ey) = (DX[d as usize], DY[d as usize]);
@@ -310,7 +327,7 @@ mod tests {
     #[test]
     fn table_matches_direct_computation_everywhere() {
         let g = Point::new(20, 20);
-        let h = Heuristic::new(g, true, 0.3, 1.0, 2.0);
+        let h = Heuristic::new(g, attract(0.3, 1.0), 2.0);
         // Normalisation constant: ratio of any entry to its direct value.
         let scale =
             h.weight(Point::new(25, 21), 4) / direct(Point::new(25, 21), g, 4, 0.3, 1.0, 2.0);
@@ -332,7 +349,7 @@ mod tests {
     #[test]
     fn attraction_prefers_moves_towards_the_goal() {
         let g = Point::new(10, 0);
-        let h = Heuristic::new(g, true, 0.05, 1.0, 2.0);
+        let h = Heuristic::new(g, attract(0.05, 1.0), 2.0);
         let at = Point::new(5, 0);
         let east = h.weight(at, 0);
         let west = h.weight(at, 4);
@@ -349,7 +366,7 @@ mod tests {
     #[test]
     fn plain_aca_prefers_straight_steps_only() {
         let g = Point::new(10, 10);
-        let h = Heuristic::new(g, false, 0.05, 1.0, 2.0);
+        let h = Heuristic::new(g, None, 2.0);
         let p = Point::new(5, 5);
         assert_eq!(h.weight(p, 0), 1.0);
         assert_eq!(h.weight(p, 4), 1.0);
@@ -358,7 +375,7 @@ mod tests {
 
     #[test]
     fn extreme_parameters_stay_finite() {
-        let h = Heuristic::new(Point::new(3, 3), true, 1e-30, 1e6, 16.0);
+        let h = Heuristic::new(Point::new(3, 3), attract(1e-30, 1e6), 16.0);
         for w in h.weights.iter() {
             assert!(w.is_finite() && *w >= 0.0, "{w}");
         }
@@ -382,7 +399,7 @@ mod tests {
     #[test]
     fn the_scale_is_a_move_that_exists() {
         // The paper's a, xi, beta: the best move any cell can make weighs exactly 1.
-        let h = Heuristic::new(Point::new(20, 20), true, 0.05, 1.0, 2.0);
+        let h = Heuristic::new(Point::new(20, 20), attract(0.05, 1.0), 2.0);
         let max = move_weights(&h).iter().map(|w| w.2).fold(0.0f32, f32::max);
         assert_eq!(max, 1.0);
         // Entries no move uses are 0 (they are never read).
@@ -400,7 +417,7 @@ mod tests {
         // differ by 0.05^(-16 * 2 sqrt 2), about 1e59, more than f32 can hold between 1 and 0.
         let goal = Point::new(20, 20);
         for (a, xi) in [(0.05, 1.0), (0.3, 1.0), (0.05, 0.5)] {
-            let h = Heuristic::new(goal, true, a, xi, 16.0);
+            let h = Heuristic::new(goal, attract(a, xi), 16.0);
             let ws = move_weights(&h);
             for &(p, d, w) in &ws {
                 assert!(w > 0.0 && w.is_finite(), "a {a}: {p:?} d{d}: {w}");

@@ -18,7 +18,7 @@
 //! | [`geometry`] | path lengths and the segment rule used by smoothing and path checks |
 //! | [`heuristic`] | the distance heuristic and the goal attraction of the potential field |
 //! | [`pheromone`] | the pheromone table: storage, evaporation, deposit, clamping |
-//! | [`colony`] | one ant: the transition rule, tabu list, backtracking (or dying) |
+//! | [`ant`] | one ant's walk: the transition rule, tabu list, backtracking (or dying), tightening |
 //! | [`update`] | the per-iteration pheromone update: classic deposit and the wolves rule |
 //! | [`smoothing`] | line-of-sight smoothing of the raw ant path |
 //! | [`refine`] | local search: the exact shortest path in a window sliding along a raw path |
@@ -92,9 +92,10 @@
 extern crate alloc;
 
 pub(crate) mod fmt;
+mod named;
 
+pub mod ant;
 pub mod bitmap;
-pub mod colony;
 pub mod error;
 pub mod geometry;
 pub mod grid;
@@ -115,7 +116,7 @@ pub mod update;
 #[cfg(test)]
 mod testutil;
 
-pub use colony::DeadEnd;
+pub use ant::DeadEnd;
 pub use error::Error;
 pub use grid::{Grid, Point};
 pub use planner::{

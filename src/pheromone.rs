@@ -21,24 +21,32 @@ use crate::grid::{Dir, Point, DX, DY};
 /// off the map's index range (the caller only asks about allowed moves, so this does not happen).
 #[inline]
 pub fn edge(width: u16, p: Point, d: Dir) -> Option<(usize, usize)> {
-    let d = d & 7;
-    let (q, slot) = if d < 4 {
-        (p, d)
-    } else {
-        let di = usize::from(d);
-        // A u16 plus -1..=1: no i32 overflow.
-        let x = i32::from(p.x).wrapping_add(DX.get(di).copied().unwrap_or(0));
-        let y = i32::from(p.y).wrapping_add(DY.get(di).copied().unwrap_or(0));
-        if x < 0 || y < 0 {
-            return None;
-        }
-        (Point::new(x as u16, y as u16), d.wrapping_sub(4)) // d >= 4
-    };
+    let (x, y, slot) = owner(p, d);
+    if x < 0 || y < 0 {
+        return None;
+    }
+    let q = Point::new(x as u16, y as u16);
     // At most 65535 * 65535 + 65535 < 2^32: fits the (at least 32-bit) usize, see `crate::grid`.
     let cell = usize::from(q.y)
         .wrapping_mul(usize::from(width))
         .wrapping_add(usize::from(q.x));
     Some((cell, usize::from(slot)))
+}
+
+/// The cell that owns the undirected edge `(p, d)` (`p` itself for E, SE, S, SW, else the
+/// neighbour, which may be off the map: hence `i32` coordinates) and the edge's slot in it.
+#[inline]
+fn owner(p: Point, d: Dir) -> (i32, i32, u8) {
+    let d = d & 7;
+    if d < 4 {
+        (i32::from(p.x), i32::from(p.y), d)
+    } else {
+        let di = usize::from(d);
+        // A u16 plus -1..=1: no i32 overflow.
+        let x = i32::from(p.x).wrapping_add(DX.get(di).copied().unwrap_or(0));
+        let y = i32::from(p.y).wrapping_add(DY.get(di).copied().unwrap_or(0));
+        (x, y, d.wrapping_sub(4)) // d >= 4
+    }
 }
 
 /// For each direction, the offset from `4 * cell` to the edge's slot in a flattened table: `d`
@@ -127,16 +135,9 @@ impl Blocks {
     /// Flat index (`4 * block + slot`) of the undirected edge `(p, d)`.
     #[inline]
     pub fn index(&self, p: Point, d: Dir) -> usize {
-        let d = d & 7;
-        let (q, slot) = if d < 4 {
-            (p, d)
-        } else {
-            let di = usize::from(d);
-            // Callers only ask about allowed moves, so the neighbour is on the map.
-            let x = i32::from(p.x).wrapping_add(DX.get(di).copied().unwrap_or(0));
-            let y = i32::from(p.y).wrapping_add(DY.get(di).copied().unwrap_or(0));
-            (Point::new(x as u16, y as u16), d.wrapping_sub(4))
-        };
+        let (x, y, slot) = owner(p, d);
+        // Callers only ask about allowed moves, so the owner is on the map.
+        let q = Point::new(x as u16, y as u16);
         self.block(q)
             .wrapping_mul(4)
             .wrapping_add(usize::from(slot))

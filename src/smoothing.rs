@@ -24,8 +24,9 @@
 //!
 //! All three work in place on the caller's buffers and keep collinear points out of the output.
 
-use crate::geometry::{distance, segment_clear};
+use crate::geometry::{bend, distance, segment_clear};
 use crate::grid::{Grid, Point};
+use crate::named::named;
 
 /// How to post-process the raw path.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
@@ -45,50 +46,16 @@ pub enum SmoothingKind {
     Shortest,
 }
 
-impl SmoothingKind {
-    /// All three, default first.
-    pub const ALL: [SmoothingKind; 3] = [
-        SmoothingKind::Shortest,
-        SmoothingKind::Greedy,
-        SmoothingKind::None,
-    ];
-
-    /// Lower-case name (`"shortest"`, `"greedy"`, `"none"`).
-    pub const fn name(self) -> &'static str {
-        match self {
-            SmoothingKind::None => "none",
-            SmoothingKind::Greedy => "greedy",
-            SmoothingKind::Shortest => "shortest",
-        }
-    }
-
-    /// Parse a name (case-insensitive).
-    pub fn from_name(s: &str) -> Option<Self> {
-        Self::ALL
-            .into_iter()
-            .find(|k| k.name().eq_ignore_ascii_case(s))
-    }
-}
-
-impl core::fmt::Display for SmoothingKind {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        f.write_str(self.name())
-    }
-}
+named!(
+    SmoothingKind,
+    "All three, default first.",
+    [Shortest => "shortest", Greedy => "greedy", None => "none"]
+);
 
 /// True if `b` lies on the straight line from `a` to `c`, between them.
 fn collinear_between(a: Point, b: Point, c: Point) -> bool {
-    // Differences of u16 values and their products (< 2^33) cannot wrap in i64.
-    let (ux, uy) = (
-        i64::from(b.x).wrapping_sub(i64::from(a.x)),
-        i64::from(b.y).wrapping_sub(i64::from(a.y)),
-    );
-    let (vx, vy) = (
-        i64::from(c.x).wrapping_sub(i64::from(b.x)),
-        i64::from(c.y).wrapping_sub(i64::from(b.y)),
-    );
-    ux.wrapping_mul(vy) == uy.wrapping_mul(vx)
-        && ux.wrapping_mul(vx).wrapping_add(uy.wrapping_mul(vy)) >= 0
+    let (cross, dot) = bend(a, b, c);
+    cross == 0 && dot >= 0
 }
 
 /// Remove interior points of `pts[..n]` that lie straight between their neighbours; returns the

@@ -20,8 +20,8 @@
 
 use std::time::Duration;
 
+use ohaca::ant::Ant;
 use ohaca::bitmap::words;
-use ohaca::colony::Colony;
 use ohaca::grid::Moves;
 use ohaca::heuristic::Heuristic;
 use ohaca::pheromone::{Blocks, Table};
@@ -41,13 +41,7 @@ fn first_iteration_arrivals(prep: &Prepared, params: &Params, seeds: &[u64]) -> 
     let blocks = Blocks::new(map.width(), map.height());
     let mut tau_buf = vec![[params.tau0; 4]; blocks.count()];
     let tau = Table::new(blocks, &mut tau_buf);
-    let heuristic = Heuristic::new(
-        case.goal,
-        params.algorithm.attracts(),
-        params.a,
-        params.xi,
-        params.beta,
-    );
+    let heuristic = Heuristic::new(case.goal, params.attraction(), params.beta);
     let moves = Moves::new(grid, &[]);
     // The first iteration as the planner runs it, pruning included when the parameters ask.
     let mut dead = vec![0u32; words(cells)];
@@ -55,7 +49,7 @@ fn first_iteration_arrivals(prep: &Prepared, params: &Params, seeds: &[u64]) -> 
         let mut stack = vec![0u32; cells];
         prune(&moves, case.start, case.goal, &mut dead, &mut stack);
     }
-    let colony = Colony {
+    let ant = Ant {
         moves: &moves,
         start: case.start,
         goal: case.goal,
@@ -73,7 +67,7 @@ fn first_iteration_arrivals(prep: &Prepared, params: &Params, seeds: &[u64]) -> 
         let mut rng = Xoshiro128pp::from_u64(seed);
         for _ in 0..params.ants {
             total += 1;
-            arrived += u64::from(colony.walk(&mut rng, &mut tabu, &mut tour).is_ok());
+            arrived += u64::from(ant.walk(&mut rng, &mut tabu, &mut tour).is_ok());
         }
     }
     arrived as f64 / total as f64

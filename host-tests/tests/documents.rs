@@ -1,6 +1,6 @@
 //! Figures in the documents that a test can produce, checked here so they cannot go stale
 //! (the byte-exact example of `docs/PROTOCOL.md`, and that its plan is the core's, are checked by
-//! `src/protocol/tests.rs`):
+//! `src/protocol/tests/document.rs`):
 //!
 //! - the request size limits of `docs/PROTOCOL.md`: the reader's 259 COBS bytes (delimiter not
 //!   counted), `TooLarge` reporting the frame's whole length, and the largest request's size;

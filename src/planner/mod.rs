@@ -7,7 +7,7 @@
 //! prune the cells no shortest path needs                 (prune)
 //! tau = tau0 everywhere (a warm start keeps the previous run's tau, reset near map changes: warm)
 //! repeat `iterations` times (or until the best has not improved for `patience` iterations):
-//!     each of `ants` ants walks start -> goal            (colony)
+//!     each of `ants` ants walks start -> goal            (ant)
 //!     each ant that arrived deposits Q / L on its path    (update)
 //!     HACA/OHACA: reward the iteration's best, punish its worst (update, wolves rule)
 //!     tau = clamp((1 - rho) tau + deposits, tau_min, tau_max)
@@ -35,6 +35,8 @@ pub use params::{Algorithm, Params};
 pub use plan::{CurvePoint, Plan, RawPath};
 pub use run::Run;
 pub use warm::{Area, Memory, REPAIR_RADIUS};
+#[cfg(any(feature = "alloc", test))]
+pub(crate) use workspace::OwnedBuffers;
 pub use workspace::{Buffers, Storage, Workspace};
 
 use crate::error::Error;

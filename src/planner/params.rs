@@ -1,8 +1,10 @@
 //! The planner's parameters: which variant runs ([`Algorithm`]) and every tunable ([`Params`]),
 //! with their valid ranges ([`Params::validate`]).
 
-use crate::colony::DeadEnd;
+use crate::ant::DeadEnd;
 use crate::error::{Error, Param};
+use crate::heuristic::Attraction;
+use crate::named::named;
 use crate::smoothing::SmoothingKind;
 
 /// The four variants the paper compares.
@@ -25,38 +27,13 @@ pub enum Algorithm {
     Ohaca,
 }
 
-impl core::fmt::Display for Algorithm {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        f.write_str(self.name())
-    }
-}
+named!(
+    Algorithm,
+    "All four, in the paper's order.",
+    [Aca => "aca", Paca => "paca", Haca => "haca", Ohaca => "ohaca"]
+);
 
 impl Algorithm {
-    /// All four, in the paper's order.
-    pub const ALL: [Algorithm; 4] = [
-        Algorithm::Aca,
-        Algorithm::Paca,
-        Algorithm::Haca,
-        Algorithm::Ohaca,
-    ];
-
-    /// Lower-case name (`"aca"`, ...).
-    pub const fn name(self) -> &'static str {
-        match self {
-            Algorithm::Aca => "aca",
-            Algorithm::Paca => "paca",
-            Algorithm::Haca => "haca",
-            Algorithm::Ohaca => "ohaca",
-        }
-    }
-
-    /// Parse a lower-case name.
-    pub fn from_name(s: &str) -> Option<Self> {
-        Self::ALL
-            .into_iter()
-            .find(|a| a.name().eq_ignore_ascii_case(s))
-    }
-
     /// Uses the goal attraction in the heuristic.
     pub const fn attracts(self) -> bool {
         !matches!(self, Algorithm::Aca)
@@ -114,7 +91,7 @@ pub struct Params {
     pub dead_end: DeadEnd,
     /// How OHACA smooths the result (the other variants never smooth).
     pub smoothing: SmoothingKind,
-    /// Straighten each ant's path before the pheromone update ([`crate::colony::tighten`]); not in
+    /// Straighten each ant's path before the pheromone update ([`crate::ant::tighten`]); not in
     /// the paper, off for faithful comparisons.
     pub tighten: bool,
     /// Prune the cells no shortest path needs before the ants run ([`crate::prune`]); not in the
@@ -167,6 +144,19 @@ impl Params {
             tighten: false,
             prune: false,
             ..Params::DEFAULT
+        }
+    }
+
+    /// The goal attraction of the heuristic: `a` and `xi` for the variants that attract
+    /// ([`Algorithm::attracts`]), `None` for plain ACA.
+    pub const fn attraction(&self) -> Option<Attraction> {
+        if self.algorithm.attracts() {
+            Some(Attraction {
+                a: self.a,
+                xi: self.xi,
+            })
+        } else {
+            None
         }
     }
 

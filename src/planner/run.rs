@@ -5,7 +5,7 @@
 //! The firmware yields to its executor between steps, so it can answer other requests and cancel
 //! a plan by dropping (or finishing) the run.
 
-use crate::colony::{tighten, Colony, Lost, Walk};
+use crate::ant::{tighten, Ant, Lost, Walk};
 use crate::error::{Endpoint, Error};
 use crate::geometry::{polyline_length, steps_length, turns};
 use crate::grid::{Dir, Grid, Moves, Point, Reach};
@@ -195,13 +195,7 @@ impl<'g, 'a> Run<'g, 'a> {
             }
         }
         ws.delta.fill([0.0; 4]);
-        let heuristic = Heuristic::new(
-            goal,
-            params.algorithm.attracts(),
-            params.a,
-            params.xi,
-            params.beta,
-        );
+        let heuristic = Heuristic::new(goal, params.attraction(), params.beta);
         crate::fmt::debug!(
             "plan: {} cells ({} pruned), ants {}, iterations {}",
             cells,
@@ -315,7 +309,7 @@ impl<'g, 'a> Run<'g, 'a> {
         );
         let tau = Table::new(self.blocks, tau);
         let mut delta = Table::new(self.blocks, delta);
-        let colony = Colony {
+        let ant = Ant {
             moves: &moves,
             start: self.start,
             goal: self.goal,
@@ -328,7 +322,7 @@ impl<'g, 'a> Run<'g, 'a> {
         };
         let mut it = Iteration::default();
         for _ in 0..p.ants {
-            let walk = match colony.walk(&mut self.rng, tabu, tour) {
+            let walk = match ant.walk(&mut self.rng, tabu, tour) {
                 Ok(w) => w,
                 Err(Lost::Exhausted) => {
                     // Only possible when the flood fill could not decide: now it is decided.

@@ -200,6 +200,53 @@ impl<'a> Workspace<'a> {
     }
 }
 
+/// The buffers of a run, owned: as arrays of compile-time capacities by [`Storage`], as `Vec`s
+/// sized at run time by `heap::HeapStorage`. The one place that lends them to a [`Workspace`],
+/// so both storages follow whatever buffers the workspace takes.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct OwnedBuffers<Tau, Bits, Moves, Tour, Points, Links, Curve, Guide> {
+    pub(crate) tau: Tau,
+    pub(crate) delta: Tau,
+    pub(crate) tabu: Bits,
+    pub(crate) dead: Bits,
+    pub(crate) moves: Moves,
+    pub(crate) tours: [Tour; 4],
+    pub(crate) points: Points,
+    pub(crate) links: Links,
+    pub(crate) curve: Curve,
+    pub(crate) guide: Guide,
+}
+
+impl<Tau, Bits, Moves, Tour, Points, Links, Curve, Guide>
+    OwnedBuffers<Tau, Bits, Moves, Tour, Points, Links, Curve, Guide>
+where
+    Tau: AsMut<[[f32; 4]]>,
+    Bits: AsMut<[u32]>,
+    Moves: AsMut<[u8]>,
+    Tour: AsMut<[Dir]>,
+    Points: AsMut<[Point]>,
+    Links: AsMut<[u32]>,
+    Curve: AsMut<[CurvePoint]>,
+    Guide: AsMut<[u32]>,
+{
+    /// Borrow the buffers as a workspace for one run.
+    pub(crate) fn workspace(&mut self) -> Workspace<'_> {
+        let [t0, t1, t2, t3] = &mut self.tours;
+        Workspace::new(Buffers {
+            tau: self.tau.as_mut(),
+            delta: self.delta.as_mut(),
+            tabu: self.tabu.as_mut(),
+            dead: self.dead.as_mut(),
+            moves: self.moves.as_mut(),
+            tours: [t0.as_mut(), t1.as_mut(), t2.as_mut(), t3.as_mut()],
+            points: self.points.as_mut(),
+            links: self.links.as_mut(),
+            curve: self.curve.as_mut(),
+            guide: self.guide.as_mut(),
+        })
+    }
+}
+
 /// Fixed-capacity storage for a [`Workspace`]: bit sets of `WORDS` words (maps of up to
 /// `32 * WORDS` cells), ant paths of up to `STEPS - 1` steps, `LINKS` links, a move table for maps
 /// of up to `MOVES` cells (0: none), and a curve of `CURVE` iterations. Put it in a `static` on
@@ -220,17 +267,26 @@ pub struct Storage<
     const MOVES: usize = 0,
     const CURVE: usize = 128,
 > {
-    tau: [[f32; 4]; BLOCKS],
-    delta: [[f32; 4]; BLOCKS],
-    tabu: [u32; WORDS],
-    dead: [u32; WORDS],
-    moves: [u8; MOVES],
-    tours: [[Dir; STEPS]; 4],
-    points: [Point; STEPS],
-    links: [u32; LINKS],
-    curve: [CurvePoint; CURVE],
-    guide: [u32; GUIDE_BLOCKS],
+    buffers: Arrays<WORDS, STEPS, LINKS, MOVES, CURVE>,
 }
+
+/// The buffers of a [`Storage`], each an array.
+type Arrays<
+    const WORDS: usize,
+    const STEPS: usize,
+    const LINKS: usize,
+    const MOVES: usize,
+    const CURVE: usize,
+> = OwnedBuffers<
+    [[f32; 4]; BLOCKS],
+    [u32; WORDS],
+    [u8; MOVES],
+    [Dir; STEPS],
+    [Point; STEPS],
+    [u32; LINKS],
+    [CurvePoint; CURVE],
+    [u32; GUIDE_BLOCKS],
+>;
 
 impl<
         const WORDS: usize,
@@ -246,39 +302,29 @@ impl<
     /// Zeroed storage (a `const fn`, so it can initialise a `static`).
     pub const fn new() -> Self {
         Storage {
-            tau: [[0.0; 4]; BLOCKS],
-            delta: [[0.0; 4]; BLOCKS],
-            tabu: [0; WORDS],
-            dead: [0; WORDS],
-            moves: [0; MOVES],
-            tours: [[0; STEPS]; 4],
-            points: [Point::new(0, 0); STEPS],
-            links: [0; LINKS],
-            curve: [CurvePoint {
-                best: 0.0,
-                mean: 0.0,
-                best_so_far: 0.0,
-                arrived: 0,
-            }; CURVE],
-            guide: [0; GUIDE_BLOCKS],
+            buffers: OwnedBuffers {
+                tau: [[0.0; 4]; BLOCKS],
+                delta: [[0.0; 4]; BLOCKS],
+                tabu: [0; WORDS],
+                dead: [0; WORDS],
+                moves: [0; MOVES],
+                tours: [[0; STEPS]; 4],
+                points: [Point::new(0, 0); STEPS],
+                links: [0; LINKS],
+                curve: [CurvePoint {
+                    best: 0.0,
+                    mean: 0.0,
+                    best_so_far: 0.0,
+                    arrived: 0,
+                }; CURVE],
+                guide: [0; GUIDE_BLOCKS],
+            },
         }
     }
 
     /// Borrow the storage as a [`Workspace`].
     pub fn workspace(&mut self) -> Workspace<'_> {
-        let [t0, t1, t2, t3] = &mut self.tours;
-        Workspace::new(Buffers {
-            tau: &mut self.tau,
-            delta: &mut self.delta,
-            tabu: &mut self.tabu,
-            dead: &mut self.dead,
-            moves: &mut self.moves,
-            tours: [t0, t1, t2, t3],
-            points: &mut self.points,
-            links: &mut self.links,
-            curve: &mut self.curve,
-            guide: &mut self.guide,
-        })
+        self.buffers.workspace()
     }
 }
 

@@ -1,21 +1,9 @@
-//! Tests of map uploads (raw and run-length), cell updates and warm plans: every error path,
-//! round trips, and the byte-exact examples of docs/PROTOCOL.md ("Big maps and cell updates").
+//! Map uploads (raw and run-length), cell updates and warm plans: every error path and the round
+//! trips.
 
 use super::*;
 
-/// A small deterministic generator.
-struct Lcg(u64);
-impl Lcg {
-    fn next(&mut self) -> u32 {
-        self.0 = self
-            .0
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (self.0 >> 33) as u32
-    }
-}
-
-const LIMITS: MapLimits = MapLimits {
+pub(super) const LIMITS: MapLimits = MapLimits {
     max_width: 512,
     max_height: 512,
 };
@@ -41,7 +29,7 @@ fn runs_map(rng: &mut Lcg, cells: usize, max_run: u32) -> Vec<u8> {
     bits
 }
 
-fn rle(bits: &[u8], cells: usize) -> Vec<u8> {
+pub(super) fn rle(bits: &[u8], cells: usize) -> Vec<u8> {
     RleEncoder::new(bits, cells as u32).collect()
 }
 
@@ -183,7 +171,14 @@ fn raw_uploads_write_the_map() {
     assert!(same_cells(&bits, &out, cells));
 }
 
-fn chunk(enc: Encoding, w: u16, h: u16, offset: u32, total: u32, c: &[u8]) -> MapChunk<'_> {
+pub(super) fn chunk(
+    enc: Encoding,
+    w: u16,
+    h: u16,
+    offset: u32,
+    total: u32,
+    c: &[u8],
+) -> MapChunk<'_> {
     MapChunk {
         encoding: enc,
         width: w,
@@ -454,197 +449,4 @@ fn set_cells_with_a_ragged_byte_string_does_not_decode() {
         decode_request(&mut f[..n]),
         Err(DecodeError::Undecodable { id: Some(1) })
     );
-}
-
-// ---- docs/PROTOCOL.md, "Big maps and cell updates": byte-exact examples ------------------------
-
-/// The examples of the section, in order: each request with its reply.
-fn doc_examples() -> Vec<(u32, Request<'static>, Reply<'static>)> {
-    const CODE: [u8; 3] = [5, 1, 6];
-    const CELLS: [Point; 2] = [Point::new(2, 0), Point::new(2, 1)];
-    const WALL: [Point; 1] = [Point::new(3, 1)];
-    vec![
-        (
-            5,
-            Request::SetMapRle {
-                width: 4,
-                height: 3,
-                offset: 0,
-                total_len: 3,
-                chunk: &CODE,
-            },
-            Reply::Ack,
-        ),
-        (
-            6,
-            Request::SetRect {
-                x: 1,
-                y: 1,
-                width: 3,
-                height: 1,
-                blocked: true,
-            },
-            Reply::Ack,
-        ),
-        (
-            7,
-            Request::SetCells {
-                blocked: false,
-                cells: Waypoints::Points(&CELLS),
-            },
-            Reply::Ack,
-        ),
-        (
-            8,
-            Request::SetRect {
-                x: 2,
-                y: 2,
-                width: 3,
-                height: 1,
-                blocked: true,
-            },
-            Reply::Error(ErrorReply::with(ErrorCode::OutsideMap, 4, 2)),
-        ),
-        (
-            9,
-            Request::PlanWarm {
-                start: Point::new(0, 2),
-                goal: Point::new(3, 2),
-                seed: None,
-            },
-            Reply::Error(ErrorReply::with(ErrorCode::Cancelled, 0, 0)),
-        ),
-        (
-            10,
-            Request::SetCells {
-                blocked: true,
-                cells: Waypoints::Points(&WALL),
-            },
-            Reply::Ack,
-        ),
-    ]
-}
-
-fn frame_of(id: u32, r: &Request<'_>) -> Vec<u8> {
-    let mut buf = vec![0u8; MAX_REQUEST_WIRE];
-    let n = encode_request(id, r, &mut buf).unwrap();
-    buf.truncate(n);
-    buf
-}
-
-fn reply_frame_of(id: u32, r: &Reply<'_>) -> Vec<u8> {
-    let mut buf = vec![0u8; 256];
-    let n = encode_reply(id, r, &mut buf).unwrap();
-    buf.truncate(n);
-    buf
-}
-
-fn payload(frame: &[u8]) -> Vec<u8> {
-    let mut b = frame[..frame.len() - 1].to_vec();
-    let n = frame::cobs_decode_in_place(&mut b).unwrap();
-    b.truncate(n);
-    b
-}
-
-/// The hex after each `marker` (`;` starts a comment).
-fn doc_hex(doc: &str, marker: &str) -> Vec<u8> {
-    doc.lines()
-        .filter_map(|l| l.strip_prefix(marker))
-        .flat_map(|l| {
-            l.split(';')
-                .next()
-                .unwrap_or("")
-                .split_whitespace()
-                .map(|t| u8::from_str_radix(t, 16).unwrap_or_else(|_| panic!("bad hex {t:?}")))
-                .collect::<Vec<_>>()
-        })
-        .collect()
-}
-
-#[test]
-fn protocol_doc_map_examples_are_exact() {
-    let doc = include_str!("../../docs/PROTOCOL.md");
-    let (mut rq, mut rqw, mut rp, mut rpw) = (vec![], vec![], vec![], vec![]);
-    for (id, req, rep) in doc_examples() {
-        let f = frame_of(id, &req);
-        rq.extend(payload(&f));
-        rqw.extend(f);
-        let f = reply_frame_of(id, &rep);
-        rp.extend(payload(&f));
-        rpw.extend(f);
-    }
-    let hint = "docs/PROTOCOL.md (Big maps and cell updates) drifted: regenerate with \
-        `cargo test -p ohaca --lib --target host-tuple print_protocol_doc_map_examples -- \
-        --ignored --nocapture`";
-    assert_eq!(doc_hex(doc, "-> "), rq, "{hint}");
-    assert_eq!(doc_hex(doc, "}> "), rqw, "{hint}");
-    assert_eq!(doc_hex(doc, "<- "), rp, "{hint}");
-    assert_eq!(doc_hex(doc, "<{ "), rpw, "{hint}");
-    // The RLE code in the text is the map's.
-    assert_eq!(rle(&[0x20, 0x00], 12), [5, 1, 6]);
-}
-
-/// What the examples do to the 4x3 map, applied here: the map after each, and that the
-/// replies are what the device's rules give.
-#[test]
-fn protocol_doc_map_examples_are_what_the_rules_give() {
-    let mut map = [0u8; 2];
-    let mut up = Upload::new();
-    let ex = doc_examples();
-    let Request::SetMapRle {
-        width,
-        height,
-        offset,
-        total_len,
-        chunk: c,
-    } = ex[0].1
-    else {
-        panic!()
-    };
-    let m = chunk(Encoding::Rle, width, height, offset, total_len, c);
-    assert_eq!(up.accept(&m, LIMITS), Ok(true));
-    assert_eq!(up.write(&m, &mut map), Ok(Some((4, 3))));
-    assert_eq!(map[0], 0x20);
-    for (_, req, rep) in ex[1..4].iter().chain(&ex[5..]) {
-        let got = match *req {
-            Request::SetRect {
-                x,
-                y,
-                width,
-                height,
-                blocked,
-            } => set_rect((4, 3), &mut map, (x, y, width, height), blocked),
-            Request::SetCells { blocked, cells } => set_cells((4, 3), &mut map, &cells, blocked),
-            _ => panic!(),
-        };
-        let got = match got {
-            Ok(()) => Reply::Ack,
-            Err(e) => Reply::Error(e),
-        };
-        assert_eq!(&got, rep);
-    }
-    // Row 1 blocked from x 1 to 3, then (2, 1) cleared: cells 5 and 7 blocked ((3, 1) again).
-    assert_eq!(map[0], 0xA0);
-    assert_eq!(map[1] & 0x0F, 0);
-}
-
-#[test]
-#[ignore = "prints the examples of docs/PROTOCOL.md, Big maps and cell updates"]
-fn print_protocol_doc_map_examples() {
-    let hex = |b: &[u8]| {
-        b.iter()
-            .map(|x| format!("{x:02x}"))
-            .collect::<Vec<_>>()
-            .join(" ")
-    };
-    for (id, req, rep) in doc_examples() {
-        println!("\n# {req:?}");
-        let f = frame_of(id, &req);
-        println!("-> {:<48}; payload", hex(&payload(&f)));
-        println!("}}> {}", hex(&f));
-        println!("# {rep:?}");
-        let f = reply_frame_of(id, &rep);
-        println!("<- {:<48}; payload", hex(&payload(&f)));
-        println!("<{{ {}", hex(&f));
-    }
 }

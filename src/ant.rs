@@ -20,6 +20,7 @@
 use crate::bitmap;
 use crate::grid::{is_diagonal, neighbour, opposite, Dir, Moves, Point};
 use crate::heuristic::Heuristic;
+use crate::named::named;
 use crate::pheromone::{slot_offsets, Table};
 use crate::rng::Xoshiro128pp;
 use crate::route::Route;
@@ -40,31 +41,7 @@ pub enum DeadEnd {
     Die,
 }
 
-impl DeadEnd {
-    /// Both, default first.
-    pub const ALL: [DeadEnd; 2] = [DeadEnd::Backtrack, DeadEnd::Die];
-
-    /// Lower-case name (`"backtrack"`, `"die"`).
-    pub const fn name(self) -> &'static str {
-        match self {
-            DeadEnd::Backtrack => "backtrack",
-            DeadEnd::Die => "die",
-        }
-    }
-
-    /// Parse a name (case-insensitive).
-    pub fn from_name(s: &str) -> Option<Self> {
-        Self::ALL
-            .into_iter()
-            .find(|d| d.name().eq_ignore_ascii_case(s))
-    }
-}
-
-impl core::fmt::Display for DeadEnd {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        f.write_str(self.name())
-    }
-}
+named!(DeadEnd, "Both, default first.", [Backtrack => "backtrack", Die => "die"]);
 
 /// A finished walk.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -95,7 +72,7 @@ pub enum Lost {
 }
 
 /// Everything an ant reads; borrowed for one iteration.
-pub struct Colony<'g, 't, 'h> {
+pub struct Ant<'g, 't, 'h> {
     /// The map's allowed moves.
     pub moves: &'g Moves<'g>,
     /// Start cell.
@@ -130,7 +107,7 @@ fn pow_alpha(tau: f32, alpha: f32) -> f32 {
     }
 }
 
-impl Colony<'_, '_, '_> {
+impl Ant<'_, '_, '_> {
     /// Walk one ant. `tabu` is a bit set of at least `words(cells)` words (its content is
     /// replaced: it starts as the dead cells); `tour` receives the directions and bounds the path's
     /// length.
@@ -455,6 +432,7 @@ impl<'a> PathIndex<'a> {
 mod tests {
     use super::*;
     use crate::grid::Grid;
+    use crate::heuristic::Attraction;
     use crate::pheromone::Blocks;
 
     fn setup(rows: &[&str]) -> (Vec<u8>, u16, u16) {
@@ -484,10 +462,10 @@ mod tests {
         let g = Grid::new(w, h, &b).unwrap();
         let mut tau_buf = vec![[1.0f32; 4]; g.cells()];
         let tau = Table::new(Blocks::new(w, h), &mut tau_buf);
-        let heur = Heuristic::new(goal, true, a, 1.0, 2.0);
+        let heur = Heuristic::new(goal, Some(Attraction { a, xi: 1.0 }), 2.0);
         let moves = Moves::new(g, &[]);
         let dead = vec![0u32; bitmap::words(g.cells())];
-        let c = Colony {
+        let c = Ant {
             moves: &moves,
             start,
             goal,

@@ -1,0 +1,230 @@
+//! Messages: every request and reply round trips, the largest fit their limits, a streamed path
+//! is byte-exact, and the planner's errors map to wire codes and back.
+
+use super::*;
+
+#[test]
+fn every_request_round_trips() {
+    for (i, r) in requests().into_iter().enumerate() {
+        let id = i as u32 * 0x0101_0101;
+        let mut f = enc_req(id, &r);
+        assert_eq!(f.pop(), Some(0));
+        assert!(!f.contains(&0));
+        assert_eq!(decode_request(&mut f).unwrap(), (id, r));
+    }
+}
+
+#[test]
+fn every_reply_round_trips() {
+    for (i, r) in replies().into_iter().enumerate() {
+        let id = u32::MAX - i as u32;
+        let mut f = enc_rep(id, &r);
+        assert_eq!(f.pop(), Some(0));
+        let (got_id, got) = decode_reply(&mut f).unwrap();
+        assert_eq!((got_id, got), (id, r));
+        if let Reply::Path(p) = got {
+            // Received waypoints come back packed and read the same.
+            assert!(matches!(p.waypoints, Waypoints::Packed(_)));
+            if !p.waypoints.is_empty() {
+                assert_eq!(p.waypoints.iter().collect::<Vec<_>>(), WPTS);
+                assert_eq!(p.waypoints.get(2), Some(Point::new(3, 2)));
+                assert_eq!(p.waypoints.get(3), None);
+            }
+        }
+    }
+}
+
+#[test]
+fn largest_messages_fit_their_limits() {
+    let chunk = [0xFFu8; MAX_CHUNK];
+    let big = Request::SetMap {
+        width: u16::MAX,
+        height: u16::MAX,
+        offset: u32::MAX,
+        total_len: u32::MAX,
+        chunk: &chunk,
+    };
+    let mut buf = [0u8; MAX_REQUEST_WIRE];
+    encode_request(u32::MAX, &big, &mut buf).unwrap();
+    let p = Params {
+        seed: u64::MAX,
+        ants: u16::MAX,
+        iterations: u16::MAX,
+        patience: u16::MAX,
+        warm_patience: u16::MAX,
+        ..Params::default()
+    };
+    encode_request(u32::MAX, &Request::SetParams(p), &mut buf).unwrap();
+
+    let wp = vec![Point::new(u16::MAX, u16::MAX); MAX_WAYPOINTS];
+    let dirs = vec![7u8; MAX_DIRECTIONS];
+    let r = Reply::Path(PathReply {
+        raw_length: f32::MAX,
+        length: f32::MAX,
+        turns: u32::MAX,
+        iterations: u16::MAX,
+        best_iteration: u16::MAX,
+        moves: u64::MAX,
+        ticks: u64::MAX,
+        raw_cells: u32::MAX,
+        warm: true,
+        waypoints: Waypoints::Points(&wp),
+        directions: &dirs,
+    });
+    let mut f = vec![0u8; MAX_REPLY_WIRE];
+    let n = encode_reply(u32::MAX, &r, &mut f).unwrap();
+    assert!(n <= MAX_REPLY_WIRE);
+    let mut reader = ReplyReader::new();
+    let mut got = None;
+    for &b in &f[..n] {
+        if let Feed::Frame(fr) = reader.push(b) {
+            got = Some(decode_reply(fr).map(|(id, r)| (id, format!("{r:?}"))));
+        }
+    }
+    assert_eq!(got.unwrap().unwrap(), (u32::MAX, format!("{r:?}")));
+}
+
+/// The frame [`PathStream`] produces, read `piece` bytes at a time.
+fn streamed(id: u32, p: &PathReply<'_>, piece: usize) -> Vec<u8> {
+    let mut s = PathStream::new(id, p).unwrap();
+    let mut out = vec![];
+    let mut buf = vec![0u8; piece];
+    while !s.is_done() {
+        let n = s.fill(&mut buf);
+        assert!(n == piece || s.is_done(), "a short piece before the end");
+        out.extend_from_slice(&buf[..n]);
+    }
+    assert_eq!(s.fill(&mut buf), 0);
+    assert!(s.is_done());
+    out
+}
+
+#[test]
+fn path_stream_is_byte_exact() {
+    let mut rng = Lcg(7);
+    // Lengths around COBS's 254-byte blocks, bytes with and without zeros, every id size.
+    let mut cases: Vec<(Vec<Point>, Vec<u8>)> = vec![
+        (vec![], vec![]),
+        (WPTS.to_vec(), DIRS.to_vec()),
+        (
+            vec![Point::new(u16::MAX, u16::MAX); MAX_WAYPOINTS],
+            vec![7; MAX_DIRECTIONS],
+        ),
+        (
+            vec![Point::new(0, 0); MAX_WAYPOINTS],
+            vec![0; MAX_DIRECTIONS],
+        ),
+    ];
+    for n in [
+        1usize, 60, 61, 62, 63, 64, 200, 250, 251, 252, 253, 254, 255, 256, 508, 509, 1000,
+    ] {
+        let pts = (0..n / 4 + 1)
+            .map(|_| Point::new(rng.next() as u16 % 300 + 1, rng.next() as u16 % 300 + 1))
+            .collect();
+        let dirs = (0..n).map(|_| rng.byte() % 8).collect();
+        cases.push((pts, dirs));
+        let dirs_nonzero = (0..n).map(|_| rng.byte() % 7 + 1).collect();
+        cases.push((vec![Point::new(257, 513)], dirs_nonzero));
+    }
+    for (i, (pts, dirs)) in cases.iter().enumerate() {
+        for id in [0, 1, 300, u32::MAX] {
+            let p = PathReply {
+                ticks: u64::from(rng.next()) << (i % 32),
+                moves: if i % 2 == 0 { 0 } else { u64::MAX },
+                raw_length: if i % 3 == 0 { 0.0 } else { 41.799 },
+                waypoints: Waypoints::Points(pts),
+                directions: dirs,
+                ..path()
+            };
+            let want = enc_rep(id, &Reply::Path(p));
+            for piece in [1, 2, 7, 64, 255, 256, 6000] {
+                assert_eq!(
+                    streamed(id, &p, piece),
+                    want,
+                    "case {i} id {id} piece {piece}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn path_stream_refuses_what_encode_reply_refuses() {
+    let wp = vec![Point::new(u16::MAX, u16::MAX); MAX_WAYPOINTS + 40];
+    let dirs = vec![7u8; MAX_DIRECTIONS];
+    let p = PathReply {
+        waypoints: Waypoints::Points(&wp),
+        directions: &dirs,
+        ..path()
+    };
+    let mut buf = vec![0u8; MAX_REPLY_WIRE];
+    let whole = encode_reply(1, &Reply::Path(p), &mut buf);
+    assert!(matches!(whole, Err(EncodeError::BufferTooSmall { .. })));
+    assert_eq!(PathStream::new(1, &p).err(), whole.err());
+}
+
+#[test]
+fn error_codes_map_the_planner_errors_both_ways() {
+    use crate::error::Endpoint::{Goal, Start};
+    // Every planner error with the wire code docs/PROTOCOL.md gives it.
+    let all = [
+        (Error::BadMap, 1),
+        (
+            Error::MapTooLarge {
+                cells: 2000,
+                capacity: 1024,
+            },
+            2,
+        ),
+        (Error::OutOfBounds(Start), 3),
+        (Error::OutOfBounds(Goal), 4),
+        (Error::Blocked(Start), 5),
+        (Error::Blocked(Goal), 6),
+        (Error::BadParam(Param::Tau), 7),
+        (Error::NoPath, 8),
+        (Error::Cancelled, 9),
+        (Error::NoAntArrived, 10),
+    ];
+    for (e, code) in all {
+        let reply = ErrorReply::from(e);
+        assert_eq!(reply.code.code(), code, "{e:?}");
+        assert_eq!(Error::try_from(reply), Ok(e), "{e:?}");
+    }
+    for p in Param::ALL {
+        let e = Error::BadParam(p);
+        assert_eq!(Error::try_from(ErrorReply::from(e)), Ok(e));
+    }
+    // The protocol's own codes, and a parameter number out of range, are no planner error.
+    for c in ErrorCode::ALL.into_iter().filter(|c| c.code() >= 16) {
+        assert_eq!(Error::try_from(ErrorReply::new(c)), Err(ErrorReply::new(c)));
+    }
+    let bad = ErrorReply::with(ErrorCode::BadParam, 9, 0);
+    assert_eq!(Error::try_from(bad), Err(bad));
+    assert_eq!(
+        ErrorReply::from(Error::MapTooLarge {
+            cells: 2000,
+            capacity: 1024
+        }),
+        ErrorReply::with(ErrorCode::MapTooLarge, 2000, 1024)
+    );
+    assert_eq!(
+        ErrorReply::from(Error::BadParam(Param::Rho)),
+        ErrorReply::with(ErrorCode::BadParam, 4, 0)
+    );
+    for (i, c) in ErrorCode::ALL.iter().enumerate() {
+        assert_eq!(ErrorCode::from_code(c.code()), Some(*c));
+        assert!(!c.to_string().is_empty());
+        if i > 0 {
+            assert!(ErrorCode::ALL[i - 1].code() < c.code());
+        }
+    }
+    assert_eq!(ErrorCode::try_from(0u8), Err(UnknownCode(0)));
+    assert_eq!(
+        ErrorReply::with(ErrorCode::MapTooLarge, 2000, 1024).to_string(),
+        "map too large (2000 cells, capacity 1024)"
+    );
+    assert_eq!(
+        DecodeError::TooLarge { len: 9, max: 8 }.to_string(),
+        "frame of 9 bytes exceeds the limit of 8"
+    );
+}

@@ -1,0 +1,255 @@
+//! Tests of the local search: validity, never longer, exactness in one window, budgets and
+//! resuming, determinism.
+
+use super::*;
+
+fn grid(rows: &[&str]) -> (Vec<u8>, u16, u16) {
+    crate::testutil::bits(rows)
+}
+
+fn open(w: usize, h: usize) -> (Vec<u8>, u16, u16) {
+    (vec![0u8; (w * h).div_ceil(8)], w as u16, h as u16)
+}
+
+struct Heapless {
+    g: Vec<u32>,
+    f: Vec<u32>,
+    link: Vec<u8>,
+    heap: Vec<u16>,
+    pos: Vec<u16>,
+}
+
+impl Heapless {
+    fn new(cells: usize, fill: u8) -> Self {
+        Heapless {
+            g: vec![u32::from(fill) * 0x0101_0101; cells],
+            f: vec![u32::from(fill) * 0x0101_0101; cells],
+            link: vec![fill; cells],
+            heap: vec![u16::from(fill); cells],
+            pos: vec![u16::from(fill); cells],
+        }
+    }
+    fn scratch(&mut self) -> Scratch<'_> {
+        Scratch {
+            g: &mut self.g,
+            f: &mut self.f,
+            link: &mut self.link,
+            heap: &mut self.heap,
+            pos: &mut self.pos,
+        }
+    }
+}
+
+/// Length in search units; panics unless `p` is a valid path on `g`.
+fn cost(g: &Grid<'_>, p: &[Point]) -> u32 {
+    assert!(g.is_free(p[0]));
+    p.windows(2)
+        .map(|s| {
+            let d = dir_between(s[0], s[1]).expect("neighbours");
+            assert_eq!(g.step(s[0], d), Some(s[1]), "illegal step {s:?}");
+            step_cost(s[0], s[1])
+        })
+        .sum()
+}
+
+fn run(g: &Grid<'_>, path: &[Point], cells: usize) -> (Vec<Point>, Budget) {
+    let mut out = vec![Point::default(); path.len() + 16];
+    let mut s = Heapless::new(cells, 0xA5);
+    let mut b = Budget::unlimited();
+    let k = refine(g, path, &mut out, s.scratch(), &mut b).unwrap();
+    out.truncate(k);
+    assert_eq!(out[0], path[0]);
+    assert_eq!(out[k - 1], *path.last().unwrap());
+    assert!(cost(g, &out) <= cost(g, path));
+    (out, b)
+}
+
+/// A path that walks `dirs` from `start`.
+fn walk(start: Point, dirs: &[u8]) -> Vec<Point> {
+    let mut p = vec![start];
+    for &d in dirs {
+        let q = *p.last().unwrap();
+        p.push(Point::new(
+            (i32::from(q.x) + DX[d as usize]) as u16,
+            (i32::from(q.y) + DY[d as usize]) as u16,
+        ));
+    }
+    p
+}
+
+#[test]
+fn detour_becomes_the_optimum_inside_one_window() {
+    // Around a wall: down, right along the bottom, up; the optimum hugs the wall's end.
+    let rows = [
+        "..........",
+        "..........",
+        "....#.....",
+        "....#.....",
+        "....#.....",
+        "..........",
+        "..........",
+        "..........",
+    ];
+    let (b, w, h) = grid(&rows);
+    let g = Grid::new(w, h, &b).unwrap();
+    // (1,3) -> down to row 7, right to x 8, up to (8,3).
+    let mut dirs = vec![2u8; 4];
+    dirs.extend([0u8; 7]);
+    dirs.extend([6u8; 4]);
+    let path = walk(Point::new(1, 3), &dirs);
+    let (out, b) = run(&g, &path, 64 * 64);
+    // Optimum (over or under the wall): 4 diagonals and 3 straight steps.
+    assert_eq!(cost(&g, &out), 4 * DIAGONAL + 3 * STRAIGHT, "{out:?}");
+    assert!(b.improved >= 1 && b.expanded > 0);
+}
+
+#[test]
+fn long_zigzag_on_a_map_wider_than_the_window() {
+    // 300 x 12 open map; the path zigzags between rows 2 and 8 all the way.
+    let (b, w, h) = open(300, 12);
+    let g = Grid::new(w, h, &b).unwrap();
+    let mut dirs = vec![];
+    for k in 0..50 {
+        let d = if k % 2 == 0 { 1 } else { 7 }; // SE / NE
+        dirs.extend([d; 5]);
+    }
+    dirs.extend([0; 49]);
+    let path = walk(Point::new(0, 2), &dirs);
+    assert_eq!(path.last().unwrap(), &Point::new(299, 2));
+    let (out, b) = run(&g, &path, 32 * 32);
+    // Straight along row 2 is the optimum. Windows see only local pieces: a one-row offset
+    // whose two diagonals lie further apart than a window can stay (each costs
+    // `DIAGONAL - STRAIGHT` extra); the zigzag itself (100 diagonals) is gone.
+    let opt = 299 * STRAIGHT;
+    let c = cost(&g, &out);
+    let ys: Vec<(u16, u16)> = out
+        .windows(2)
+        .filter(|w| w[0].y != w[1].y)
+        .map(|w| (w[0].x, w[0].y))
+        .collect();
+    assert!(
+        c <= opt + 8 * (DIAGONAL - STRAIGHT),
+        "{c} vs {opt} {b:?} {ys:?}"
+    );
+    assert!(c < cost(&g, &path) - 90 * (DIAGONAL - STRAIGHT));
+    // Linear: windows are a small multiple of path / window.
+    assert!(b.windows < 4 * 2 * (path.len() as u32 / 8), "{b:?}");
+}
+
+#[test]
+fn never_longer_and_deterministic_whatever_the_scratch_held() {
+    let rows = [
+        "....#.......#.....",
+        "..#.#..###..#..#..",
+        "..#....#.......#..",
+        "..####.#.#####.#..",
+        ".......#.....#....",
+    ];
+    let (b, w, h) = grid(&rows);
+    let g = Grid::new(w, h, &b).unwrap();
+    // A wandering but valid path: BFS-free hand walk along row 4 then up the right side.
+    let mut dirs = vec![0u8; 6]; // (0,4) -> (6,4)
+    dirs.extend([6u8; 4]); // up to (6,0)
+    dirs.extend([0u8; 5]); // -> (11,0)
+    dirs.extend([2u8, 2]); // (11,2)
+    dirs.extend([0u8; 3]); // (14,2)
+    dirs.extend([2u8, 2]); // (14,4)
+    dirs.extend([0u8; 3]); // (17,4)
+    let path = walk(Point::new(0, 4), &dirs);
+    let (a, _) = run(&g, &path, 64 * 64);
+    for fill in [0u8, 0xFF, 0x3C] {
+        let mut out = vec![Point::new(7, 7); path.len() + 3];
+        let mut s = Heapless::new(64 * 64, fill);
+        let k = refine(&g, &path, &mut out, s.scratch(), &mut Budget::unlimited()).unwrap();
+        assert_eq!(&out[..k], &a[..]);
+    }
+    // Whole map in one window: the exact optimum, and fewer cells.
+    assert!(cost(&g, &a) < cost(&g, &path));
+}
+
+#[test]
+fn too_little_scratch_returns_the_input() {
+    let (b, w, h) = open(20, 20);
+    let g = Grid::new(w, h, &b).unwrap();
+    let path = walk(Point::new(0, 0), &[0, 2, 0, 2, 0, 2, 0, 2]);
+    let (out, bud) = run(&g, &path, MIN_SIDE * MIN_SIDE - 1);
+    assert_eq!(out, path);
+    assert_eq!(bud, Budget::unlimited());
+    // One more cell side and it works.
+    let (out, _) = run(&g, &path, MIN_SIDE * MIN_SIDE);
+    assert_eq!(cost(&g, &out), 4 * DIAGONAL);
+}
+
+#[test]
+fn bad_inputs_are_errors() {
+    let (b, w, h) = open(8, 8);
+    let g = Grid::new(w, h, &b).unwrap();
+    let mut out = vec![Point::default(); 8];
+    let mut s = Heapless::new(64, 0);
+    let mut bud = Budget::unlimited();
+    let jump = [Point::new(0, 0), Point::new(2, 0)];
+    assert_eq!(
+        refine(&g, &jump, &mut out, s.scratch(), &mut bud),
+        Err(Error::NoPath)
+    );
+    assert_eq!(
+        refine(&g, &[], &mut out, s.scratch(), &mut bud),
+        Err(Error::NoPath)
+    );
+    let off = [Point::new(8, 0)];
+    assert_eq!(
+        refine(&g, &off, &mut out, s.scratch(), &mut bud),
+        Err(Error::NoPath)
+    );
+    let long = walk(Point::new(0, 0), &[0; 7]);
+    assert_eq!(
+        refine(&g, &long, &mut out[..7], s.scratch(), &mut bud),
+        Err(Error::MapTooLarge {
+            cells: 8,
+            capacity: 7
+        })
+    );
+    // A single cell is a path.
+    assert_eq!(
+        refine(&g, &long[..1], &mut out, s.scratch(), &mut bud),
+        Ok(1)
+    );
+}
+
+#[test]
+fn a_budget_stops_and_resumes_to_the_same_result() {
+    let (b, w, h) = open(200, 30);
+    let g = Grid::new(w, h, &b).unwrap();
+    let mut dirs = vec![];
+    for k in 0..39 {
+        dirs.extend(if k % 2 == 0 {
+            [1u8, 1, 0, 0, 0]
+        } else {
+            [7u8, 7, 0, 0, 0]
+        });
+    }
+    let path = walk(Point::new(0, 5), &dirs);
+    let (whole, total) = run(&g, &path, 24 * 24);
+    let mut out = vec![Point::default(); path.len() + 16];
+    let mut s = Heapless::new(24 * 24, 0);
+    let mut r = Refiner::new(&g, &path, &mut out, DEFAULT_PASSES).unwrap();
+    let mut calls = 0;
+    let mut spent = Budget::unlimited();
+    loop {
+        let mut bud = Budget::new(50);
+        calls += 1;
+        let done = r.resume(&g, &mut out, &mut s.scratch(), &mut bud);
+        // Stops at most one window past the limit.
+        assert!(bud.expanded < 50 + 24 * 24);
+        spent.expanded += bud.expanded;
+        spent.windows += bud.windows;
+        if done {
+            break;
+        }
+    }
+    let k = r.finish(&mut out);
+    assert_eq!(&out[..k], &whole[..]);
+    assert_eq!(spent.expanded, total.expanded);
+    assert_eq!(spent.windows, total.windows);
+    assert!(calls > 3, "{calls}");
+}
