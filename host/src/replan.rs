@@ -319,7 +319,9 @@ pub fn drive(
     let mut robot = start;
     let mut trail = vec![start];
     let mut steps: Vec<Step> = Vec::new();
-    steps.push(plan_step(planner, robot, goal, &map, changed, blocked, false)?);
+    steps.push(plan_step(
+        planner, robot, goal, &map, changed, blocked, false,
+    )?);
     for (i, e) in scenario.events.iter().enumerate() {
         let path = steps.last().map(|s| s.plan.raw.clone()).unwrap_or_default();
         // The robot drives `at` of its path (its last cell is the goal: stop one short).
@@ -435,8 +437,7 @@ pub fn check(map: &Map, start: Point, goal: Point, raw: &[Point]) -> Result<(), 
     if raw.first() != Some(&start) || raw.last() != Some(&goal) {
         return Err("the path does not join start and goal".into());
     }
-    for w in raw.windows(2) {
-        let (a, b) = (w[0], w[1]);
+    for (&a, &b) in raw.iter().zip(raw.iter().skip(1)) {
         let ok = (0..8u8).any(|d| grid.step(a, d) == Some(b));
         if !ok {
             return Err(format!(
@@ -509,10 +510,8 @@ mod tests {
     #[test]
     fn a_wall_ahead_makes_the_robot_replan_around_it() {
         let map = open(24, 24);
-        let sc = Scenario::parse(
-            r#"{"events":[{"at":0.3,"wall_ahead":{"cells":7,"ahead":4}}]}"#,
-        )
-        .unwrap();
+        let sc = Scenario::parse(r#"{"events":[{"at":0.3,"wall_ahead":{"cells":7,"ahead":4}}]}"#)
+            .unwrap();
         for warm in [false, true] {
             let mut p = HostPlanner::new(Params::default());
             let ends = (Point::new(1, 12), Point::new(22, 12));
@@ -539,7 +538,7 @@ mod tests {
         )
         .unwrap();
         let ends = (Point::new(0, 0), Point::new(19, 19));
-        let mut host = || HostPlanner::new(Params::default());
+        let host = || HostPlanner::new(Params::default());
         let cold = drive(&sc, &map, ends, &mut host(), false).unwrap();
         let warm = drive(&sc, &map, ends, &mut host(), true).unwrap();
         assert_eq!(cold.steps[0].plan, warm.steps[0].plan);

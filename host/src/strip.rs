@@ -40,7 +40,10 @@ impl Canvas {
     fn cell(&mut self, p: Point, c: Rgb<u8>) {
         for dy in 0..self.s {
             for dx in 0..self.s {
-                let (x, y) = (self.x0 + u32::from(p.x) * self.s + dx, u32::from(p.y) * self.s + dy);
+                let (x, y) = (
+                    self.x0 + u32::from(p.x) * self.s + dx,
+                    u32::from(p.y) * self.s + dy,
+                );
                 if x < self.img.width() && y < self.img.height() {
                     self.img.put_pixel(x, y, c);
                 }
@@ -77,8 +80,8 @@ impl Canvas {
 
     /// A polyline through cell centres, `w` pixels wide.
     fn line(&mut self, pts: &[Point], w: i64, c: Rgb<u8>) {
-        for seg in pts.windows(2) {
-            let (a, b) = (self.centre(seg[0]), self.centre(seg[1]));
+        for (&p, &q) in pts.iter().zip(pts.iter().skip(1)) {
+            let (a, b) = (self.centre(p), self.centre(q));
             let n = (b.0 - a.0).abs().max((b.1 - a.1).abs()).max(1);
             for i in 0..=n {
                 let x = a.0 + (b.0 - a.0) * i / n;
@@ -117,30 +120,31 @@ fn plan_positions(drive: &Drive) -> Vec<usize> {
 
 /// Draw the picture of the drive at trail index `t` (plan `k` active) onto `c`.
 fn scene(c: &mut Canvas, drive: &Drive, at: &[usize], k: usize, t: usize, goal: Point) {
-    let Some(step) = drive.steps.get(k) else {
+    let (Some(step), Some(&here)) = (drive.steps.get(k), at.get(k)) else {
         return;
     };
     c.map(&step.map);
     let w = i64::from((c.s / 3).max(1));
+    let r = i64::from((c.s / 2).max(2));
     for s in drive.steps.iter().take(k + 1) {
         for &p in &s.changed {
-            c.cell(p, if s.blocked { ADDED } else { CLEARED });
+            // A little larger than a cell, so a one-cell wall shows on a 1000-cell map.
+            c.dot(p, r, if s.blocked { ADDED } else { CLEARED });
         }
     }
-    if t == at[k] && k > 0 {
+    if t == here && k > 0 {
         // The moment of the replan: the plan it drops.
-        if let Some(prev) = drive.steps.get(k - 1) {
-            let from = t - at[k - 1];
+        if let (Some(prev), Some(&there)) = (drive.steps.get(k - 1), at.get(k - 1)) {
+            let from = t.saturating_sub(there);
             c.line(prev.plan.raw.get(from..).unwrap_or(&[]), w, OLD);
         }
     }
-    let from = t - at[k];
+    let from = t.saturating_sub(here);
     c.line(step.plan.raw.get(from..).unwrap_or(&[]), w, RAW);
     if from == 0 {
         c.line(&step.plan.waypoints, w + 1, SMOOTH);
     }
     c.line(drive.trail.get(..=t).unwrap_or(&[]), w + 1, TRAIL);
-    let r = i64::from((c.s / 2).max(2));
     c.dot(goal, r, GOAL);
     if let Some(&p) = drive.trail.get(t) {
         c.dot(p, r, TRAIL);
@@ -151,7 +155,10 @@ fn scene(c: &mut Canvas, drive: &Drive, at: &[usize], k: usize, t: usize, goal: 
 pub fn strip(drive: &Drive, goal: Point) -> Result<RgbImage, String> {
     let first = drive.steps.first().ok_or("no plans to draw")?;
     let s = scale(&first.map);
-    let (pw, ph) = (u32::from(first.map.width) * s, u32::from(first.map.height) * s);
+    let (pw, ph) = (
+        u32::from(first.map.width) * s,
+        u32::from(first.map.height) * s,
+    );
     let n = drive.steps.len() as u32;
     let mut c = Canvas {
         img: RgbImage::from_pixel(n * pw + (n - 1) * GAP, ph, Rgb([255, 255, 255])),
@@ -159,9 +166,9 @@ pub fn strip(drive: &Drive, goal: Point) -> Result<RgbImage, String> {
         x0: 0,
     };
     let at = plan_positions(drive);
-    for k in 0..drive.steps.len() {
+    for (k, &t) in at.iter().enumerate() {
         c.x0 = k as u32 * (pw + GAP);
-        scene(&mut c, drive, &at, k, at[k], goal);
+        scene(&mut c, drive, &at, k, t, goal);
     }
     Ok(c.img)
 }
@@ -177,7 +184,10 @@ pub fn save_strip(drive: &Drive, goal: Point, path: &Path) -> Result<(), String>
 pub fn save_gif(drive: &Drive, goal: Point, path: &Path) -> Result<(), String> {
     let first = drive.steps.first().ok_or("no plans to draw")?;
     let s = scale(&first.map).min(4);
-    let (pw, ph) = (u32::from(first.map.width) * s, u32::from(first.map.height) * s);
+    let (pw, ph) = (
+        u32::from(first.map.width) * s,
+        u32::from(first.map.height) * s,
+    );
     let at = plan_positions(drive);
     let stride = (drive.trail.len() / 60).max(1);
     let mut times: Vec<usize> = (0..drive.trail.len()).step_by(stride).collect();
@@ -197,10 +207,19 @@ pub fn save_gif(drive: &Drive, goal: Point, path: &Path) -> Result<(), String> {
             x0: 0,
         };
         scene(&mut c, drive, &at, k, t, goal);
-        let pause = if at.contains(&t) || t + 1 == drive.trail.len() { 900 } else { 80 };
+        let pause = if at.contains(&t) || t + 1 == drive.trail.len() {
+            900
+        } else {
+            80
+        };
         let rgba: RgbaImage = image::DynamicImage::ImageRgb8(c.img).to_rgba8();
-        enc.encode_frame(Frame::from_parts(rgba, 0, 0, Delay::from_numer_denom_ms(pause, 1)))
-            .map_err(|e| e.to_string())?;
+        enc.encode_frame(Frame::from_parts(
+            rgba,
+            0,
+            0,
+            Delay::from_numer_denom_ms(pause, 1),
+        ))
+        .map_err(|e| e.to_string())?;
     }
     Ok(())
 }

@@ -62,7 +62,10 @@ fn warm_and_cold_replans_on_the_device_are_the_host_cores() {
             let host = drive(&sc, &map, ends, &mut HostPlanner::new(p), warm).expect("host");
             let d = drive(&sc, &map, ends, &mut dev, warm).expect("device");
             assert_same_drive(&what, &host, &d);
-            assert!(!d.steps[0].plan.warm, "{what}: the first plan after an upload is cold");
+            assert!(
+                !d.steps[0].plan.warm,
+                "{what}: the first plan after an upload is cold"
+            );
             assert_eq!(d.steps[1].plan.warm, warm, "{what}");
             assert!(!d.steps[1].changed.is_empty(), "{what}");
         }
@@ -113,7 +116,10 @@ fn plan_warm_keeps_the_colony_only_for_the_same_goal_and_map() {
     assert!(!warm(&mut link, g), "no colony yet");
     assert!(warm(&mut link, g), "same goal");
     assert!(!warm(&mut link, other), "another goal");
-    assert!(!warm(&mut link, g), "back to the first goal: its colony was replaced");
+    assert!(
+        !warm(&mut link, g),
+        "back to the first goal: its colony was replaced"
+    );
     // A refused plan (start on an obstacle) leaves the colony alone.
     let blocked = (0..26)
         .flat_map(|y| (0..26).map(move |x| Point::new(x, y)))

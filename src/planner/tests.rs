@@ -279,7 +279,8 @@ fn warm_runs_stop_after_the_warm_patience_and_stay_valid() {
         let first = Run::warm(&g, Point::new(0, 0), goal, &p, st.workspace(), &mut memory).unwrap();
         let (_, warm, _) = run_to_end(first);
         assert!(!warm);
-        let mut run = Run::warm(&g, Point::new(0, 5), goal, &p, st.workspace(), &mut memory).unwrap();
+        let mut run =
+            Run::warm(&g, Point::new(0, 5), goal, &p, st.workspace(), &mut memory).unwrap();
         assert!(run.is_warm());
         while run.step() {}
         let best = run.best_iteration().unwrap();
@@ -288,7 +289,14 @@ fn warm_runs_stop_after_the_warm_patience_and_stay_valid() {
         assert_eq!(plan.iterations, best + warm_patience + 1);
         assert_eq!(plan.raw().last(), Some(goal));
         // Another goal: cold, with the cold patience.
-        let run = Run::warm(&g, Point::new(0, 5), Point::new(7, 0), &p, st.workspace(), &mut memory);
+        let run = Run::warm(
+            &g,
+            Point::new(0, 5),
+            Point::new(7, 0),
+            &p,
+            st.workspace(),
+            &mut memory,
+        );
         assert!(!run.unwrap().is_warm());
     }
 }

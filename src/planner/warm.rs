@@ -225,7 +225,9 @@ mod tests {
             for bx in 0..32u16 {
                 let e = tau.entries()[usize::from(by) * 32 + usize::from(bx)];
                 let near = (lo..=hi).contains(&bx) && (lo..=hi).contains(&by);
-                let want = if near { [1.0; 4] } else if (bx, by) == (0, 0) {
+                let want = if near {
+                    [1.0; 4]
+                } else if (bx, by) == (0, 0) {
                     [100.0, 0.01, 7.0, 7.0]
                 } else {
                     [50.0; 4]

@@ -23,7 +23,7 @@ use super::{bad_input, print};
 pub struct Args {
     #[command(flatten)]
     pub input: MapArgs,
-    /// The changes: a JSON file (see `docs/REPLANNING.md`)
+    /// The changes: a JSON file (see `docs/HOST.md`, `ohaca replan`)
     #[arg(long, value_name = "FILE")]
     pub events: PathBuf,
     /// Plan on a device over TCP, e.g. QEMU's UART (default: the host core)
@@ -131,9 +131,9 @@ fn table(rows: &[Row]) -> String {
             .ticks
             .map_or("-".to_string(), |t| format!("{:.2} M", t as f64 / 1000.0));
         let opt = r.optimum.map_or("-".into(), |o| format!("{o:.2}"));
-        let ratio = r
-            .optimum
-            .map_or("-".into(), |o| format!("{:.4}", f64::from(r.raw_length) / o));
+        let ratio = r.optimum.map_or("-".into(), |o| {
+            format!("{:.4}", f64::from(r.raw_length) / o)
+        });
         out += &format!(
             "{:<5} {:<5} {:<11} {:<12} {:<5} {:<11} {:<10} {:<13} {:<7.2} {:<9.2} {:<8} {}\n",
             r.mode,
@@ -205,7 +205,10 @@ pub fn run(args: &Args) -> u8 {
     }
     if let Some(d) = &last {
         for (path, save) in [
-            (&args.png, strip::save_strip as fn(&Drive, Point, &std::path::Path) -> _),
+            (
+                &args.png,
+                strip::save_strip as fn(&Drive, Point, &std::path::Path) -> _,
+            ),
             (&args.gif, strip::save_gif),
         ] {
             if let Some(path) = path {
@@ -222,12 +225,22 @@ pub fn run(args: &Args) -> u8 {
 /// raw length.
 fn summary(rows: &[Row]) -> String {
     let mut out = String::new();
-    let cold: Vec<&Row> = rows.iter().filter(|r| r.mode == "cold" && r.plan > 0).collect();
-    let warm: Vec<&Row> = rows.iter().filter(|r| r.mode == "warm" && r.plan > 0).collect();
+    let cold: Vec<&Row> = rows
+        .iter()
+        .filter(|r| r.mode == "cold" && r.plan > 0)
+        .collect();
+    let warm: Vec<&Row> = rows
+        .iter()
+        .filter(|r| r.mode == "warm" && r.plan > 0)
+        .collect();
     for (c, w) in cold.iter().zip(&warm) {
         let cost = match (c.ticks, w.ticks) {
-            (Some(ct), Some(wt)) if ct > 0 => format!("instructions {:.1} %", 100.0 * wt as f64 / ct as f64),
-            _ if c.moves > 0 => format!("ant moves {:.1} %", 100.0 * w.moves as f64 / c.moves as f64),
+            (Some(ct), Some(wt)) if ct > 0 => {
+                format!("instructions {:.1} %", 100.0 * wt as f64 / ct as f64)
+            }
+            _ if c.moves > 0 => {
+                format!("ant moves {:.1} %", 100.0 * w.moves as f64 / c.moves as f64)
+            }
             _ => "-".into(),
         };
         out += &format!(
