@@ -12,8 +12,8 @@ pub mod wire_frame;
 use arbitrary::{Arbitrary, Unstructured};
 use ohaca::geometry::{polyline_length, segment_clear, steps_length};
 use ohaca::grid::{is_diagonal, Grid, Point};
-use ohaca::planner::{Buffers, CurvePoint, Workspace};
-use ohaca::{plan, Algorithm, DeadEnd, Error, Params, SmoothingKind};
+use ohaca::planner::{Area, Buffers, CurvePoint, Memory, Plan, Run, Workspace};
+use ohaca::{Algorithm, DeadEnd, Error, Params, SmoothingKind};
 
 /// A planner input: a small map, endpoints and parameters including extremes.
 #[derive(Debug)]
@@ -24,6 +24,16 @@ pub struct PlannerInput {
     pub start: Point,
     pub goal: Point,
     pub params: Params,
+    /// A replan after the first plan: cells flipped (blocked or cleared), then `PlanWarm` from a
+    /// new start to the same goal, on the colony the first plan left.
+    pub replan: Option<Replan>,
+}
+
+/// Cell changes and a warm replan (see [`PlannerInput::replan`]).
+#[derive(Debug)]
+pub struct Replan {
+    pub changes: Vec<(Point, bool)>,
+    pub start: Point,
 }
 
 fn pick_f32(u: &mut Unstructured<'_>, choices: &[f32]) -> arbitrary::Result<f32> {
@@ -81,6 +91,18 @@ impl<'a> Arbitrary<'a> for PlannerInput {
             tighten: bool::arbitrary(u)?,
             prune: bool::arbitrary(u)?,
         };
+        let replan = if bool::arbitrary(u)? {
+            let n = u.int_in_range(0..=12usize)?;
+            let mut changes = Vec::with_capacity(n);
+            for _ in 0..n {
+                let p = Point::new(u.int_in_range(0..=width)?, u.int_in_range(0..=height)?);
+                changes.push((p, bool::arbitrary(u)?));
+            }
+            let start = Point::new(u.int_in_range(0..=width)?, u.int_in_range(0..=height)?);
+            Some(Replan { changes, start })
+        } else {
+            None
+        };
         Ok(PlannerInput {
             width,
             height,
@@ -88,16 +110,19 @@ impl<'a> Arbitrary<'a> for PlannerInput {
             start,
             goal,
             params,
+            replan,
         })
     }
 }
 
-/// Plan and check every promise the planner makes. Panics (= a fuzz finding) on a broken one.
+/// Plan and check every promise the planner makes, then (if asked) change cells and replan warm
+/// on the same buffers and check again. Panics (= a fuzz finding) on a broken promise.
 pub fn check_planner(input: &PlannerInput) {
-    let Ok(grid) = Grid::new(input.width, input.height, &input.bits) else {
+    let (w, h) = (input.width, input.height);
+    if Grid::new(w, h, &input.bits).is_err() {
         return;
-    };
-    let cells = grid.cells();
+    }
+    let cells = usize::from(w) * usize::from(h);
     let blocks = cells.min(ohaca::pheromone::BLOCKS);
     let guide = ohaca::route::GUIDE_BLOCKS;
     let mut tau = vec![[0f32; 4]; blocks];
@@ -110,27 +135,79 @@ pub fn check_planner(input: &PlannerInput) {
     let mut links = vec![0u32; cells.max(guide)];
     let mut curve = vec![CurvePoint::default(); 16];
     let mut guide_words = vec![0u32; guide];
-    let [t0, t1, t2, t3] = &mut tours[..] else {
-        return;
-    };
-    let ws = Workspace::new(Buffers {
-        tau: &mut tau,
-        delta: &mut delta,
-        tabu: &mut tabu,
-        dead: &mut dead,
-        moves: &mut moves,
-        tours: [t0, t1, t2, t3],
-        points: &mut points,
-        links: &mut links,
-        curve: &mut curve,
-        guide: &mut guide_words,
-    });
+    let mut bits = input.bits.clone();
+    let mut memory = Memory::new();
     let p = &input.params;
-    match plan(&grid, input.start, input.goal, p, ws) {
+    let rounds = [(input.start, false)]
+        .into_iter()
+        .chain(input.replan.as_ref().map(|r| (r.start, true)));
+    for (start, warm) in rounds {
+        if warm {
+            for &(c, blocked) in input.replan.iter().flat_map(|r| &r.changes) {
+                if c.x < w && c.y < h {
+                    let i = usize::from(c.y) * usize::from(w) + usize::from(c.x);
+                    if let Some(b) = bits.get_mut(i / 8) {
+                        if blocked {
+                            *b |= 1 << (i % 8);
+                        } else {
+                            *b &= !(1 << (i % 8));
+                        }
+                    }
+                    memory.changed(Area::cell(c));
+                }
+            }
+        }
+        let Ok(grid) = Grid::new(w, h, &bits) else {
+            return;
+        };
+        let [t0, t1, t2, t3] = &mut tours[..] else {
+            return;
+        };
+        let ws = Workspace::new(Buffers {
+            tau: &mut tau,
+            delta: &mut delta,
+            tabu: &mut tabu,
+            dead: &mut dead,
+            moves: &mut moves,
+            tours: [t0, t1, t2, t3],
+            points: &mut points,
+            links: &mut links,
+            curve: &mut curve,
+            guide: &mut guide_words,
+        });
+        let was_warm = memory.is_warm_for(w, h, input.goal);
+        let result = if warm {
+            Run::warm(&grid, start, input.goal, p, ws, &mut memory)
+        } else {
+            Run::cold(&grid, start, input.goal, p, ws, &mut memory)
+        }
+        .and_then(|mut run| {
+            assert_eq!(
+                run.is_warm(),
+                warm && was_warm,
+                "warm exactly when the memory matches"
+            );
+            while run.step() {}
+            run.finish()
+        });
+        check_result(&grid, start, input.goal, p, result);
+    }
+}
+
+/// Check one plan's result against every promise the planner makes.
+fn check_result(
+    grid: &Grid<'_>,
+    start: Point,
+    goal: Point,
+    p: &Params,
+    result: Result<Plan<'_>, Error>,
+) {
+    let cells = grid.cells();
+    match result {
         Ok(plan) => {
             let raw: Vec<Point> = plan.raw().collect();
-            assert_eq!(raw.first(), Some(&input.start));
-            assert_eq!(raw.last(), Some(&input.goal));
+            assert_eq!(raw.first(), Some(&start));
+            assert_eq!(raw.last(), Some(&goal));
             for (w, &d) in raw.windows(2).zip(plan.directions()) {
                 assert_eq!(
                     grid.step(w[0], d),
@@ -146,11 +223,11 @@ pub fn check_planner(input: &PlannerInput) {
             let straight = plan.directions().len() as u32 - diag;
             assert_eq!(plan.raw_length, steps_length(straight, diag));
             let wp = plan.waypoints();
-            assert_eq!(wp.first(), Some(&input.start));
-            assert_eq!(wp.last(), Some(&input.goal));
+            assert_eq!(wp.first(), Some(&start));
+            assert_eq!(wp.last(), Some(&goal));
             for s in wp.windows(2) {
                 assert!(
-                    segment_clear(&grid, s[0], s[1]),
+                    segment_clear(grid, s[0], s[1]),
                     "smoothed segment {s:?} touches an obstacle"
                 );
             }
@@ -181,8 +258,7 @@ pub fn check_planner(input: &PlannerInput) {
         Err(e @ (Error::NoPath | Error::NoAntArrived)) => {
             let mut m = vec![0u32; ohaca::bitmap::words(cells)];
             let mut q = vec![0u32; cells];
-            let reachable =
-                grid.reachable(input.start, input.goal, &mut m, &mut q) == ohaca::grid::Reach::Yes;
+            let reachable = grid.reachable(start, goal, &mut m, &mut q) == ohaca::grid::Reach::Yes;
             if e == Error::NoPath {
                 assert!(!reachable, "NoPath on a reachable goal");
             } else {
@@ -193,9 +269,9 @@ pub fn check_planner(input: &PlannerInput) {
             }
         }
         Err(Error::OutOfBounds(_)) => {
-            assert!(!grid.contains(input.start) || !grid.contains(input.goal))
+            assert!(!grid.contains(start) || !grid.contains(goal))
         }
-        Err(Error::Blocked(_)) => assert!(!grid.is_free(input.start) || !grid.is_free(input.goal)),
+        Err(Error::Blocked(_)) => assert!(!grid.is_free(start) || !grid.is_free(goal)),
         Err(e) => panic!("unexpected error {e}"),
     }
 }
