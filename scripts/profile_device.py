@@ -56,7 +56,8 @@ def run_session(trace, args):
             params[k] = float(v) if "." in v else int(v)
         expect(dev.call(req_set_params(params)), "Ack")
         goal = tuple(int(v) for v in args.goal.split(",")) if args.goal else (w - 1, h - 1)
-        r = expect(dev.call(req_plan((0, 0), goal, seed=args.seed)), "Path")
+        start = tuple(int(v) for v in args.start.split(","))
+        r = expect(dev.call(req_plan(start, goal, seed=args.seed)), "Path")
         return r
     finally:
         qemu.terminate()
@@ -104,6 +105,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--map", default=os.path.join(ROOT, "maps/complex-26.map"))
+    ap.add_argument("--start", default="0,0")
     ap.add_argument("--goal", help="default: the map's far corner")
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--param", action="append", default=[], help="e.g. patience=0")

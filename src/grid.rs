@@ -167,6 +167,36 @@ impl<'a> Grid<'a> {
         self.blocked_index(i)
     }
 
+    /// True if the cells `(x, y)` for `x` in `x0..=x1` are all on the map and free (also when the
+    /// run is empty, `x0 > x1`, and `y` is on the map). Reads the map a byte at a time.
+    pub fn run_free(&self, y: u16, x0: i32, x1: i32) -> bool {
+        if y >= self.height || x0 < 0 || x1 >= i32::from(self.width) {
+            return false;
+        }
+        if x0 > x1 {
+            return true;
+        }
+        // On the map: both indices are below `cells` (see the index note at the top).
+        let row = usize::from(y).wrapping_mul(usize::from(self.width));
+        let i0 = row.wrapping_add(x0 as usize);
+        let i1 = row.wrapping_add(x1 as usize);
+        let (b0, b1) = (i0 >> 3, i1 >> 3);
+        let first = 0xFFu8 << (i0 & 7) as u32;
+        let last = 0xFFu8 >> (7u32.wrapping_sub(i1 as u32) & 7); // 7 - i1 % 8
+        let byte = |k: usize| self.bits.get(k).copied().unwrap_or(0xFF);
+        if b0 == b1 {
+            return byte(b0) & first & last == 0;
+        }
+        if byte(b0) & first != 0 || byte(b1) & last != 0 {
+            return false;
+        }
+        // The whole bytes in between.
+        match self.bits.get(b0.wrapping_add(1)..b1) {
+            Some(mid) => mid.iter().all(|&m| m == 0),
+            None => false,
+        }
+    }
+
     /// Where move `d` from `p` leads, or `None` if the target is outside the map or blocked, or
     /// the move is a diagonal that would cut a corner.
     #[inline]
