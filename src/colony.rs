@@ -299,6 +299,9 @@ fn roulette(rng: &mut Xoshiro128pp, w: &[f32], total: f32) -> usize {
 /// with one entry per map cell it is indexed by cell; shorter, it is an open-addressing hash
 /// table over the path's cells, which needs a power of two of at least twice the path's cells
 /// (a longer path is returned untightened). Both give the same result.
+///
+/// `visited` is the walk's tabu set (every cell of the path is in it): a neighbour outside it is
+/// not on the path and is not looked up. An empty set looks up every neighbour; same result.
 pub fn tighten(
     moves: &Moves<'_>,
     start: Point,
@@ -306,6 +309,7 @@ pub fn tighten(
     tour: &mut [Dir],
     cells: &mut [Point],
     pos: &mut [u32],
+    visited: &[u32],
 ) -> Walk {
     let grid = moves.grid();
     // Cannot wrap for a real walk (steps < cells); were `steps` usize::MAX, `tour.get(..steps)`
@@ -343,6 +347,10 @@ pub fn tighten(
             let d = mask.trailing_zeros() as u8;
             mask &= mask.wrapping_sub(1);
             let nb = ci.wrapping_add_signed(offsets.get(usize::from(d)).copied().unwrap_or(0));
+            // Not visited: not on the path (a cell beyond the set reads as visited).
+            if !bitmap::get(visited, nb) {
+                continue;
+            }
             if let Some(j) = index.find(nb, |j| cells.get(j).map(|&q| grid.index(q))) {
                 if j > best.0 {
                     best = (j, d);
