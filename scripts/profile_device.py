@@ -46,7 +46,7 @@ def run_session(trace, args):
          "-icount", "shift=0", "-d", "in_asm,exec,nochain", "-D", trace, "-kernel", ELF],
         stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     try:
-        dev = Device("127.0.0.1", port)
+        dev = Device("127.0.0.1", port, timeout=900.0)  # tracing is slow
         hello = expect(dev.call(req_hello()), "Hello")
         w, h, bits, _ = load_map(args.map)
         expect(dev.set_map(w, h, bits), "Ack")

@@ -257,24 +257,30 @@ impl<'a> Grid<'a> {
         }
         // Interior: x - 1, y - 1 and the rows above and below exist. Each row's three bits start
         // at bit `(row * w + x - 1)`, which is below `cells`, so nothing here wraps.
-        let mut nb = 0usize;
-        let mut row = y
+        let top = y
             .wrapping_sub(1)
             .wrapping_mul(w)
             .wrapping_add(x)
             .wrapping_sub(1);
-        for r in 0..3usize {
-            let lo = self.bits.get(row >> 3).copied().unwrap_or(0xFF);
-            let hi = self
-                .bits
-                .get((row >> 3).wrapping_add(1))
-                .copied()
-                .unwrap_or(0xFF);
-            let three = ((usize::from(hi) << 8 | usize::from(lo)) >> (row & 7)) & 7;
-            nb |= three << r.wrapping_mul(3);
-            row = row.wrapping_add(w);
-        }
-        MASK9.get(nb).copied().unwrap_or(0)
+        let mid = top.wrapping_add(w);
+        let bottom = mid.wrapping_add(w);
+        let nb = self.three(top) | self.three(mid) << 3 | self.three(bottom) << 6;
+        MASK9.get(nb & 511).copied().unwrap_or(0)
+    }
+
+    /// The blocked bits of cells `i`, `i + 1`, `i + 2` (bits 0-2; beyond the map: blocked).
+    #[inline]
+    fn three(&self, i: usize) -> usize {
+        let b = i >> 3;
+        let pair = match self.bits.get(b..b.wrapping_add(2)) {
+            Some(&[lo, hi]) => usize::from(hi) << 8 | usize::from(lo),
+            // The last byte of the buffer (or none): what lies beyond reads as blocked.
+            _ => match self.bits.get(b) {
+                Some(&lo) => 0xFF00 | usize::from(lo),
+                None => 0xFFFF,
+            },
+        };
+        (pair >> (i & 7)) & 7
     }
 
     /// Flood fill from `start` over allowed moves: is `goal` reachable?
