@@ -289,6 +289,12 @@ impl<'a> Grid<'a> {
     /// of cell indices of any length. A breadth-first frontier longer than the ring cannot be
     /// held, and the answer is then [`Reach::Unknown`] (the planner's first backtracking ant
     /// decides instead).
+    ///
+    /// The fill follows the four straight moves only: a diagonal move is allowed only when both
+    /// cells beside it are free, and then the two straight moves through either of them reach the
+    /// same cell, so the cells reachable with the eight moves are exactly those reachable with the
+    /// four. The marks start as a copy of the map's blocked bits (the same bit order), so one
+    /// test-and-set per neighbour both skips obstacles and marks the cell.
     pub fn reachable(
         &self,
         start: Point,
@@ -301,10 +307,24 @@ impl<'a> Grid<'a> {
             return Reach::No;
         }
         let cap = queue.len();
-        if mark.len() < crate::bitmap::words(cells) || cap == 0 {
+        let Some(mark) = mark.get_mut(..crate::bitmap::words(cells)) else {
+            return Reach::Unknown;
+        };
+        if cap == 0 {
             return Reach::Unknown;
         }
-        crate::bitmap::clear(mark, cells);
+        // Blocked cells start marked (bytes beyond the buffer read as blocked; bits beyond the
+        // map are never asked about: the fill stays on the map).
+        for (k, m) in mark.iter_mut().enumerate() {
+            let b = k.wrapping_mul(4); // < bytes_for(cells) + 4: no wrap
+            *m = match self.bits.get(b..b.wrapping_add(4)) {
+                Some(&[b0, b1, b2, b3]) => u32::from_le_bytes([b0, b1, b2, b3]),
+                _ => {
+                    let byte = |i: usize| self.bits.get(b.wrapping_add(i)).copied().unwrap_or(0xFF);
+                    u32::from_le_bytes([byte(0), byte(1), byte(2), byte(3)])
+                }
+            };
+        }
         // Ring buffer: `head` is the next to pop, `len` how many are queued (both < cap).
         let (mut head, mut len) = (0usize, 0usize);
         let si = self.index(start);
@@ -314,7 +334,9 @@ impl<'a> Grid<'a> {
         }
         len = len.wrapping_add(1);
         let gi = self.index(goal);
-        let offsets = self.offsets();
+        let w = usize::from(self.width);
+        // Cells of the first and last row: no neighbour above / below.
+        let last_row = cells.wrapping_sub(w); // cells >= w
         while len > 0 {
             let Some(&i) = queue.get(head) else { break };
             head = head.wrapping_add(1);
@@ -326,13 +348,20 @@ impl<'a> Grid<'a> {
             if i == gi {
                 return Reach::Yes;
             }
-            let p = self.point(i);
-            let mut m = self.mask_at(p);
-            while m != 0 {
-                let d = m.trailing_zeros() as usize & 7;
-                m &= m.wrapping_sub(1);
-                // An allowed move: the neighbour is on the map, its index `i + offset`.
-                let ni = i.wrapping_add_signed(offsets.get(d).copied().unwrap_or(0));
+            // `w > 0` (checked in `Grid::new`), so the remainder exists.
+            let x = i.checked_rem(w).unwrap_or(0);
+            // W, E, N, S; a missing side repeats the cell itself (already marked).
+            let next = [
+                if x > 0 { i.wrapping_sub(1) } else { i },
+                if x.wrapping_add(1) < w {
+                    i.wrapping_add(1)
+                } else {
+                    i
+                },
+                if i >= w { i.wrapping_sub(w) } else { i },
+                if i < last_row { i.wrapping_add(w) } else { i },
+            ];
+            for ni in next {
                 if crate::bitmap::insert(mark, ni) {
                     if len == cap {
                         return Reach::Unknown;
@@ -513,6 +542,58 @@ mod tests {
             open.reachable(Point::new(0, 0), Point::new(7, 7), &mut m, &mut q),
             Reach::Unknown
         );
+    }
+
+    #[test]
+    fn flood_fill_agrees_with_eight_moves() {
+        // Random maps (about 40 % blocked), every start and goal: the four-move fill decides
+        // like a breadth-first search over the eight allowed moves.
+        let mut x = 0x2545_F491u32;
+        for (w, h) in [(10u16, 10u16), (7, 13), (16, 4)] {
+            for _ in 0..20 {
+                let cells = usize::from(w) * usize::from(h);
+                let mut b = vec![0u8; cells.div_ceil(8)];
+                for i in 0..cells {
+                    x ^= x << 13;
+                    x ^= x >> 17;
+                    x ^= x << 5;
+                    if x % 5 < 2 {
+                        b[i / 8] |= 1 << (i % 8);
+                    }
+                }
+                let g = Grid::new(w, h, &b).unwrap();
+                let mut mark = vec![0u32; crate::bitmap::words(cells)];
+                let mut queue = vec![0u32; cells];
+                for s in 0..cells {
+                    // Eight-move BFS from s.
+                    let mut seen = vec![false; cells];
+                    let mut todo = vec![g.point(s)];
+                    seen[s] = g.is_free(g.point(s));
+                    while let Some(p) = todo.pop() {
+                        if !g.is_free(p) {
+                            continue;
+                        }
+                        for d in 0..8 {
+                            if let Some(q) = g.step(p, d) {
+                                if !seen[g.index(q)] {
+                                    seen[g.index(q)] = true;
+                                    todo.push(q);
+                                }
+                            }
+                        }
+                    }
+                    for t in 0..cells {
+                        let want = if seen[t] && g.is_free(g.point(t)) {
+                            Reach::Yes
+                        } else {
+                            Reach::No
+                        };
+                        let got = g.reachable(g.point(s), g.point(t), &mut mark, &mut queue);
+                        assert_eq!(got, want, "{w}x{h} {:?} -> {:?}", g.point(s), g.point(t));
+                    }
+                }
+            }
+        }
     }
 
     #[test]
