@@ -20,7 +20,7 @@
 use crate::bitmap;
 use crate::grid::{is_diagonal, neighbour, opposite, Dir, Moves, Point};
 use crate::heuristic::Heuristic;
-use crate::pheromone::{slot_offsets, Table};
+use crate::pheromone::Table;
 use crate::rng::Xoshiro128pp;
 use crate::route::Route;
 
@@ -140,12 +140,29 @@ impl Colony<'_, '_, '_> {
         tabu: &mut [u32],
         tour: &mut [Dir],
     ) -> Result<Walk, Lost> {
+        // The common exponent gets its own copy of the loop, without a test per candidate;
+        // `pow_alpha(t, 1.0)` is `t`, so both give the same weights.
+        if self.alpha == 1.0 {
+            self.walk_with(rng, tabu, tour, |t| t)
+        } else {
+            let alpha = self.alpha;
+            self.walk_with(rng, tabu, tour, |t| pow_alpha(t, alpha))
+        }
+    }
+
+    /// [`Colony::walk`] with `tau^alpha` computed by `pow`.
+    #[inline(always)]
+    fn walk_with(
+        &self,
+        rng: &mut Xoshiro128pp,
+        tabu: &mut [u32],
+        tour: &mut [Dir],
+        pow: impl Fn(f32) -> f32,
+    ) -> Result<Walk, Lost> {
         let grid = self.moves.grid();
         bitmap::copy(tabu, self.dead, grid.cells());
         let offsets = grid.offsets();
-        let slots = slot_offsets(&offsets);
         let blocks = self.tau.blocks();
-        let per_cell = blocks.shift() == 0;
         let tau = self.tau.flat();
         let goal = grid.index(self.goal);
         let mut cur = self.start;
@@ -157,6 +174,9 @@ impl Colony<'_, '_, '_> {
         // The sub-goal changes only when the ant enters another block.
         let mut block = usize::MAX;
         let mut target = self.goal;
+        // Only the first `n` entries are read, each written first in the same step.
+        let mut cand_dir = [0u8; 8];
+        let mut cand_w = [0.0f32; 8];
         while ci != goal {
             let eta = match self.route {
                 None => self.heuristic.row(cur),
@@ -170,8 +190,7 @@ impl Colony<'_, '_, '_> {
                 }
             };
             let mut mask = self.moves.at(ci, cur);
-            let mut cand_dir = [0u8; 8];
-            let mut cand_w = [0.0f32; 8];
+            let edges = blocks.edges(cur);
             let mut n = 0usize;
             let mut total = 0.0f32;
             let mut seen = 0u32;
@@ -189,17 +208,10 @@ impl Colony<'_, '_, '_> {
                     }
                     continue;
                 }
-                let ti = if per_cell {
-                    // `ci` is a cell index and the table holds 16 bytes a cell in memory, so
-                    // `4 * ci` does not wrap (if it did, `get` would fail).
-                    ci.wrapping_mul(4)
-                        .wrapping_add_signed(slots.get(di).copied().unwrap_or(0))
-                } else {
-                    blocks.index(cur, di as u8)
-                };
+                let ti = edges.get(di).copied().unwrap_or(usize::MAX);
                 let t = tau.get(ti).copied().unwrap_or(0.0);
-                let w = pow_alpha(t, self.alpha) * eta.get(di);
-                if let (Some(cd), Some(cw)) = (cand_dir.get_mut(n), cand_w.get_mut(n)) {
+                let w = pow(t) * eta.get(di);
+                if let (Some(cd), Some(cw)) = (cand_dir.get_mut(n & 7), cand_w.get_mut(n & 7)) {
                     *cd = di as u8;
                     *cw = w;
                 }
