@@ -282,7 +282,9 @@ impl Colony<'_, '_, '_> {
 #[inline]
 fn roulette(rng: &mut Xoshiro128pp, w: &[f32], total: f32) -> usize {
     let n = w.len();
-    if !(total > 0.0 && total.is_finite()) {
+    // `0 < total <= MAX`: positive and finite (NaN fails both), with two float comparisons
+    // (`is_finite` compiles to integer bit tests on the M4).
+    if !(total > 0.0 && total <= f32::MAX) {
         // A 32-bit word times n <= 8 candidates: well below 2^64.
         return (u64::from(rng.next_word()).wrapping_mul(n as u64) >> 32) as usize;
     }
@@ -352,6 +354,14 @@ pub fn tighten(
     while i.wrapping_add(1) < n {
         let Some(&cp) = cells.get(i) else { break };
         let ci = grid.index(cp);
+        // The path's cells before and after this one are known without a look-up.
+        let prev = match i.checked_sub(1).and_then(|k| cells.get(k)) {
+            Some(&q) => grid.index(q),
+            None => usize::MAX,
+        };
+        let next = cells
+            .get(i.wrapping_add(1))
+            .map_or(usize::MAX, |&q| grid.index(q));
         let mut mask = moves.at(ci, cp);
         // Furthest later path cell one allowed move away (the next cell always qualifies).
         let mut best = (i, 0u8);
@@ -359,8 +369,15 @@ pub fn tighten(
             let d = mask.trailing_zeros() as u8;
             mask &= mask.wrapping_sub(1);
             let nb = ci.wrapping_add_signed(offsets.get(usize::from(d)).copied().unwrap_or(0));
-            // Not visited: not on the path (a cell beyond the set reads as visited).
-            if !bitmap::get(visited, nb) {
+            // Not visited: not on the path (a cell beyond the set reads as visited). The previous
+            // cell cannot be the furthest; the next one is at `i + 1` (cells are unique on a path).
+            if !bitmap::get(visited, nb) || nb == prev {
+                continue;
+            }
+            if nb == next {
+                if i.wrapping_add(1) > best.0 {
+                    best = (i.wrapping_add(1), d);
+                }
                 continue;
             }
             if let Some(j) = index.find(nb, |j| cells.get(j).map(|&q| grid.index(q))) {
