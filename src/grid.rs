@@ -147,6 +147,12 @@ impl<'a> Grid<'a> {
         }
     }
 
+    /// True if cell index `i` is blocked or beyond the map's bits.
+    #[inline]
+    pub fn blocked_at(&self, i: usize) -> bool {
+        self.blocked_index(i)
+    }
+
     /// True if `p` is inside the map and free.
     #[inline]
     pub fn is_free(&self, p: Point) -> bool {
