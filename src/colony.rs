@@ -349,11 +349,38 @@ pub fn tighten(
     let mut i = 0usize;
     let mut out = 0usize;
     let (mut straight, mut diagonal) = (0u32, 0u32);
+    let (width, height) = (usize::from(grid.width()), usize::from(grid.height()));
     // `i < n` throughout (it only ever becomes a valid index into `cells`), so no `wrapping_` below
     // wraps: `out <= i` and `straight + diagonal == out`.
     while i.wrapping_add(1) < n {
         let Some(&cp) = cells.get(i) else { break };
         let ci = grid.index(cp);
+        // Fast path, away from the map's border: when no neighbour but the path's previous and
+        // next cells was visited, the next cell is the furthest. `tour[i]` still holds the step
+        // from cell `i` to `i + 1` and `tour[i - 1]` the step into cell `i` (the output so far
+        // ends at index `out - 1 < i`, and its last step, if at `i - 1`, is that same step).
+        if let Some(&next_d) = tour.get(i) {
+            let (x, y) = (usize::from(cp.x), usize::from(cp.y));
+            if x > 0 && y > 0 && x.wrapping_add(1) < width && y.wrapping_add(1) < height {
+                let mut others = bitmap::around(visited, ci, width) & !(1u8 << (next_d & 7));
+                if let Some(&in_d) = i.checked_sub(1).and_then(|k| tour.get(k)) {
+                    others &= !(1u8 << (opposite(in_d) & 7));
+                }
+                if others == 0 {
+                    if let Some(slot) = tour.get_mut(out) {
+                        *slot = next_d;
+                    }
+                    out = out.wrapping_add(1);
+                    if is_diagonal(next_d) {
+                        diagonal = diagonal.wrapping_add(1);
+                    } else {
+                        straight = straight.wrapping_add(1);
+                    }
+                    i = i.wrapping_add(1);
+                    continue;
+                }
+            }
+        }
         // The path's cells before and after this one are known without a look-up.
         let prev = match i.checked_sub(1).and_then(|k| cells.get(k)) {
             Some(&q) => grid.index(q),
