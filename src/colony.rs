@@ -177,6 +177,8 @@ impl Colony<'_, '_, '_> {
         // Only the first `n` entries are read, each written first in the same step.
         let mut cand_dir = [0u8; 8];
         let mut cand_w = [0.0f32; 8];
+        let width = usize::from(grid.width());
+        let last_row = usize::from(grid.height()).wrapping_sub(1);
         while ci != goal {
             let eta = match self.route {
                 None => self.heuristic.row(cur),
@@ -189,25 +191,45 @@ impl Colony<'_, '_, '_> {
                     self.heuristic.row_toward(cur, target)
                 }
             };
-            let mut mask = self.moves.at(ci, cur);
+            let allowed = self.moves.at(ci, cur);
+            // The allowed moves into visited (or pruned) cells: from a 3 x 3 read of the tabu
+            // set away from the border, one test a move on it.
+            let (x, y) = (usize::from(cur.x), usize::from(cur.y));
+            let tabu_moves = if x > 0 && y > 0 && x.wrapping_add(1) < width && y < last_row {
+                bitmap::around(tabu, ci, width) & allowed
+            } else {
+                let mut t = 0u8;
+                let mut m = allowed;
+                while m != 0 {
+                    let di = m.trailing_zeros() as usize & 7;
+                    m &= m.wrapping_sub(1);
+                    let ni = ci.wrapping_add_signed(offsets.get(di).copied().unwrap_or(0));
+                    if bitmap::get(tabu, ni) {
+                        t |= 1 << di;
+                    }
+                }
+                t
+            };
+            // A visited neighbour (not a pruned one) may offer a shortcut.
+            let mut seen = 0u32;
+            let mut m = tabu_moves;
+            while m != 0 {
+                let di = m.trailing_zeros() as usize & 7;
+                m &= m.wrapping_sub(1);
+                let ni = ci.wrapping_add_signed(offsets.get(di).copied().unwrap_or(0));
+                // At most 8: one per bit of the mask.
+                seen = seen.wrapping_add(u32::from(!bitmap::get(self.dead, ni)));
+            }
+            let mut mask = allowed & !tabu_moves;
             let edges = blocks.edges(cur);
             let mut n = 0usize;
             let mut total = 0.0f32;
-            let mut seen = 0u32;
-            // Visit the allowed moves only (set bits of the mask, lowest first).
+            // Visit the open moves only (set bits of the mask, lowest first).
             while mask != 0 {
                 // `& 7`: the mask is non-zero, so this is the index itself, and the compiler
                 // knows it is in range for the 8-entry tables below.
                 let di = mask.trailing_zeros() as usize & 7;
                 mask &= mask.wrapping_sub(1); // mask != 0: clears the lowest set bit
-                let ni = ci.wrapping_add_signed(offsets.get(di).copied().unwrap_or(0));
-                if bitmap::get(tabu, ni) {
-                    // A visited neighbour (not a pruned one) may offer a shortcut.
-                    if !bitmap::get(self.dead, ni) {
-                        seen = seen.wrapping_add(1); // at most 8: one per bit of the mask
-                    }
-                    continue;
-                }
                 let ti = edges.get(di).copied().unwrap_or(usize::MAX);
                 let t = tau.get(ti).copied().unwrap_or(0.0);
                 let w = pow(t) * eta.get(di);
