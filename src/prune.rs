@@ -130,16 +130,29 @@ fn try_prune(
     if all == 0 {
         return false; // blocked (or isolated: nothing to gain)
     }
-    let mut live = all;
-    let mut m = all;
-    while m != 0 {
-        let d = m.trailing_zeros() as usize & 7;
-        m &= m.wrapping_sub(1);
-        let ni = ci.wrapping_add_signed(offsets.get(d).copied().unwrap_or(0));
-        if bitmap::get(dead, ni) {
-            live &= !(1 << d);
+    let grid = moves.grid();
+    let w = usize::from(grid.width());
+    let (x, y) = (usize::from(p.x), usize::from(p.y));
+    let live = if x > 0
+        && y > 0
+        && x.wrapping_add(1) < w
+        && y.wrapping_add(1) < usize::from(grid.height())
+    {
+        // Away from the border: the dead neighbours in one 3 x 3 read.
+        all & !bitmap::around(dead, ci, w)
+    } else {
+        let mut live = all;
+        let mut m = all;
+        while m != 0 {
+            let d = m.trailing_zeros() as usize & 7;
+            m &= m.wrapping_sub(1);
+            let ni = ci.wrapping_add_signed(offsets.get(d).copied().unwrap_or(0));
+            if bitmap::get(dead, ni) {
+                live &= !(1 << d);
+            }
         }
-    }
+        live
+    };
     let ok = match CLIQUE.get(usize::from(live)).copied().unwrap_or(0) {
         0 => false,
         1 => true,
