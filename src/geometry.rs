@@ -49,6 +49,11 @@ fn floor_div(n: i64, d: i64) -> i64 {
 /// (exact integer arithmetic), and checked a byte of the map at a time
 /// ([`Grid::run_free`]).
 pub fn segment_clear(grid: &Grid<'_>, a: Point, b: Point) -> bool {
+    // Both endpoint cells are touched; with both on the map, every touched cell lies in the
+    // box they span (the segment runs between their centres), so on the map too.
+    if !grid.contains(a) || !grid.contains(b) {
+        return false;
+    }
     // Order by y so the walk goes top to bottom.
     let (p, q) = if a.y <= b.y { (a, b) } else { (b, a) };
     if p.y == q.y {
@@ -77,6 +82,7 @@ pub fn segment_clear(grid: &Grid<'_>, a: Point, b: Point) -> bool {
     // Floor and ceiling (of v / 2dy) where the current row starts: the centre of `p`.
     let (mut prev_fl, mut prev_ce) = (i32::from(p.x), i32::from(p.x).wrapping_add(1));
     let right = dx >= 0;
+    let width = usize::from(grid.width());
     for row in p.y..=q.y {
         let (cur_fl, cur_ce) = if row == q.y {
             (i32::from(q.x), i32::from(q.x).wrapping_add(1))
@@ -88,7 +94,12 @@ pub fn segment_clear(grid: &Grid<'_>, a: Point, b: Point) -> bool {
         } else {
             (cur_ce.wrapping_sub(1), prev_fl)
         };
-        if !grid.run_free(row, lo, hi) {
+        // lo <= hi within the box (see above): indices on the map.
+        let base = usize::from(row).wrapping_mul(width);
+        if !grid.bits_clear(
+            base.wrapping_add(lo as usize),
+            base.wrapping_add(hi as usize),
+        ) {
             return false;
         }
         prev_fl = cur_fl;

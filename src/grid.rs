@@ -184,8 +184,13 @@ impl<'a> Grid<'a> {
         }
         // On the map: both indices are below `cells` (see the index note at the top).
         let row = usize::from(y).wrapping_mul(usize::from(self.width));
-        let i0 = row.wrapping_add(x0 as usize);
-        let i1 = row.wrapping_add(x1 as usize);
+        self.bits_clear(row.wrapping_add(x0 as usize), row.wrapping_add(x1 as usize))
+    }
+
+    /// True if the cells with indices `i0..=i1` (`i0 <= i1`) are all free; cells beyond the
+    /// buffer count as blocked. Reads the map a byte at a time.
+    #[inline]
+    pub fn bits_clear(&self, i0: usize, i1: usize) -> bool {
         let (b0, b1) = (i0 >> 3, i1 >> 3);
         let first = 0xFFu8 << (i0 & 7) as u32;
         let last = 0xFFu8 >> (7u32.wrapping_sub(i1 as u32) & 7); // 7 - i1 % 8
