@@ -106,6 +106,8 @@ def main():
     ap.add_argument("--goal", default=None, help="default: the map's far corner")
     ap.add_argument("--seeds", type=int, default=10)
     ap.add_argument("--hellos", type=int, default=100)
+    ap.add_argument("--default-only", action="store_true",
+                    help="only the default plans: no full runs, no Hello round trips")
     args = ap.parse_args()
 
     w, h, bits, _ = load_map(args.map)
@@ -121,12 +123,24 @@ def main():
         defaults = hello["defaults"]
         expect(dev.set_map(w, h, bits), "Ack")
         early = plans(dev, start, goal, seeds)
-        expect(dev.call(req_set_params(dict(defaults, patience=0))), "Ack")
-        full = plans(dev, start, goal, seeds)
-        expect(dev.call(req_set_params(defaults)), "Ack")
+        if not args.default_only:
+            expect(dev.call(req_set_params(dict(defaults, patience=0))), "Ack")
+            full = plans(dev, start, goal, seeds)
+            expect(dev.call(req_set_params(defaults)), "Ack")
     finally:
         log = q.stop()
     parts = split_log(log)
+    if args.default_only:
+        print("| seed | iterations | best | raw | length | moves | instructions | Run::new / "
+              "iterations / finish |")
+        print("| --- | --- | --- | --- | --- | --- | --- | --- |")
+        for i, (s, e) in enumerate(zip(seeds, early)):
+            split = (" / ".join(f"{mi(t):.2f}" for t in parts[i]) + " M"
+                     if len(parts) == len(seeds) else "")
+            print(f"| {s} | {e['iterations']} | {e['best_iteration']} | {e['raw_length']:.4f} | "
+                  f"{e['length']:.4f} | {e['moves']} | {mi(e['ticks']):.2f} M | {split} |")
+        print(summary_row("default", early, parts if len(parts) == len(seeds) else []))
+        return 0
     if len(parts) != 2 * len(seeds):
         parts = []  # no defmt-print, or a log that does not match: leave the split out
 

@@ -46,7 +46,7 @@ def run_session(trace, args):
          "-icount", "shift=0", "-d", "in_asm,exec,nochain", "-D", trace, "-kernel", ELF],
         stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     try:
-        dev = Device("127.0.0.1", port)
+        dev = Device("127.0.0.1", port, timeout=900.0)  # tracing is slow
         hello = expect(dev.call(req_hello()), "Hello")
         w, h, bits, _ = load_map(args.map)
         expect(dev.set_map(w, h, bits), "Ack")
@@ -56,7 +56,8 @@ def run_session(trace, args):
             params[k] = float(v) if "." in v else int(v)
         expect(dev.call(req_set_params(params)), "Ack")
         goal = tuple(int(v) for v in args.goal.split(",")) if args.goal else (w - 1, h - 1)
-        r = expect(dev.call(req_plan((0, 0), goal, seed=args.seed)), "Path")
+        start = tuple(int(v) for v in args.start.split(","))
+        r = expect(dev.call(req_plan(start, goal, seed=args.seed)), "Path")
         return r
     finally:
         qemu.terminate()
@@ -104,6 +105,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--map", default=os.path.join(ROOT, "maps/complex-26.map"))
+    ap.add_argument("--start", default="0,0")
     ap.add_argument("--goal", help="default: the map's far corner")
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--param", action="append", default=[], help="e.g. patience=0")

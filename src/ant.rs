@@ -21,7 +21,7 @@ use crate::bitmap;
 use crate::grid::{is_diagonal, neighbour, opposite, Dir, Moves, Point};
 use crate::heuristic::Heuristic;
 use crate::named::named;
-use crate::pheromone::{slot_offsets, Table};
+use crate::pheromone::Table;
 use crate::rng::Xoshiro128pp;
 use crate::route::Route;
 
@@ -117,12 +117,29 @@ impl Ant<'_, '_, '_> {
         tabu: &mut [u32],
         tour: &mut [Dir],
     ) -> Result<Walk, Lost> {
+        // The common exponent gets its own copy of the loop, without a test per candidate;
+        // `pow_alpha(t, 1.0)` is `t`, so both give the same weights.
+        if self.alpha == 1.0 {
+            self.walk_with(rng, tabu, tour, |t| t)
+        } else {
+            let alpha = self.alpha;
+            self.walk_with(rng, tabu, tour, |t| pow_alpha(t, alpha))
+        }
+    }
+
+    /// [`Ant::walk`] with `tau^alpha` computed by `pow`.
+    #[inline(always)]
+    fn walk_with(
+        &self,
+        rng: &mut Xoshiro128pp,
+        tabu: &mut [u32],
+        tour: &mut [Dir],
+        pow: impl Fn(f32) -> f32,
+    ) -> Result<Walk, Lost> {
         let grid = self.moves.grid();
         bitmap::copy(tabu, self.dead, grid.cells());
         let offsets = grid.offsets();
-        let slots = slot_offsets(&offsets);
         let blocks = self.tau.blocks();
-        let per_cell = blocks.shift() == 0;
         let tau = self.tau.flat();
         let goal = grid.index(self.goal);
         let mut cur = self.start;
@@ -134,6 +151,11 @@ impl Ant<'_, '_, '_> {
         // The sub-goal changes only when the ant enters another block.
         let mut block = usize::MAX;
         let mut target = self.goal;
+        // Only the first `n` entries are read, each written first in the same step.
+        let mut cand_dir = [0u8; 8];
+        let mut cand_w = [0.0f32; 8];
+        let width = usize::from(grid.width());
+        let last_row = usize::from(grid.height()).wrapping_sub(1);
         while ci != goal {
             let eta = match self.route {
                 None => self.heuristic.row(cur),
@@ -146,37 +168,49 @@ impl Ant<'_, '_, '_> {
                     self.heuristic.row_toward(cur, target)
                 }
             };
-            let mut mask = self.moves.at(ci, cur);
-            let mut cand_dir = [0u8; 8];
-            let mut cand_w = [0.0f32; 8];
+            let allowed = self.moves.at(ci, cur);
+            // The allowed moves into visited (or pruned) cells: from a 3 x 3 read of the tabu
+            // set away from the border, one test a move on it.
+            let (x, y) = (usize::from(cur.x), usize::from(cur.y));
+            let tabu_moves = if x > 0 && y > 0 && x.wrapping_add(1) < width && y < last_row {
+                bitmap::around(tabu, ci, width) & allowed
+            } else {
+                let mut t = 0u8;
+                let mut m = allowed;
+                while m != 0 {
+                    let di = m.trailing_zeros() as usize & 7;
+                    m &= m.wrapping_sub(1);
+                    let ni = ci.wrapping_add_signed(offsets.get(di).copied().unwrap_or(0));
+                    if bitmap::get(tabu, ni) {
+                        t |= 1 << di;
+                    }
+                }
+                t
+            };
+            // A visited neighbour (not a pruned one) may offer a shortcut.
+            let mut seen = 0u32;
+            let mut m = tabu_moves;
+            while m != 0 {
+                let di = m.trailing_zeros() as usize & 7;
+                m &= m.wrapping_sub(1);
+                let ni = ci.wrapping_add_signed(offsets.get(di).copied().unwrap_or(0));
+                // At most 8: one per bit of the mask.
+                seen = seen.wrapping_add(u32::from(!bitmap::get(self.dead, ni)));
+            }
+            let mut mask = allowed & !tabu_moves;
+            let edges = blocks.edges(cur);
             let mut n = 0usize;
             let mut total = 0.0f32;
-            let mut seen = 0u32;
-            // Visit the allowed moves only (set bits of the mask, lowest first).
+            // Visit the open moves only (set bits of the mask, lowest first).
             while mask != 0 {
                 // `& 7`: the mask is non-zero, so this is the index itself, and the compiler
                 // knows it is in range for the 8-entry tables below.
                 let di = mask.trailing_zeros() as usize & 7;
                 mask &= mask.wrapping_sub(1); // mask != 0: clears the lowest set bit
-                let ni = ci.wrapping_add_signed(offsets.get(di).copied().unwrap_or(0));
-                if bitmap::get(tabu, ni) {
-                    // A visited neighbour (not a pruned one) may offer a shortcut.
-                    if !bitmap::get(self.dead, ni) {
-                        seen = seen.wrapping_add(1); // at most 8: one per bit of the mask
-                    }
-                    continue;
-                }
-                let ti = if per_cell {
-                    // `ci` is a cell index and the table holds 16 bytes a cell in memory, so
-                    // `4 * ci` does not wrap (if it did, `get` would fail).
-                    ci.wrapping_mul(4)
-                        .wrapping_add_signed(slots.get(di).copied().unwrap_or(0))
-                } else {
-                    blocks.index(cur, di as u8)
-                };
+                let ti = edges.get(di).copied().unwrap_or(usize::MAX);
                 let t = tau.get(ti).copied().unwrap_or(0.0);
-                let w = pow_alpha(t, self.alpha) * eta.get(di);
-                if let (Some(cd), Some(cw)) = (cand_dir.get_mut(n), cand_w.get_mut(n)) {
+                let w = pow(t) * eta.get(di);
+                if let (Some(cd), Some(cw)) = (cand_dir.get_mut(n & 7), cand_w.get_mut(n & 7)) {
                     *cd = di as u8;
                     *cw = w;
                 }
@@ -247,7 +281,9 @@ impl Ant<'_, '_, '_> {
 #[inline]
 fn roulette(rng: &mut Xoshiro128pp, w: &[f32], total: f32) -> usize {
     let n = w.len();
-    if !(total > 0.0 && total.is_finite()) {
+    // `0 < total <= MAX`: positive and finite (NaN fails both), with two float comparisons
+    // (`is_finite` compiles to integer bit tests on the M4).
+    if !(total > 0.0 && total <= f32::MAX) {
         // A 32-bit word times n <= 8 candidates: well below 2^64.
         return (u64::from(rng.next_word()).wrapping_mul(n as u64) >> 32) as usize;
     }
@@ -276,6 +312,9 @@ fn roulette(rng: &mut Xoshiro128pp, w: &[f32], total: f32) -> usize {
 /// with one entry per map cell it is indexed by cell; shorter, it is an open-addressing hash
 /// table over the path's cells, which needs a power of two of at least twice the path's cells
 /// (a longer path is returned untightened). Both give the same result.
+///
+/// `visited` is the walk's tabu set (every cell of the path is in it): a neighbour outside it is
+/// not on the path and is not looked up. An empty set looks up every neighbour; same result.
 pub fn tighten(
     moves: &Moves<'_>,
     start: Point,
@@ -283,6 +322,7 @@ pub fn tighten(
     tour: &mut [Dir],
     cells: &mut [Point],
     pos: &mut [u32],
+    visited: &[u32],
 ) -> Walk {
     let grid = moves.grid();
     // Cannot wrap for a real walk (steps < cells); were `steps` usize::MAX, `tour.get(..steps)`
@@ -308,11 +348,46 @@ pub fn tighten(
     let mut i = 0usize;
     let mut out = 0usize;
     let (mut straight, mut diagonal) = (0u32, 0u32);
+    let (width, height) = (usize::from(grid.width()), usize::from(grid.height()));
     // `i < n` throughout (it only ever becomes a valid index into `cells`), so no `wrapping_` below
     // wraps: `out <= i` and `straight + diagonal == out`.
     while i.wrapping_add(1) < n {
         let Some(&cp) = cells.get(i) else { break };
         let ci = grid.index(cp);
+        // Fast path, away from the map's border: when no neighbour but the path's previous and
+        // next cells was visited, the next cell is the furthest. `tour[i]` still holds the step
+        // from cell `i` to `i + 1` and `tour[i - 1]` the step into cell `i` (the output so far
+        // ends at index `out - 1 < i`, and its last step, if at `i - 1`, is that same step).
+        if let Some(&next_d) = tour.get(i) {
+            let (x, y) = (usize::from(cp.x), usize::from(cp.y));
+            if x > 0 && y > 0 && x.wrapping_add(1) < width && y.wrapping_add(1) < height {
+                let mut others = bitmap::around(visited, ci, width) & !(1u8 << (next_d & 7));
+                if let Some(&in_d) = i.checked_sub(1).and_then(|k| tour.get(k)) {
+                    others &= !(1u8 << (opposite(in_d) & 7));
+                }
+                if others == 0 {
+                    if let Some(slot) = tour.get_mut(out) {
+                        *slot = next_d;
+                    }
+                    out = out.wrapping_add(1);
+                    if is_diagonal(next_d) {
+                        diagonal = diagonal.wrapping_add(1);
+                    } else {
+                        straight = straight.wrapping_add(1);
+                    }
+                    i = i.wrapping_add(1);
+                    continue;
+                }
+            }
+        }
+        // The path's cells before and after this one are known without a look-up.
+        let prev = match i.checked_sub(1).and_then(|k| cells.get(k)) {
+            Some(&q) => grid.index(q),
+            None => usize::MAX,
+        };
+        let next = cells
+            .get(i.wrapping_add(1))
+            .map_or(usize::MAX, |&q| grid.index(q));
         let mut mask = moves.at(ci, cp);
         // Furthest later path cell one allowed move away (the next cell always qualifies).
         let mut best = (i, 0u8);
@@ -320,6 +395,17 @@ pub fn tighten(
             let d = mask.trailing_zeros() as u8;
             mask &= mask.wrapping_sub(1);
             let nb = ci.wrapping_add_signed(offsets.get(usize::from(d)).copied().unwrap_or(0));
+            // Not visited: not on the path (a cell beyond the set reads as visited). The previous
+            // cell cannot be the furthest; the next one is at `i + 1` (cells are unique on a path).
+            if !bitmap::get(visited, nb) || nb == prev {
+                continue;
+            }
+            if nb == next {
+                if i.wrapping_add(1) > best.0 {
+                    best = (i.wrapping_add(1), d);
+                }
+                continue;
+            }
             if let Some(j) = index.find(nb, |j| cells.get(j).map(|&q| grid.index(q))) {
                 if j > best.0 {
                     best = (j, d);

@@ -58,6 +58,55 @@ pub fn copy(dst: &mut [u32], src: &[u32], cells: usize) {
     }
 }
 
+/// The bits of cells `i`, `i + 1`, `i + 2` (bits 0-2; beyond the buffer: set).
+#[inline]
+pub fn three(bits: &[u32], i: usize) -> u32 {
+    let (k, s) = (i >> 5, (i & 31) as u32);
+    let lo = bits.get(k).copied().unwrap_or(u32::MAX) >> s;
+    if s <= 29 {
+        return lo & 7;
+    }
+    // The three bits straddle two words (s is 30 or 31, so 32 - s is 1 or 2).
+    let hi = bits.get(k.wrapping_add(1)).copied().unwrap_or(u32::MAX);
+    (lo | hi << (32u32.wrapping_sub(s) & 31)) & 7
+}
+
+/// The set's members among the eight neighbours of cell `i` of a map `width` cells wide, as a
+/// direction mask (bit `d`: the neighbour in direction `d` of [`crate::grid`]). `i` must not lie
+/// on the map's border (its neighbours' indices are taken as `i +- 1`, `i +- width`).
+#[inline]
+pub fn around(bits: &[u32], i: usize, width: usize) -> u8 {
+    // Border cells are excluded by the caller, so `i - width - 1` does not wrap.
+    let top = i.wrapping_sub(width).wrapping_sub(1);
+    let mid = top.wrapping_add(width);
+    let bottom = mid.wrapping_add(width);
+    let nb = three(bits, top) | three(bits, mid) << 3 | three(bits, bottom) << 6;
+    RING9.get(nb as usize & 511).copied().unwrap_or(0)
+}
+
+/// For each 3 x 3 neighbourhood (bit `3 r + c` = cell `(x - 1 + c, y - 1 + r)`), the same cells as
+/// a direction mask (bit `d` = the neighbour in direction `d`; the centre is left out).
+#[allow(clippy::indexing_slicing, clippy::arithmetic_side_effects)]
+static RING9: [u8; 512] = {
+    use crate::grid::{DX, DY};
+    let mut t = [0u8; 512];
+    let mut nb = 0usize;
+    while nb < 512 {
+        let mut m = 0u8;
+        let mut d = 0usize;
+        while d < 8 {
+            let bit = ((1 + DY[d]) * 3 + (1 + DX[d])) as usize;
+            if (nb >> bit) & 1 == 1 {
+                m |= 1 << d;
+            }
+            d += 1;
+        }
+        t[nb] = m;
+        nb += 1;
+    }
+    t
+};
+
 /// Number of cells in the set among the first `cells`.
 pub fn count(bits: &[u32], cells: usize) -> u32 {
     let full = cells >> 5;
@@ -97,5 +146,34 @@ mod tests {
         assert_eq!(c, b);
         clear(&mut b, 65);
         assert_eq!(b, [0; 3]);
+    }
+
+    #[test]
+    fn around_reads_the_eight_neighbours() {
+        use crate::grid::{DX, DY};
+        let (w, h) = (37usize, 5usize);
+        let mut x = 12345u32;
+        let mut b = vec![0u32; words(w * h)];
+        for i in 0..w * h {
+            x ^= x << 13;
+            x ^= x >> 17;
+            x ^= x << 5;
+            if x & 1 == 1 {
+                set(&mut b, i);
+            }
+        }
+        for y in 1..h - 1 {
+            for cx in 1..w - 1 {
+                let i = y * w + cx;
+                let mut want = 0u8;
+                for d in 0..8 {
+                    let j = ((y as i32 + DY[d]) * w as i32 + cx as i32 + DX[d]) as usize;
+                    if get(&b, j) {
+                        want |= 1 << d;
+                    }
+                }
+                assert_eq!(around(&b, i, w), want, "cell {i}");
+            }
+        }
     }
 }

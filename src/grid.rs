@@ -147,6 +147,12 @@ impl<'a> Grid<'a> {
         }
     }
 
+    /// True if cell index `i` is blocked or beyond the map's bits.
+    #[inline]
+    pub fn blocked_at(&self, i: usize) -> bool {
+        self.blocked_index(i)
+    }
+
     /// True if `p` is inside the map and free.
     #[inline]
     pub fn is_free(&self, p: Point) -> bool {
@@ -165,6 +171,41 @@ impl<'a> Grid<'a> {
             .wrapping_mul(usize::from(self.width))
             .wrapping_add(x as usize);
         self.blocked_index(i)
+    }
+
+    /// True if the cells `(x, y)` for `x` in `x0..=x1` are all on the map and free (also when the
+    /// run is empty, `x0 > x1`, and `y` is on the map). Reads the map a byte at a time.
+    pub fn run_free(&self, y: u16, x0: i32, x1: i32) -> bool {
+        if y >= self.height || x0 < 0 || x1 >= i32::from(self.width) {
+            return false;
+        }
+        if x0 > x1 {
+            return true;
+        }
+        // On the map: both indices are below `cells` (see the index note at the top).
+        let row = usize::from(y).wrapping_mul(usize::from(self.width));
+        self.bits_clear(row.wrapping_add(x0 as usize), row.wrapping_add(x1 as usize))
+    }
+
+    /// True if the cells with indices `i0..=i1` (`i0 <= i1`) are all free; cells beyond the
+    /// buffer count as blocked. Reads the map a byte at a time.
+    #[inline]
+    pub fn bits_clear(&self, i0: usize, i1: usize) -> bool {
+        let (b0, b1) = (i0 >> 3, i1 >> 3);
+        let first = 0xFFu8 << (i0 & 7) as u32;
+        let last = 0xFFu8 >> (7u32.wrapping_sub(i1 as u32) & 7); // 7 - i1 % 8
+        let byte = |k: usize| self.bits.get(k).copied().unwrap_or(0xFF);
+        if b0 == b1 {
+            return byte(b0) & first & last == 0;
+        }
+        if byte(b0) & first != 0 || byte(b1) & last != 0 {
+            return false;
+        }
+        // The whole bytes in between.
+        match self.bits.get(b0.wrapping_add(1)..b1) {
+            Some(mid) => mid.iter().all(|&m| m == 0),
+            None => false,
+        }
     }
 
     /// Where move `d` from `p` leads, or `None` if the target is outside the map or blocked, or
@@ -227,24 +268,30 @@ impl<'a> Grid<'a> {
         }
         // Interior: x - 1, y - 1 and the rows above and below exist. Each row's three bits start
         // at bit `(row * w + x - 1)`, which is below `cells`, so nothing here wraps.
-        let mut nb = 0usize;
-        let mut row = y
+        let top = y
             .wrapping_sub(1)
             .wrapping_mul(w)
             .wrapping_add(x)
             .wrapping_sub(1);
-        for r in 0..3usize {
-            let lo = self.bits.get(row >> 3).copied().unwrap_or(0xFF);
-            let hi = self
-                .bits
-                .get((row >> 3).wrapping_add(1))
-                .copied()
-                .unwrap_or(0xFF);
-            let three = ((usize::from(hi) << 8 | usize::from(lo)) >> (row & 7)) & 7;
-            nb |= three << r.wrapping_mul(3);
-            row = row.wrapping_add(w);
-        }
-        MASK9.get(nb).copied().unwrap_or(0)
+        let mid = top.wrapping_add(w);
+        let bottom = mid.wrapping_add(w);
+        let nb = self.three(top) | self.three(mid) << 3 | self.three(bottom) << 6;
+        MASK9.get(nb & 511).copied().unwrap_or(0)
+    }
+
+    /// The blocked bits of cells `i`, `i + 1`, `i + 2` (bits 0-2; beyond the map: blocked).
+    #[inline]
+    fn three(&self, i: usize) -> usize {
+        let b = i >> 3;
+        let pair = match self.bits.get(b..b.wrapping_add(2)) {
+            Some(&[lo, hi]) => usize::from(hi) << 8 | usize::from(lo),
+            // The last byte of the buffer (or none): what lies beyond reads as blocked.
+            _ => match self.bits.get(b) {
+                Some(&lo) => 0xFF00 | usize::from(lo),
+                None => 0xFFFF,
+            },
+        };
+        (pair >> (i & 7)) & 7
     }
 
     /// Flood fill from `start` over allowed moves: is `goal` reachable?
@@ -253,6 +300,12 @@ impl<'a> Grid<'a> {
     /// of cell indices of any length. A breadth-first frontier longer than the ring cannot be
     /// held, and the answer is then [`Reach::Unknown`] (the planner's first backtracking ant
     /// decides instead).
+    ///
+    /// The fill follows the four straight moves only: a diagonal move is allowed only when both
+    /// cells beside it are free, and then the two straight moves through either of them reach the
+    /// same cell, so the cells reachable with the eight moves are exactly those reachable with the
+    /// four. The marks start as a copy of the map's blocked bits (the same bit order), so one
+    /// test-and-set per neighbour both skips obstacles and marks the cell.
     pub fn reachable(
         &self,
         start: Point,
@@ -265,10 +318,24 @@ impl<'a> Grid<'a> {
             return Reach::No;
         }
         let cap = queue.len();
-        if mark.len() < crate::bitmap::words(cells) || cap == 0 {
+        let Some(mark) = mark.get_mut(..crate::bitmap::words(cells)) else {
+            return Reach::Unknown;
+        };
+        if cap == 0 {
             return Reach::Unknown;
         }
-        crate::bitmap::clear(mark, cells);
+        // Blocked cells start marked (bytes beyond the buffer read as blocked; bits beyond the
+        // map are never asked about: the fill stays on the map).
+        for (k, m) in mark.iter_mut().enumerate() {
+            let b = k.wrapping_mul(4); // < bytes_for(cells) + 4: no wrap
+            *m = match self.bits.get(b..b.wrapping_add(4)) {
+                Some(&[b0, b1, b2, b3]) => u32::from_le_bytes([b0, b1, b2, b3]),
+                _ => {
+                    let byte = |i: usize| self.bits.get(b.wrapping_add(i)).copied().unwrap_or(0xFF);
+                    u32::from_le_bytes([byte(0), byte(1), byte(2), byte(3)])
+                }
+            };
+        }
         // Ring buffer: `head` is the next to pop, `len` how many are queued (both < cap).
         let (mut head, mut len) = (0usize, 0usize);
         let si = self.index(start);
@@ -278,7 +345,9 @@ impl<'a> Grid<'a> {
         }
         len = len.wrapping_add(1);
         let gi = self.index(goal);
-        let offsets = self.offsets();
+        let w = usize::from(self.width);
+        // Cells of the first and last row: no neighbour above / below.
+        let last_row = cells.wrapping_sub(w); // cells >= w
         while len > 0 {
             let Some(&i) = queue.get(head) else { break };
             head = head.wrapping_add(1);
@@ -290,13 +359,20 @@ impl<'a> Grid<'a> {
             if i == gi {
                 return Reach::Yes;
             }
-            let p = self.point(i);
-            let mut m = self.mask_at(p);
-            while m != 0 {
-                let d = m.trailing_zeros() as usize & 7;
-                m &= m.wrapping_sub(1);
-                // An allowed move: the neighbour is on the map, its index `i + offset`.
-                let ni = i.wrapping_add_signed(offsets.get(d).copied().unwrap_or(0));
+            // `w > 0` (checked in `Grid::new`), so the remainder exists.
+            let x = i.checked_rem(w).unwrap_or(0);
+            // W, E, N, S; a missing side repeats the cell itself (already marked).
+            let next = [
+                if x > 0 { i.wrapping_sub(1) } else { i },
+                if x.wrapping_add(1) < w {
+                    i.wrapping_add(1)
+                } else {
+                    i
+                },
+                if i >= w { i.wrapping_sub(w) } else { i },
+                if i < last_row { i.wrapping_add(w) } else { i },
+            ];
+            for ni in next {
                 if crate::bitmap::insert(mark, ni) {
                     if len == cap {
                         return Reach::Unknown;
@@ -477,6 +553,58 @@ mod tests {
             open.reachable(Point::new(0, 0), Point::new(7, 7), &mut m, &mut q),
             Reach::Unknown
         );
+    }
+
+    #[test]
+    fn flood_fill_agrees_with_eight_moves() {
+        // Random maps (about 40 % blocked), every start and goal: the four-move fill decides
+        // like a breadth-first search over the eight allowed moves.
+        let mut x = 0x2545_F491u32;
+        for (w, h) in [(10u16, 10u16), (7, 13), (16, 4)] {
+            for _ in 0..20 {
+                let cells = usize::from(w) * usize::from(h);
+                let mut b = vec![0u8; cells.div_ceil(8)];
+                for i in 0..cells {
+                    x ^= x << 13;
+                    x ^= x >> 17;
+                    x ^= x << 5;
+                    if x % 5 < 2 {
+                        b[i / 8] |= 1 << (i % 8);
+                    }
+                }
+                let g = Grid::new(w, h, &b).unwrap();
+                let mut mark = vec![0u32; crate::bitmap::words(cells)];
+                let mut queue = vec![0u32; cells];
+                for s in 0..cells {
+                    // Eight-move BFS from s.
+                    let mut seen = vec![false; cells];
+                    let mut todo = vec![g.point(s)];
+                    seen[s] = g.is_free(g.point(s));
+                    while let Some(p) = todo.pop() {
+                        if !g.is_free(p) {
+                            continue;
+                        }
+                        for d in 0..8 {
+                            if let Some(q) = g.step(p, d) {
+                                if !seen[g.index(q)] {
+                                    seen[g.index(q)] = true;
+                                    todo.push(q);
+                                }
+                            }
+                        }
+                    }
+                    for t in 0..cells {
+                        let want = if seen[t] && g.is_free(g.point(t)) {
+                            Reach::Yes
+                        } else {
+                            Reach::No
+                        };
+                        let got = g.reachable(g.point(s), g.point(t), &mut mark, &mut queue);
+                        assert_eq!(got, want, "{w}x{h} {:?} -> {:?}", g.point(s), g.point(t));
+                    }
+                }
+            }
+        }
     }
 
     #[test]

@@ -142,6 +142,37 @@ impl Blocks {
             .wrapping_mul(4)
             .wrapping_add(usize::from(slot))
     }
+
+    /// The flat indices of the eight edges leaving `p`, by direction: `[index(p, 0), ...,
+    /// index(p, 7)]` for every direction whose neighbour is on the map (the others are
+    /// meaningless), computed once for all eight. The four edges `p` owns sit in its block; the
+    /// other four in the block of the neighbour, which is `p`'s own block unless `p` lies on the
+    /// block's left, top or right side.
+    #[inline]
+    pub fn edges(&self, p: Point) -> [usize; 8] {
+        let side = (1u16 << (self.shift & 15)).wrapping_sub(1);
+        let b4 = self.block(p).wrapping_mul(4);
+        // Leaving the block to the left (W), to the right (E, only NE matters here) or upwards.
+        let left = if p.x & side == 0 { 4 } else { 0 };
+        let right = if p.x & side == side { 4 } else { 0 };
+        let up = if p.y & side == 0 {
+            self.across.wrapping_mul(4)
+        } else {
+            0
+        };
+        // Each is `4 * block + slot`; the block sums wrap only for neighbours off the map.
+        let n4 = b4.wrapping_sub(up);
+        [
+            b4,
+            b4.wrapping_add(1),
+            b4.wrapping_add(2),
+            b4.wrapping_add(3),
+            b4.wrapping_sub(left),
+            n4.wrapping_sub(left).wrapping_add(1),
+            n4.wrapping_add(2),
+            n4.wrapping_add(right).wrapping_add(3),
+        ]
+    }
 }
 
 /// A pheromone (or pheromone-increment) table over a map: [`Blocks::count`] entries.
@@ -302,6 +333,33 @@ mod tests {
             let p = Point::new(2, 2);
             let q = Point::new((2 + DX[d as usize]) as u16, (2 + DY[d as usize]) as u16);
             assert_eq!(b.index(p, d), b.index(q, opposite(d)));
+        }
+    }
+
+    #[test]
+    fn edges_are_the_eight_indices() {
+        for (w, h) in [
+            (7u16, 5u16),
+            (32, 32),
+            (33, 40),
+            (64, 64),
+            (100, 37),
+            (256, 256),
+        ] {
+            let b = Blocks::new(w, h);
+            for y in 0..h {
+                for x in 0..w {
+                    let p = Point::new(x, y);
+                    let e = b.edges(p);
+                    for d in 0..8u8 {
+                        let (nx, ny) =
+                            (i32::from(x) + DX[d as usize], i32::from(y) + DY[d as usize]);
+                        if nx >= 0 && ny >= 0 && nx < i32::from(w) && ny < i32::from(h) {
+                            assert_eq!(e[d as usize], b.index(p, d), "{w}x{h} {p:?} d{d}");
+                        }
+                    }
+                }
+            }
         }
     }
 

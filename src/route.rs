@@ -143,7 +143,21 @@ fn links(moves: &Moves<'_>, blocks: Blocks, dead: &[u32], words: &mut [u32]) {
             let p = Point::new(x, y);
             let ci = grid.index(p);
             if !crate::bitmap::get(dead, ci) {
-                let mut m = moves.at(ci, p);
+                // Only the moves that leave the block: across its left, right, top or bottom side.
+                let mut leaving = 0u8;
+                if x & last == 0 {
+                    leaving |= 0x38; // W, NW, SW
+                }
+                if x & last == last {
+                    leaving |= 0x83; // E, NE, SE
+                }
+                if y & last == 0 {
+                    leaving |= 0xE0; // N, NW, NE
+                }
+                if y & last == last {
+                    leaving |= 0x0E; // S, SW, SE
+                }
+                let mut m = moves.at(ci, p) & leaving;
                 let b = blocks.block(p);
                 while m != 0 {
                     let d = m.trailing_zeros() as usize & 7;

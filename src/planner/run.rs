@@ -333,7 +333,7 @@ impl<'g, 'a> Run<'g, 'a> {
             };
             self.moves = self.moves.saturating_add(u64::from(walk.moves));
             let walk = if p.tighten && walk.may_tighten {
-                tighten(&moves, self.start, walk, tour, points, links)
+                tighten(&moves, self.start, walk, tour, points, links, tabu)
             } else {
                 walk
             };

@@ -1,0 +1,72 @@
+//! One plan as the device makes it (ant paths bounded to the firmware's 1,023 steps, no move
+//! table on maps of more than 1,024 cells), for profiling the core on the host with callgrind,
+//! whose instruction counts follow the device's: the phases are the functions `Run::new`,
+//! `Run::step` and `Run::finish`.
+//!
+//! ```text
+//! cargo build --release -p ohaca-host-tests --target host-tuple --example device_plan
+//! valgrind --tool=callgrind target/x86_64-unknown-linux-gnu/release/examples/device_plan \
+//!     [--map maps/large/Boston_0_256.map] [--start 184,0] [--goal 8,254] [--seeds 1] [--patience P]
+//! ```
+//!
+//! Prints one line per seed: iterations, lengths, ant moves and a hash of the raw path and the
+//! waypoints (identical lines before and after a change: identical paths).
+
+use std::hash::{DefaultHasher, Hash, Hasher};
+
+use ohaca::grid::Point;
+use ohaca::heap::HeapStorage;
+use ohaca::planner::Run;
+use ohaca::Params;
+use ohaca_host_tests::maps::Map;
+
+/// The firmware's `PLAN_STEPS`.
+const STEPS: usize = 1023;
+
+fn point(s: &str) -> Point {
+    let (x, y) = s.split_once(',').expect("X,Y");
+    Point::new(x.parse().expect("X"), y.parse().expect("Y"))
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let mut map = String::from("maps/large/Boston_0_256.map");
+    let (mut start, mut goal) = (Point::new(184, 0), Point::new(8, 254));
+    let mut seeds = 1u64;
+    let mut params = Params::default();
+    let mut it = args.iter();
+    while let Some(flag) = it.next() {
+        let v = it.next().expect("every option takes a value");
+        match flag.as_str() {
+            "--map" => map = v.clone(),
+            "--start" => start = point(v),
+            "--goal" => goal = point(v),
+            "--seeds" => seeds = v.parse().expect("--seeds N"),
+            "--patience" => params.patience = v.parse().expect("--patience P"),
+            _ => panic!("unknown option {flag}"),
+        }
+    }
+    let m = Map::load(&map).unwrap_or_else(|e| panic!("{e}"));
+    let grid = m.grid();
+    let mut st = HeapStorage::with_steps(m.cells(), STEPS, m.cells() <= 1024, 1024)
+        .unwrap_or_else(|e| panic!("{e}"));
+    for seed in 1..=seeds {
+        let p = Params { seed, ..params };
+        let mut run = Run::new(&grid, start, goal, &p, st.workspace()).expect("plan");
+        while run.step() {}
+        let pl = run.finish().expect("a path");
+        let mut h = DefaultHasher::new();
+        pl.raw().collect::<Vec<_>>().hash(&mut h);
+        pl.waypoints().hash(&mut h);
+        println!(
+            "seed {seed}: it {} best {} raw {:.4} len {:.4} moves {} pruned {} hash {:016x}",
+            pl.iterations,
+            pl.best_iteration,
+            pl.raw_length,
+            pl.length,
+            pl.moves,
+            pl.pruned,
+            h.finish()
+        );
+    }
+}
