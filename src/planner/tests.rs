@@ -319,3 +319,31 @@ fn a_refused_warm_start_leaves_the_memory_alone() {
     assert_eq!(memory, kept);
     assert_eq!(st.workspace().pheromone(), &before[..]);
 }
+
+#[test]
+fn a_warm_start_after_a_change_that_cuts_the_goal_off_ends_with_no_path() {
+    let (mut b, w, h) = grid(&ROWS);
+    let goal = Point::new(7, 5);
+    let p = Params::default();
+    let mut st: S64 = Storage::new();
+    let mut memory = Memory::new();
+    {
+        let g = Grid::new(w, h, &b).unwrap();
+        run_to_end(Run::cold(&g, Point::new(0, 0), goal, &p, st.workspace(), &mut memory).unwrap());
+    }
+    // Wall off the goal's corner: (6, 4), (7, 4) and (6, 5).
+    for (x, y) in [(6usize, 4usize), (7, 4), (6, 5)] {
+        let i = y * 8 + x;
+        b[i / 8] |= 1 << (i % 8);
+        memory.changed(Area::cell(Point::new(x as u16, y as u16)));
+    }
+    let g = Grid::new(w, h, &b).unwrap();
+    // Warm with backtracking ants: no flood fill, the first ant proves it.
+    let mut run = Run::warm(&g, Point::new(0, 0), goal, &p, st.workspace(), &mut memory).unwrap();
+    assert!(run.is_warm());
+    assert!(!run.step());
+    assert_eq!(run.finish().err(), Some(Error::NoPath));
+    // Cold: the flood fill refuses it at once.
+    let e = Run::cold(&g, Point::new(0, 0), goal, &p, st.workspace(), &mut memory);
+    assert_eq!(e.err(), Some(Error::NoPath));
+}
