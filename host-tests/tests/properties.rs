@@ -318,6 +318,8 @@ proptest! {
                             prop_assert_eq!(w.length, plan.length.to_bits());
                         }
                     }
+                    // The flood fill of the first step: the whole run says the same.
+                    Err(Error::NoPath) => prop_assert_eq!(whole.err(), Some(Error::NoPath)),
                     Err(e) => {
                         prop_assert_eq!(e, Error::NoAntArrived);
                         prop_assert!(steps == 0 || p.dead_end == DeadEnd::Die);

@@ -59,22 +59,18 @@ pub fn plan_map_in(
     storage.ensure(map.cells(), usize::from(params.iterations))?;
     let grid = map.grid()?;
     let t0 = Instant::now();
-    let mut run = match Run::new(&grid, start, goal, params, storage.workspace()) {
-        Ok(run) => run,
-        Err(Error::NoPath) => {
-            return Ok(PlanReport::not_found(
-                params,
-                Error::NoPath,
-                Some(0),
-                t0.elapsed(),
-            ))
-        }
-        Err(e) => return Err(e.into()),
-    };
+    let mut run = Run::new(&grid, start, goal, params, storage.workspace())?;
     while run.step() {}
     let iterations = run.iteration();
     match run.finish() {
         Ok(plan) => Ok(PlanReport::from_plan(&plan, t0.elapsed())),
+        // The first step's flood fill found the goal unreachable.
+        Err(Error::NoPath) => Ok(PlanReport::not_found(
+            params,
+            Error::NoPath,
+            Some(0),
+            t0.elapsed(),
+        )),
         // Only with `DeadEnd::Die`: the goal is reachable but no ant got there.
         Err(Error::NoAntArrived) => Ok(PlanReport::not_found(
             params,

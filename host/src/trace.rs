@@ -46,29 +46,25 @@ pub fn plan_traced(
     storage.ensure(map.cells(), usize::from(params.iterations))?;
     let grid = map.grid()?;
     let t0 = Instant::now();
-    let mut run = match Run::new(&grid, start, goal, params, storage.workspace()) {
-        Ok(run) => run,
-        Err(Error::NoPath) => {
-            return Ok(Traced {
-                report: PlanReport::not_found(params, Error::NoPath, Some(0), t0.elapsed()),
-                best_so_far: Vec::new(),
-                pheromone: None,
-                ants_sent: 0,
-                ants_arrived: 0,
-            })
-        }
-        Err(e) => return Err(e.into()),
-    };
+    let mut run = Run::new(&grid, start, goal, params, storage.workspace())?;
     while run.step() {}
     let iterations = run.iteration();
     let ants_sent = u64::from(iterations) * u64::from(params.ants);
-    let (report, best_so_far, ants_arrived) = match run.finish() {
+    let finished = run.finish();
+    let no_path = matches!(finished, Err(Error::NoPath));
+    let (report, best_so_far, ants_arrived) = match finished {
         Ok(plan) => {
             let report = PlanReport::from_plan(&plan, t0.elapsed());
             let curve = plan.curve().iter().map(|c| c.best_so_far).collect();
             let arrived = plan.curve().iter().map(|c| u64::from(c.arrived)).sum();
             (report, curve, arrived)
         }
+        // The first step's flood fill found the goal unreachable.
+        Err(Error::NoPath) => (
+            PlanReport::not_found(params, Error::NoPath, Some(0), t0.elapsed()),
+            Vec::new(),
+            0,
+        ),
         // Only with `DeadEnd::Die`: no ant ever arrived, so the best so far was never finite.
         Err(Error::NoAntArrived) => (
             PlanReport::not_found(
@@ -83,7 +79,7 @@ pub fn plan_traced(
         Err(e) => return Err(e.into()),
     };
     // The plan is gone; the workspace's pheromone buffer still holds the last iteration's table.
-    let pheromone = pheromone.then(|| {
+    let pheromone = (pheromone && !no_path).then(|| {
         let ws = storage.workspace();
         let tau = ws.pheromone();
         tau.get(..map.cells()).unwrap_or(tau).to_vec()

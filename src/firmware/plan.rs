@@ -81,6 +81,15 @@ async fn plan(
     if job.warm {
         defmt::info!("plan {}: warm start asked, warm {}", job.id, run.is_warm());
     }
+    // The setup a piece at a time (flood fill, pruning, coarse route: each reads the whole map),
+    // yielding between the pieces like between iterations.
+    while run.setup_step() {
+        yield_now().await;
+        if state::cancelled(job.generation) {
+            defmt::info!("plan {} cancelled during its setup", job.id);
+            return Err(cancelled());
+        }
+    }
     let t_new = Instant::now();
     // Ticks spent inside `Run::step`, without the yields between iterations.
     let mut in_steps = 0u64;

@@ -3,7 +3,7 @@
 //!
 //! ```text
 //! validate parameters, map size, start and goal
-//! flood fill: goal unreachable -> Err(NoPath) at once
+//! flood fill: goal unreachable -> the run ends, Err(NoPath)  (first step, or setup_step)
 //! prune the cells no shortest path needs                 (prune)
 //! tau = tau0 everywhere (a warm start keeps the previous run's tau, reset near map changes: warm)
 //! repeat `iterations` times (or until the best has not improved for `patience` iterations):

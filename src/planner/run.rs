@@ -75,14 +75,32 @@ pub struct Run<'g, 'a> {
     pruned: u32,
     routed: bool,
     warm: bool,
+    setup: Setup,
     no_path: bool,
     done: bool,
 }
 
+/// The setup still to do before the first iteration, in order. Each piece reads the whole map
+/// once, so the firmware yields between them ([`Run::setup_step`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Setup {
+    /// The flood fill (is the goal reachable at all?).
+    Reach,
+    /// Dead-end pruning ([`Params::prune`]).
+    Prune,
+    /// The coarse route on large maps.
+    Route,
+    /// Nothing: the ants can walk.
+    Done,
+}
+
 impl<'g, 'a> Run<'g, 'a> {
-    /// Validate everything and prepare a run: fails at once with [`Error::NoPath`] when a flood
-    /// fill finds the goal unreachable; prunes the cells no shortest path needs
-    /// ([`Params::prune`]); sets every pheromone entry to `tau0`.
+    /// Validate everything and prepare a run: fails at once on bad parameters, a map larger than
+    /// the workspace, or a start or goal off the map or on an obstacle; sets every pheromone entry
+    /// to `tau0`. The rest of the setup (a flood fill: is the goal reachable at all?; pruning the
+    /// cells no shortest path needs, [`Params::prune`]; the coarse route of a large map) runs in
+    /// the first [`Run::step`], or piecewise through [`Run::setup_step`]; an unreachable goal
+    /// ends the run there, and [`Run::finish`] fails with [`Error::NoPath`].
     pub fn new(
         grid: &'g Grid<'g>,
         start: Point,
@@ -97,7 +115,8 @@ impl<'g, 'a> Run<'g, 'a> {
     /// the workspace holds it (same map size and goal): its pheromone is kept, reset to `tau0` near
     /// the cells changed since ([`crate::planner::REPAIR_RADIUS`]), and the run stops after
     /// [`Params::warm_patience`] stale iterations. Otherwise this is exactly [`Run::new`] (a cold
-    /// start). On success `memory` records this run; on failure nothing changed.
+    /// start). On success `memory` records this run (also when its first step then finds the goal
+    /// unreachable: the pheromone is then this run's); on failure nothing changed.
     ///
     /// The caller keeps `memory` beside the storage, calls [`Memory::changed`] for every map
     /// update and [`Memory::forget`] for a new map. See [`crate::planner`]'s `warm` module docs.
@@ -163,28 +182,7 @@ impl<'g, 'a> Run<'g, 'a> {
             }
         }
         Moves::fill(grid, ws.moves);
-        // A warm start with backtracking ants skips the flood fill: if a change cut the goal off,
-        // the first ant backs out of every branch and proves it (`Lost::Exhausted`, the run ends
-        // with `NoPath`) for about what the flood fill would have cost; otherwise the fill is pure
-        // overhead on a replan (4.6 M of 75 M instructions on Boston 256).
-        let proved_by_ants = warm.is_some() && params.dead_end == DeadEnd::Backtrack;
-        if !proved_by_ants && grid.reachable(start, goal, ws.tabu, ws.links) == Reach::No {
-            return Err(Error::NoPath);
-        }
-        let pruned = if params.prune {
-            let moves = Moves::new(*grid, ws.moves);
-            prune(&moves, start, goal, ws.dead, ws.links)
-        } else {
-            crate::bitmap::clear(ws.dead, cells);
-            0
-        };
-        // Large maps: the potential field pulls along a coarse route (not for ACA, which has no
-        // attraction).
         let guide_blocks = route::blocks(grid.width(), grid.height());
-        let routed = blocks.shift() > 0 && params.algorithm.attracts() && {
-            let moves = Moves::new(*grid, ws.moves);
-            route::build(&moves, guide_blocks, goal, ws.dead, ws.guide, ws.links)
-        };
         match warm {
             None => ws.tau.fill([params.tau0; 4]),
             Some(changes) => {
@@ -202,9 +200,8 @@ impl<'g, 'a> Run<'g, 'a> {
         ws.delta.fill([0.0; 4]);
         let heuristic = Heuristic::new(goal, params.attraction(), params.beta);
         crate::fmt::debug!(
-            "plan: {} cells ({} pruned), ants {}, iterations {}",
+            "plan: {} cells, ants {}, iterations {}",
             cells,
-            pruned,
             params.ants,
             params.iterations
         );
@@ -223,12 +220,65 @@ impl<'g, 'a> Run<'g, 'a> {
             best_iteration: 0,
             stale: 0,
             moves: 0,
-            pruned,
-            routed,
+            pruned: 0,
+            routed: false,
             warm: warm.is_some(),
+            setup: Setup::Reach,
             no_path: false,
             done: false,
         })
+    }
+
+    /// Do the next piece of the setup, if any is left: the flood fill (a goal found unreachable
+    /// ends the run: [`Run::finish`] gives [`Error::NoPath`]), the dead-end pruning, the coarse
+    /// route. Returns `true` while setup remains. Each piece reads the whole map once (on a
+    /// 256 x 256 map about as long as an iteration), so the firmware yields between them;
+    /// [`Run::step`] does whatever setup is left itself, so other callers never need this.
+    pub fn setup_step(&mut self) -> bool {
+        let grid = self.grid;
+        let p = &self.params;
+        let ws = &mut self.ws;
+        match self.setup {
+            Setup::Reach => {
+                // A warm start with backtracking ants skips the flood fill: if a change cut the
+                // goal off, the first ant backs out of every branch and proves it
+                // (`Lost::Exhausted`, the run ends with `NoPath`) for about what the flood fill
+                // would have cost; otherwise the fill is pure overhead on a replan (4.6 M of 75 M
+                // instructions on Boston 256).
+                let proved_by_ants = self.warm && p.dead_end == DeadEnd::Backtrack;
+                if !proved_by_ants
+                    && grid.reachable(self.start, self.goal, ws.tabu, ws.links) == Reach::No
+                {
+                    self.no_path = true;
+                    self.done = true;
+                    self.setup = Setup::Done;
+                    return false;
+                }
+                self.setup = Setup::Prune;
+            }
+            Setup::Prune => {
+                self.pruned = if p.prune {
+                    let moves = Moves::new(*grid, ws.moves);
+                    prune(&moves, self.start, self.goal, ws.dead, ws.links)
+                } else {
+                    crate::bitmap::clear(ws.dead, grid.cells());
+                    0
+                };
+                self.setup = Setup::Route;
+            }
+            Setup::Route => {
+                // Large maps: the potential field pulls along a coarse route (not for ACA, which
+                // has no attraction).
+                self.routed = self.blocks.shift() > 0 && p.algorithm.attracts() && {
+                    let moves = Moves::new(*grid, ws.moves);
+                    route::build(&moves, self.guide_blocks, self.goal, ws.dead, ws.guide, ws.links)
+                };
+                crate::fmt::debug!("plan: {} cells pruned", self.pruned);
+                self.setup = Setup::Done;
+            }
+            Setup::Done => {}
+        }
+        self.setup != Setup::Done
     }
 
     /// Ant moves made so far.
@@ -277,6 +327,7 @@ impl<'g, 'a> Run<'g, 'a> {
     /// With these, the iteration's pheromone update (eq. 11-13) can be recomputed by hand; the
     /// tests do.
     pub fn step_observed(&mut self, on_tour: impl FnMut(&[Dir])) -> bool {
+        while self.setup_step() {}
         if self.done {
             return false;
         }
