@@ -306,7 +306,8 @@ impl Session {
             return error(ErrorCode::TooLarge, chunk.len() as u32, MAX_CHUNK as u32);
         }
         if offset == 0 {
-            self.upload = None;
+            // A bad header (`BadMap`, `MapTooLarge`) leaves an open upload as it was
+            // (`ohaca::protocol::Upload::accept`); a good one replaces it below.
             let cells = u32::from(width) * u32::from(height);
             if cells == 0 {
                 return error(ErrorCode::BadMap, 0, 0);
