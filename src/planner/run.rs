@@ -271,7 +271,14 @@ impl<'g, 'a> Run<'g, 'a> {
                 // has no attraction).
                 self.routed = self.blocks.shift() > 0 && p.algorithm.attracts() && {
                     let moves = Moves::new(*grid, ws.moves);
-                    route::build(&moves, self.guide_blocks, self.goal, ws.dead, ws.guide, ws.links)
+                    route::build(
+                        &moves,
+                        self.guide_blocks,
+                        self.goal,
+                        ws.dead,
+                        ws.guide,
+                        ws.links,
+                    )
                 };
                 crate::fmt::debug!("plan: {} cells pruned", self.pruned);
                 self.setup = Setup::Done;
