@@ -18,7 +18,8 @@
 //! | [`geometry`] | path lengths and the segment rule used by smoothing and path checks |
 //! | [`heuristic`] | the distance heuristic and the goal attraction of the potential field |
 //! | [`pheromone`] | the pheromone table: storage, evaporation, deposit, clamping |
-//! | [`ant`] | one ant's walk: the transition rule, tabu list, backtracking (or dying), tightening |
+//! | [`ant`] | one ant's walk: the transition rule, tabu list, backtracking (or dying) |
+//! | [`tighten`] | path tightening: a finished ant path straightened before the pheromone update |
 //! | [`update`] | the per-iteration pheromone update: classic deposit and the wolves rule |
 //! | [`smoothing`] | line-of-sight smoothing of the raw ant path |
 //! | [`refine`] | local search: the exact shortest path in a window sliding along a raw path |
@@ -111,6 +112,7 @@ pub mod refine;
 pub mod rng;
 pub mod route;
 pub mod smoothing;
+pub mod tighten;
 pub mod update;
 
 #[cfg(test)]

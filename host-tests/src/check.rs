@@ -136,7 +136,7 @@ pub fn corners(points: &[Point]) -> Vec<Point> {
 }
 
 /// The first pair `(i, j)` with `j >= i + 2` such that `raw[j]` is one allowed move from `raw[i]`:
-/// a detour that [`ohaca::ant::tighten`] promises to remove. `None` for a tight path.
+/// a detour that [`ohaca::tighten::tighten`] promises to remove. `None` for a tight path.
 pub fn shortcut(map: &Map, raw: &[Point]) -> Option<(usize, usize)> {
     (0..raw.len()).find_map(|i| {
         (i + 2..raw.len())

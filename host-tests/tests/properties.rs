@@ -618,7 +618,7 @@ fn any_angle_sanity_on_the_fixed_map() {
     assert!((aa - (4.0 + 50f64.sqrt())).abs() < 1e-9, "{aa}");
 }
 
-/// `ant::tighten` promises that, with `Params::tighten` on (the default), every ant's path is
+/// `tighten::tighten` promises that, with `Params::tighten` on (the default), every ant's path is
 /// straightened: no path cell is one allowed move away from a later, non-consecutive path cell.
 /// The walk only asks for tightening when it "passed next to a visited cell"; that check once
 /// skipped the goal cell, so a detour whose only shortcut ends at the goal was kept (regression

@@ -91,7 +91,7 @@ pub struct Params {
     pub dead_end: DeadEnd,
     /// How OHACA smooths the result (the other variants never smooth).
     pub smoothing: SmoothingKind,
-    /// Straighten each ant's path before the pheromone update ([`crate::ant::tighten`]); not in
+    /// Straighten each ant's path before the pheromone update ([`crate::tighten::tighten`]); not in
     /// the paper, off for faithful comparisons.
     pub tighten: bool,
     /// Prune the cells no shortest path needs before the ants run ([`crate::prune`]); not in the

@@ -5,7 +5,7 @@
 //! The firmware yields to its executor between steps, so it can answer other requests and cancel
 //! a plan by dropping (or finishing) the run.
 
-use crate::ant::{tighten, Ant, DeadEnd, Lost, Walk};
+use crate::ant::{Ant, DeadEnd, Lost, Walk};
 use crate::error::{Endpoint, Error};
 use crate::geometry::{polyline_length, steps_length, turns};
 use crate::grid::{Dir, Grid, Moves, Point, Reach};
@@ -15,6 +15,7 @@ use crate::prune::prune;
 use crate::rng::Xoshiro128pp;
 use crate::route::{self, Route};
 use crate::smoothing::{smooth, SmoothingKind};
+use crate::tighten::tighten;
 use crate::update::{deposit, wolves};
 
 use super::params::{Algorithm, Params};

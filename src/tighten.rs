@@ -1,0 +1,226 @@
+//! Path tightening (not in the paper): a finished ant path straightened in place before the
+//! pheromone update, jumping from each cell to the furthest later path cell one allowed move away.
+//!
+//! Owns [`tighten`] and the cell -> path-position index it needs (a per-cell array, or an
+//! open-addressing hash table over the path's cells when the workspace has fewer links than the
+//! map has cells; both give the same result). Like the rest of the core it has no panic path:
+//! every index is checked, and a path it cannot index is returned unchanged.
+
+use crate::ant::Walk;
+use crate::bitmap;
+use crate::grid::{is_diagonal, neighbour, opposite, Dir, Moves, Point};
+
+/// Straighten a finished walk in place: from each cell of the path, jump to the furthest later
+/// path cell that is one allowed move away, dropping the detour in between. Returns the new walk.
+///
+/// This is not in the paper. A depth-first ant path is loop-free but can still bulge (go around
+/// three sides of a square where one step would do). Cutting such bulges before the pheromone
+/// update makes every ant deposit on a tighter path, which is what lets the colony settle on
+/// near-optimal 8-connected paths within a few iterations (see `docs/ALGORITHM.md`). It costs at
+/// most 8 lookups per path cell.
+///
+/// `cells` is scratch of at least `steps + 1` points. `pos` finds a cell's position on the path:
+/// with one entry per map cell it is indexed by cell; shorter, it is an open-addressing hash
+/// table over the path's cells, which needs a power of two of at least twice the path's cells
+/// (a longer path is returned untightened). Both give the same result.
+///
+/// `visited` is the walk's tabu set (every cell of the path is in it): a neighbour outside it is
+/// not on the path and is not looked up. An empty set looks up every neighbour; same result.
+pub fn tighten(
+    moves: &Moves<'_>,
+    start: Point,
+    walk: Walk,
+    tour: &mut [Dir],
+    cells: &mut [Point],
+    pos: &mut [u32],
+    visited: &[u32],
+) -> Walk {
+    let grid = moves.grid();
+    // Cannot wrap for a real walk (steps < cells); were `steps` usize::MAX, `tour.get(..steps)`
+    // below would fail and the walk come back unchanged.
+    let n = walk.steps.wrapping_add(1);
+    let offsets = grid.offsets();
+    let (Some(cells), Some(path)) = (cells.get_mut(..n), tour.get(..walk.steps)) else {
+        return walk;
+    };
+    let mut index = match PathIndex::new(pos, grid.cells(), n) {
+        Some(ix) => ix,
+        None => return walk,
+    };
+    // Lay the path out as cells and remember each cell's position on it.
+    let mut p = start;
+    for (i, slot) in cells.iter_mut().enumerate() {
+        *slot = p;
+        index.insert(grid.index(p), i as u32);
+        if let Some(&d) = path.get(i) {
+            p = neighbour(p, d);
+        }
+    }
+    let mut i = 0usize;
+    let mut out = 0usize;
+    let (mut straight, mut diagonal) = (0u32, 0u32);
+    let (width, height) = (usize::from(grid.width()), usize::from(grid.height()));
+    // `i < n` throughout (it only ever becomes a valid index into `cells`), so no `wrapping_` below
+    // wraps: `out <= i` and `straight + diagonal == out`.
+    while i.wrapping_add(1) < n {
+        let Some(&cp) = cells.get(i) else { break };
+        let ci = grid.index(cp);
+        // Fast path, away from the map's border: when no neighbour but the path's previous and
+        // next cells was visited, the next cell is the furthest. `tour[i]` still holds the step
+        // from cell `i` to `i + 1` and `tour[i - 1]` the step into cell `i` (the output so far
+        // ends at index `out - 1 < i`, and its last step, if at `i - 1`, is that same step).
+        if let Some(&next_d) = tour.get(i) {
+            let (x, y) = (usize::from(cp.x), usize::from(cp.y));
+            if x > 0 && y > 0 && x.wrapping_add(1) < width && y.wrapping_add(1) < height {
+                let mut others = bitmap::around(visited, ci, width) & !(1u8 << (next_d & 7));
+                if let Some(&in_d) = i.checked_sub(1).and_then(|k| tour.get(k)) {
+                    others &= !(1u8 << (opposite(in_d) & 7));
+                }
+                if others == 0 {
+                    if let Some(slot) = tour.get_mut(out) {
+                        *slot = next_d;
+                    }
+                    out = out.wrapping_add(1);
+                    if is_diagonal(next_d) {
+                        diagonal = diagonal.wrapping_add(1);
+                    } else {
+                        straight = straight.wrapping_add(1);
+                    }
+                    i = i.wrapping_add(1);
+                    continue;
+                }
+            }
+        }
+        // The path's cells before and after this one are known without a look-up.
+        let prev = match i.checked_sub(1).and_then(|k| cells.get(k)) {
+            Some(&q) => grid.index(q),
+            None => usize::MAX,
+        };
+        let next = cells
+            .get(i.wrapping_add(1))
+            .map_or(usize::MAX, |&q| grid.index(q));
+        let mut mask = moves.at(ci, cp);
+        // Furthest later path cell one allowed move away (the next cell always qualifies).
+        let mut best = (i, 0u8);
+        while mask != 0 {
+            let d = mask.trailing_zeros() as u8;
+            mask &= mask.wrapping_sub(1);
+            let nb = ci.wrapping_add_signed(offsets.get(usize::from(d)).copied().unwrap_or(0));
+            // Not visited: not on the path (a cell beyond the set reads as visited). The previous
+            // cell cannot be the furthest; the next one is at `i + 1` (cells are unique on a path).
+            if !bitmap::get(visited, nb) || nb == prev {
+                continue;
+            }
+            if nb == next {
+                if i.wrapping_add(1) > best.0 {
+                    best = (i.wrapping_add(1), d);
+                }
+                continue;
+            }
+            if let Some(j) = index.find(nb, |j| cells.get(j).map(|&q| grid.index(q))) {
+                if j > best.0 {
+                    best = (j, d);
+                }
+            }
+        }
+        let (j, d) = best;
+        if j == i {
+            // Cannot happen for a path made of allowed moves; stop rather than loop.
+            break;
+        }
+        if let Some(slot) = tour.get_mut(out) {
+            *slot = d;
+        }
+        out = out.wrapping_add(1);
+        if is_diagonal(d) {
+            diagonal = diagonal.wrapping_add(1);
+        } else {
+            straight = straight.wrapping_add(1);
+        }
+        i = j;
+    }
+    Walk {
+        steps: out,
+        straight,
+        diagonal,
+        moves: walk.moves,
+        may_tighten: false,
+    }
+}
+
+/// Cell -> position on a path: a per-cell array, or a hash table over the path's cells.
+struct PathIndex<'a> {
+    slots: &'a mut [u32],
+    /// `Some(bits)`: hash table of `2^bits` slots holding `position + 1` (0 = empty).
+    hash: Option<u32>,
+}
+
+impl<'a> PathIndex<'a> {
+    fn new(pos: &'a mut [u32], cells: usize, n: usize) -> Option<Self> {
+        if pos.len() >= cells {
+            return Some(PathIndex {
+                slots: pos,
+                hash: None,
+            });
+        }
+        // The smallest power of two of at least 2n slots (load factor <= 1/2).
+        let want = n.checked_mul(2)?.checked_next_power_of_two()?;
+        let slots = pos.get_mut(..want)?;
+        slots.fill(0);
+        Some(PathIndex {
+            slots,
+            hash: Some(want.trailing_zeros()),
+        })
+    }
+
+    #[inline]
+    fn home(bits: u32, cell: usize) -> usize {
+        // Fibonacci hashing of the (32-bit) cell index onto `bits` bits (1 <= bits <= 32).
+        ((cell as u32).wrapping_mul(0x9E37_79B9) >> (32u32.wrapping_sub(bits) & 31)) as usize
+    }
+
+    fn insert(&mut self, cell: usize, i: u32) {
+        let Some(bits) = self.hash else {
+            if let Some(s) = self.slots.get_mut(cell) {
+                *s = i;
+            }
+            return;
+        };
+        let mask = self.slots.len().wrapping_sub(1);
+        let mut h = Self::home(bits, cell) & mask;
+        // At most n entries in 2n slots: an empty slot is always found.
+        for _ in 0..self.slots.len() {
+            match self.slots.get_mut(h) {
+                Some(s) if *s == 0 => {
+                    *s = i.wrapping_add(1); // i < n <= 2^31
+                    return;
+                }
+                _ => h = h.wrapping_add(1) & mask,
+            }
+        }
+    }
+
+    /// The position of `cell`, checked against the path (`cell_at(j)` = the cell at position `j`):
+    /// a per-cell array may hold stale positions from earlier walks.
+    #[inline]
+    fn find(&self, cell: usize, cell_at: impl Fn(usize) -> Option<usize>) -> Option<usize> {
+        let Some(bits) = self.hash else {
+            let j = *self.slots.get(cell)? as usize;
+            return (cell_at(j) == Some(cell)).then_some(j);
+        };
+        let mask = self.slots.len().wrapping_sub(1);
+        let mut h = Self::home(bits, cell) & mask;
+        for _ in 0..self.slots.len() {
+            let v = *self.slots.get(h)?;
+            if v == 0 {
+                return None;
+            }
+            let j = v.wrapping_sub(1) as usize;
+            if cell_at(j) == Some(cell) {
+                return Some(j);
+            }
+            h = h.wrapping_add(1) & mask;
+        }
+        None
+    }
+}
