@@ -593,8 +593,8 @@ mod tests {
                             }
                         }
                     }
-                    for t in 0..cells {
-                        let want = if seen[t] && g.is_free(g.point(t)) {
+                    for (t, &seen_t) in seen.iter().enumerate().take(cells) {
+                        let want = if seen_t && g.is_free(g.point(t)) {
                             Reach::Yes
                         } else {
                             Reach::No

@@ -243,9 +243,10 @@ fn a_warm_start_keeps_the_pheromone_away_from_changes_and_resets_it_near_them() 
     bits[i / 8] |= 1 << (i % 8);
     memory.changed(Area::cell(c));
     let g = Grid::new(w, h, &bits).unwrap();
-    let run = Run::warm(&g, Point::new(5, 5), goal, &p, st.workspace(), &mut memory).unwrap();
-    assert!(run.is_warm());
-    drop(run);
+    let warm = Run::warm(&g, Point::new(5, 5), goal, &p, st.workspace(), &mut memory)
+        .unwrap()
+        .is_warm();
+    assert!(warm);
     let after = st.workspace().pheromone().to_vec();
     let r = i32::from(REPAIR_RADIUS) + 1;
     let mut kept = 0;
