@@ -144,15 +144,8 @@ pub fn check_planner(input: &PlannerInput) {
     for (start, warm) in rounds {
         if warm {
             for &(c, blocked) in input.replan.iter().flat_map(|r| &r.changes) {
-                if c.x < w && c.y < h {
-                    let i = usize::from(c.y) * usize::from(w) + usize::from(c.x);
-                    if let Some(b) = bits.get_mut(i / 8) {
-                        if blocked {
-                            *b |= 1 << (i % 8);
-                        } else {
-                            *b &= !(1 << (i % 8));
-                        }
-                    }
+                // The device's cell writer; a cell off the map changes nothing.
+                if ohaca::protocol::set_rect((w, h), &mut bits, (c.x, c.y, 1, 1), blocked).is_ok() {
                     memory.changed(Area::cell(c));
                 }
             }

@@ -253,20 +253,8 @@ impl<T: Transport> Planner for DevicePlanner<T> {
 }
 
 fn set_cell(map: &mut Map, p: Point, blocked: bool) -> Result<(), String> {
-    if p.x >= map.width || p.y >= map.height {
-        return Err(format!("cell ({}, {}) is outside the map", p.x, p.y));
-    }
-    let i = usize::from(p.y) * usize::from(map.width) + usize::from(p.x);
-    let b = map
-        .bits
-        .get_mut(i / 8)
-        .ok_or_else(|| "map bits too short".to_string())?;
-    if blocked {
-        *b |= 1 << (i % 8);
-    } else {
-        *b &= !(1 << (i % 8));
-    }
-    Ok(())
+    map.set(p, blocked)
+        .map_err(|_| format!("cell ({}, {}) is outside the map", p.x, p.y))
 }
 
 /// One plan of a scenario run.
@@ -274,6 +262,8 @@ fn set_cell(map: &mut Map, p: Point, blocked: bool) -> Result<(), String> {
 pub struct Step {
     /// The robot's cell when it planned.
     pub robot: Point,
+    /// Where that cell is on [`Drive::trail`] (the plan is driven from there).
+    pub at: usize,
     /// Cells changed just before this plan (empty for the first plan without `initial`).
     pub changed: Vec<Point>,
     /// Blocked (true) or cleared.
@@ -320,7 +310,13 @@ pub fn drive(
     let mut trail = vec![start];
     let mut steps: Vec<Step> = Vec::new();
     steps.push(plan_step(
-        planner, robot, goal, &map, changed, blocked, false,
+        planner,
+        (robot, 0),
+        goal,
+        &map,
+        changed,
+        blocked,
+        false,
     )?);
     for (i, e) in scenario.events.iter().enumerate() {
         let path = steps.last().map(|s| s.plan.raw.clone()).unwrap_or_default();
@@ -337,8 +333,17 @@ pub fn drive(
         planner
             .change(&cells, e.change.blocked)
             .map_err(|m| format!("event {i}: {m}"))?;
-        let step = plan_step(planner, robot, goal, &map, cells, e.change.blocked, warm)
-            .map_err(|m| format!("event {i}: {m}"))?;
+        let at = trail.len() - 1;
+        let step = plan_step(
+            planner,
+            (robot, at),
+            goal,
+            &map,
+            cells,
+            e.change.blocked,
+            warm,
+        )
+        .map_err(|m| format!("event {i}: {m}"))?;
         steps.push(step);
     }
     if let Some(last) = steps.last() {
@@ -350,7 +355,7 @@ pub fn drive(
 /// Plan from the robot's cell, check the plan and measure the optimum.
 fn plan_step(
     planner: &mut dyn Planner,
-    robot: Point,
+    (robot, at): (Point, usize),
     goal: Point,
     map: &Map,
     changed: Vec<Point>,
@@ -361,6 +366,7 @@ fn plan_step(
     check(map, robot, goal, &plan.raw)?;
     Ok(Step {
         robot,
+        at,
         changed,
         blocked,
         map: map.clone(),
@@ -524,6 +530,7 @@ mod tests {
             check(&s.map, s.robot, Point::new(22, 12), &s.plan.raw).unwrap();
             assert_eq!(s.plan.warm, warm);
             assert!(s.optimum.unwrap() > f64::from(22 - s.robot.x));
+            assert!(d.steps.iter().all(|s| d.trail[s.at] == s.robot));
             assert_eq!(d.trail.first(), Some(&Point::new(1, 12)));
             assert_eq!(d.trail.last(), Some(&Point::new(22, 12)));
         }

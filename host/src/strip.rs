@@ -105,17 +105,9 @@ impl Canvas {
     }
 }
 
-/// Where the robot is on the drive's trail at each plan (the trail index it planned from).
+/// Where the robot is on the drive's trail at each plan.
 fn plan_positions(drive: &Drive) -> Vec<usize> {
-    let mut at = Vec::with_capacity(drive.steps.len());
-    let mut i = 0usize;
-    for s in &drive.steps {
-        while drive.trail.get(i).is_some_and(|&p| p != s.robot) {
-            i += 1;
-        }
-        at.push(i.min(drive.trail.len().saturating_sub(1)));
-    }
-    at
+    drive.steps.iter().map(|s| s.at).collect()
 }
 
 /// Draw the picture of the drive at trail index `t` (plan `k` active) onto `c`.

@@ -257,8 +257,8 @@ async fn update(u: Update<'_>, blocked: bool) -> Reply<'static> {
             set_rect(size, &mut map[..], (x, y, w, h), blocked)
         }
         Update::Cells(c) => {
-            for p in c.iter() {
-                state::colony_changed(Area::cell(p));
+            if let Some(a) = c.iter().map(Area::cell).reduce(Area::union) {
+                state::colony_changed(a);
             }
             set_cells(size, &mut map[..], &c, blocked)
         }

@@ -9,9 +9,10 @@
 use std::path::PathBuf;
 use std::time::Duration;
 
+use ohaca::Params;
 use ohaca::Point;
 use ohaca_host::input::MapArgs;
-use ohaca_host::link::{Link, DEFAULT_BAUD};
+use ohaca_host::link::{Link, Transport, DEFAULT_BAUD};
 use ohaca_host::replan::{drive, DevicePlanner, Drive, HostPlanner, Planner, Scenario};
 use ohaca_host::{exit, strip, ParamArgs};
 use serde::Serialize;
@@ -97,23 +98,28 @@ fn rows(mode: &'static str, d: &Drive) -> Vec<Row> {
         .collect()
 }
 
+/// A device over `link`, told the parameters.
+fn device<T: Transport + 'static>(
+    mut link: Link<T>,
+    params: &Params,
+) -> Result<Box<dyn Planner>, String> {
+    link.hello().map_err(|e| e.to_string())?;
+    link.set_params(params).map_err(|e| e.to_string())?;
+    Ok(Box::new(DevicePlanner { link }))
+}
+
 fn planner(args: &Args) -> Result<Box<dyn Planner>, String> {
     let params = args.params.params();
     let timeout = Duration::try_from_secs_f64(args.timeout).map_err(|e| e.to_string())?;
-    let device = |mut link: Link<_>| -> Result<Box<dyn Planner>, String> {
-        link.hello().map_err(|e| e.to_string())?;
-        link.set_params(&params).map_err(|e| e.to_string())?;
-        Ok(Box::new(DevicePlanner { link }))
-    };
     if let Some(addr) = &args.tcp {
-        return device(Link::tcp(addr, timeout).map_err(|e| e.to_string())?);
+        return device(
+            Link::tcp(addr, timeout).map_err(|e| e.to_string())?,
+            &params,
+        );
     }
     if let Some(port) = &args.serial {
         let link = Link::serial(port, args.baud, timeout).map_err(|e| e.to_string())?;
-        let mut link = link;
-        link.hello().map_err(|e| e.to_string())?;
-        link.set_params(&params).map_err(|e| e.to_string())?;
-        return Ok(Box::new(DevicePlanner { link }));
+        return device(link, &params);
     }
     Ok(Box::new(HostPlanner::new(params)))
 }

@@ -65,6 +65,14 @@ impl Map {
         self.bits.get(i / 8).is_none_or(|b| (b >> (i % 8)) & 1 == 1)
     }
 
+    /// Block (`blocked`) or clear cell `p`, with the device's own cell writer
+    /// ([`ohaca::protocol::set_rect`], one cell). Fails with the protocol's `OutsideMap` when `p`
+    /// is off the map.
+    pub fn set(&mut self, p: Point, blocked: bool) -> Result<(), ohaca::protocol::ErrorReply> {
+        let size = (self.width, self.height);
+        ohaca::protocol::set_rect(size, &mut self.bits, (p.x, p.y, 1, 1), blocked)
+    }
+
     /// The map as a text grid (`.` free, `#` blocked, one row per line), which
     /// [`Map::parse`] with [`Format::Text`] reads back unchanged.
     pub fn to_text(&self) -> String {
