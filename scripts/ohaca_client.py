@@ -136,7 +136,7 @@ def unframe(wire):
 
 # ---- messages --------------------------------------------------------------------------------
 
-PROTOCOL_VERSION = 4
+PROTOCOL_VERSION = 5
 ALGORITHMS = ["aca", "paca", "haca", "ohaca"]
 DEAD_ENDS = ["backtrack", "die"]
 SMOOTHING = ["none", "greedy", "shortest"]
@@ -149,8 +149,9 @@ ERRORS = {
 PARAM_FIELDS = [
     ("algorithm", "enum"), ("ants", "u"), ("iterations", "u"), ("alpha", "f"), ("beta", "f"),
     ("rho", "f"), ("q", "f"), ("a", "f"), ("xi", "f"), ("tau0", "f"), ("tau_min", "f"),
-    ("tau_max", "f"), ("patience", "u"), ("warm_patience", "u"), ("seed", "u"), ("dead_end", "enum"),
-    ("smoothing", "enum"), ("tighten", "bool"), ("prune", "bool"),
+    ("tau_max", "f"), ("patience", "u"), ("warm_patience", "u"), ("refine_patience", "u"),
+    ("seed", "u"), ("dead_end", "enum"), ("smoothing", "enum"), ("tighten", "bool"),
+    ("prune", "bool"), ("refine", "bool"),
 ]
 
 

@@ -404,6 +404,13 @@ pub fn neighbour(p: Point, d: Dir) -> Point {
     Point::new(x as u16, y as u16)
 }
 
+/// The move from `a` to `b` if they are 8-neighbours (`neighbour(a, d) == b`), else `None`.
+pub fn direction(a: Point, b: Point) -> Option<Dir> {
+    let dx = i32::from(b.x).wrapping_sub(i32::from(a.x));
+    let dy = i32::from(b.y).wrapping_sub(i32::from(a.y));
+    (0..8u8).find(|&d| DX.get(usize::from(d)) == Some(&dx) && DY.get(usize::from(d)) == Some(&dy))
+}
+
 /// Allowed-move masks, read from a per-cell table when the caller has one (one byte a cell,
 /// [`Grid::move_mask`] of every cell) and computed with [`Grid::mask_at`] otherwise: the same
 /// values either way, so the choice changes speed and memory, never a path.

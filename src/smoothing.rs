@@ -141,16 +141,95 @@ pub fn smooth(
     dist: &mut [f32],
     prev: &mut [u32],
 ) -> usize {
-    let n = n.min(pts.len());
-    if n < 3 {
-        return n;
+    Smoother::new(kind, n, dist, prev).finish(grid, pts, dist, prev)
+}
+
+/// [`smooth`] a stretch at a time, so that a firmware can yield inside a long smoothing: the
+/// shortest-path DP advances a given number of raw cells per [`Smoother::resume`], and
+/// [`Smoother::finish`] does what is left and compacts the waypoints. The result does not depend
+/// on how the work was cut: it is [`smooth`]'s, bit for bit. The caller passes the same buffers to
+/// every call.
+#[derive(Clone, Copy, Debug)]
+pub struct Smoother {
+    kind: SmoothingKind,
+    /// Cells of the raw path.
+    n: usize,
+    /// Next raw cell of the DP (`n` once it is complete).
+    j: usize,
+    /// Entries of the `dist` ring used.
+    ring: usize,
+}
+
+impl Smoother {
+    /// Prepare to smooth `pts[..n]` with `kind`. Falls back to [`SmoothingKind::Greedy`] when
+    /// `dist` and `prev` are shorter than [`scratch_for`]`(n)`.
+    pub fn new(kind: SmoothingKind, n: usize, dist: &mut [f32], prev: &mut [u32]) -> Self {
+        let ring = n.min(LOOKBACK.wrapping_add(1));
+        let kind = if kind == SmoothingKind::Shortest && (dist.len() < ring || prev.len() < n) {
+            SmoothingKind::Greedy
+        } else {
+            kind
+        };
+        if let (Some(d0), Some(p0)) = (dist.first_mut(), prev.first_mut()) {
+            *d0 = 0.0;
+            *p0 = 0;
+        }
+        Smoother {
+            kind,
+            n,
+            j: if kind == SmoothingKind::Shortest && n >= 3 {
+                1
+            } else {
+                n
+            },
+            ring,
+        }
     }
-    let k = match kind {
-        SmoothingKind::None => n,
-        SmoothingKind::Greedy => greedy(grid, pts, n),
-        SmoothingKind::Shortest => shortest_with(grid, pts, n, dist, prev, LOOKBACK),
-    };
-    drop_collinear(pts, k)
+
+    /// Advance the DP by at most `cells` raw cells; returns `true` while some remain.
+    pub fn resume(
+        &mut self,
+        grid: &Grid<'_>,
+        pts: &[Point],
+        dist: &mut [f32],
+        prev: &mut [u32],
+        cells: usize,
+    ) -> bool {
+        let n = self.n.min(pts.len());
+        let to = self.j.saturating_add(cells).min(n);
+        let ring = dist.get_mut(..self.ring).unwrap_or_default();
+        dp_cells(grid, pts, ring, prev, LOOKBACK, self.j..to);
+        self.j = to.max(self.j);
+        self.j < n
+    }
+
+    /// Finish the DP if needed and write the waypoints to the front of `pts`; returns how many.
+    pub fn finish(
+        mut self,
+        grid: &Grid<'_>,
+        pts: &mut [Point],
+        dist: &mut [f32],
+        prev: &mut [u32],
+    ) -> usize {
+        let n = self.n.min(pts.len());
+        if n < 3 {
+            return n;
+        }
+        let k = match self.kind {
+            SmoothingKind::None => n,
+            SmoothingKind::Greedy => greedy(grid, pts, n),
+            SmoothingKind::Shortest => {
+                while self.resume(grid, pts, dist, prev, usize::MAX) {}
+                let k = trace(pts, n, prev);
+                if self.ring < n {
+                    merge(grid, pts, k)
+                } else {
+                    k
+                }
+            }
+        };
+        drop_collinear(pts, k)
+    }
 }
 
 /// The paper's greedy rule, in place.
@@ -232,14 +311,29 @@ fn shortest(
     prev: &mut [u32],
     lookback: usize,
 ) -> usize {
-    let ring = dist.len();
-    // `ring >= 1` (n >= 3), so the `checked_rem` never fails.
-    let slot = |i: usize| i.checked_rem(ring).unwrap_or(0);
-    if let (Some(d0), Some(p0)) = (dist.get_mut(0), prev.get_mut(0)) {
+    if let (Some(d0), Some(p0)) = (dist.first_mut(), prev.first_mut()) {
         *d0 = 0.0;
         *p0 = 0;
     }
-    for j in 1..n {
+    dp_cells(grid, pts, dist, prev, lookback, 1..n);
+    trace(pts, n, prev)
+}
+
+/// The DP for the raw cells `cells` (in order, after every cell before them): the shortest
+/// distance to cell `j` over the cells at most `lookback` back that see it, into the `dist` ring
+/// (cell `i` in slot `i % dist.len()`), and the chosen predecessor into `prev[j]`.
+fn dp_cells(
+    grid: &Grid<'_>,
+    pts: &[Point],
+    dist: &mut [f32],
+    prev: &mut [u32],
+    lookback: usize,
+    cells: core::ops::Range<usize>,
+) {
+    let ring = dist.len();
+    // `ring >= 1` whenever there is a cell to do, so the `checked_rem` never fails.
+    let slot = |i: usize| i.checked_rem(ring).unwrap_or(0);
+    for j in cells {
         let Some(&pj) = pts.get(j) else { break };
         // Default: come from the previous raw cell (always clear: it is a legal move).
         let before = j.wrapping_sub(1); // j >= 1
@@ -263,6 +357,11 @@ fn shortest(
             *p = from as u32;
         }
     }
+}
+
+/// Follow the DP's links from the goal (`pts[n - 1]`) back to the start and compact the chosen
+/// cells to the front of `pts`; returns how many.
+fn trace(pts: &mut [Point], n: usize, prev: &mut [u32]) -> usize {
     // Follow prev from the goal back to the start, reversing the links into "next" links.
     let mut cur = n.wrapping_sub(1); // n >= 3 (see `smooth`)
     let mut next = u32::MAX;
@@ -449,6 +548,33 @@ mod tests {
                 }
             }
             return (b, path);
+        }
+    }
+
+    #[test]
+    fn smoothing_in_stretches_equals_smoothing_at_once() {
+        let mut rng = crate::rng::Xoshiro128pp::from_u64(11);
+        for case in 0..60 {
+            let steps = 2 + case * 7; // short and longer than the look-back
+            let (b, raw) = random_walk(&mut rng, 64, 48, 0.12, steps);
+            let g = Grid::new(64, 48, &b).unwrap();
+            let n = raw.len();
+            for kind in SmoothingKind::ALL {
+                let (mut p1, mut d1, mut r1) = (raw.clone(), vec![0.0; n], vec![0; n]);
+                let k1 = smooth(&g, kind, &mut p1, n, &mut d1, &mut r1);
+                let (mut p2, mut d2, mut r2) = (raw.clone(), vec![7.0; n], vec![9; n]);
+                let mut sm = Smoother::new(kind, n, &mut d2, &mut r2);
+                let chunk = 1 + case % 13;
+                let mut calls = 0;
+                while sm.resume(&g, &p2, &mut d2, &mut r2, chunk) {
+                    calls += 1;
+                }
+                if kind == SmoothingKind::Shortest {
+                    assert_eq!(calls, (n - 1).div_ceil(chunk) - 1, "{n} {chunk}");
+                }
+                let k2 = sm.finish(&g, &mut p2, &mut d2, &mut r2);
+                assert_eq!(p1[..k1], p2[..k2], "{kind:?} case {case}");
+            }
         }
     }
 

@@ -77,6 +77,7 @@ impl<'a> Arbitrary<'a> for PlannerInput {
             tau_max: pick_f32(u, &[100.0, 1e30, 1.0])?,
             patience: *u.choose(&[0u16, 1, 20])?,
             warm_patience: *u.choose(&[0u16, 1, 3])?,
+            refine_patience: 0,
             seed: u64::arbitrary(u)?,
             dead_end: if bool::arbitrary(u)? {
                 DeadEnd::Backtrack
@@ -90,6 +91,7 @@ impl<'a> Arbitrary<'a> for PlannerInput {
             ])?,
             tighten: bool::arbitrary(u)?,
             prune: bool::arbitrary(u)?,
+            refine: false,
         };
         let replan = if bool::arbitrary(u)? {
             let n = u.int_in_range(0..=12usize)?;
@@ -103,6 +105,14 @@ impl<'a> Arbitrary<'a> for PlannerInput {
         } else {
             None
         };
+        // Decoded last, so that older inputs (which run out of bytes before) keep their meaning:
+        // the local search and its patience, and a tiling of the map (up to 60 x 60 cells) so
+        // that it applies (maps of more than 1,024 cells).
+        let mut params = params;
+        params.refine = bool::arbitrary(u)?;
+        params.refine_patience = *u.choose(&[0u16, 1, 3])?;
+        let tile = u.int_in_range(1..=3u16)?;
+        let (width, height, bits) = tiled(width, height, &bits, tile);
         Ok(PlannerInput {
             width,
             height,
@@ -113,6 +123,26 @@ impl<'a> Arbitrary<'a> for PlannerInput {
             replan,
         })
     }
+}
+
+/// The map `bits` (`w x h`) repeated `t x t` times.
+fn tiled(w: u16, h: u16, bits: &[u8], t: u16) -> (u16, u16, Vec<u8>) {
+    if t <= 1 {
+        return (w, h, bits.to_vec());
+    }
+    let (tw, th) = (w * t, h * t);
+    let (w, h, tw_) = (usize::from(w), usize::from(h), usize::from(tw));
+    let mut out = vec![0u8; (tw_ * usize::from(th)).div_ceil(8)];
+    for y in 0..usize::from(th) {
+        for x in 0..tw_ {
+            let i = (y % h) * w + x % w;
+            if bits.get(i / 8).is_some_and(|b| b & (1 << (i % 8)) != 0) {
+                let j = y * tw_ + x;
+                out[j / 8] |= 1 << (j % 8);
+            }
+        }
+    }
+    (tw, th, out)
 }
 
 /// Plan and check every promise the planner makes, then (if asked) change cells and replan warm

@@ -5,11 +5,12 @@
 //! ```text
 //! cargo run --release -p ohaca-host-tests --target host-tuple --example refine_large -- \
 //!     [--maps NAME,NAME,...] [--scen N] [--sides 48,64,128] [--passes P] [--cache DIR] \
-//!     [--smooth 1]
+//!     [--smooth 1] [--patience P]
 //! ```
 //!
 //! For each map: the `N` (default 20) scenarios of largest optimum (as in the `large` example),
-//! the exact optimum by the reference A*, the default plan (seed 1), then `refine` of its raw path
+//! the exact optimum by the reference A*, the default plan (seed 1; `--patience` overrides the
+//! early stop), then `refine` of its raw path
 //! with a window of each side. Raw paths are cached in `DIR` (default
 //! `target/refine-large-cache`), so that trying other window sides does not re-plan. Prints one
 //! Markdown row per map and side: every refined path checked valid, mean raw/opt8 before and
@@ -33,32 +34,40 @@ use ohaca_host_tests::quality::par_map;
 use ohaca_host_tests::reference::astar8;
 
 /// Raw path of the default plan, from the cache or planned (and cached).
-fn raw_path(cache: &Path, m: &LargeMap, c: usize, seed: u64) -> Vec<Point> {
+fn raw_path(cache: &Path, m: &LargeMap, c: usize, seed: u64, patience: u16) -> (Vec<Point>, u16) {
     let case = &m.cases[c];
     let file = cache.join(format!(
-        "{}-{}-{}-{}-{}-s{seed}.txt",
+        "{}-{}-{}-{}-{}-s{seed}-p{patience}.txt",
         m.name, case.start.x, case.start.y, case.goal.x, case.goal.y
     ));
     if let Ok(text) = std::fs::read_to_string(&file) {
-        return text
-            .lines()
+        let mut lines = text.lines();
+        let iterations = lines
+            .next()
+            .and_then(|l| l.strip_prefix("# iterations "))
+            .and_then(|n| n.parse().ok())
+            .expect("cache header");
+        let raw = lines
             .map(|l| {
                 let (x, y) = l.split_once(' ').expect("x y");
                 Point::new(x.parse().expect("x"), y.parse().expect("y"))
             })
             .collect();
+        return (raw, iterations);
     }
     let mut st = ohaca_host_tests::heap::storage(m.map.cells());
     let grid = m.map.grid();
     let p = Params {
         seed,
+        patience,
         ..Params::default()
     };
     let pl = plan(&grid, case.start, case.goal, &p, st.workspace()).expect("a plan");
     let raw: Vec<Point> = pl.raw().collect();
-    let text: String = raw.iter().map(|p| format!("{} {}\n", p.x, p.y)).collect();
+    let mut text = format!("# iterations {}\n", pl.iterations);
+    text.extend(raw.iter().map(|p| format!("{} {}\n", p.x, p.y)));
     std::fs::write(&file, text).expect("write the cache");
-    raw
+    (raw, pl.iterations)
 }
 
 fn main() {
@@ -72,6 +81,7 @@ fn main() {
         .join("target")
         .join("refine-large-cache");
     let mut smooth_table = false;
+    let mut patience = Params::default().patience;
     let mut it = args.iter();
     while let Some(flag) = it.next() {
         let v = it.next().expect("every option takes a value");
@@ -82,6 +92,7 @@ fn main() {
             "--passes" => passes = v.parse().expect("--passes P"),
             "--cache" => cache = PathBuf::from(v),
             "--smooth" => smooth_table = v == "1",
+            "--patience" => patience = v.parse().expect("--patience P"),
             _ => panic!("unknown option {flag}"),
         }
     }
@@ -90,8 +101,8 @@ fn main() {
         .into_iter()
         .filter(|m| only.as_ref().is_none_or(|o| o.iter().any(|n| n == &m.name)))
         .collect();
-    println!("| map | size | side | runs | valid | raw/opt8 before | after | max after | expanded/plan | expanded/raw cell | windows/plan | improved/plan |");
-    println!("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |");
+    println!("| map | size | iterations | side | runs | valid | raw/opt8 before | after | max after | expanded/plan | expanded/raw cell | windows/plan | improved/plan |");
+    println!("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |");
     let mut totals = vec![(0.0f64, 0.0f64, 0usize); sides.len()];
     let mut bases = vec![];
     for m in &maps {
@@ -101,27 +112,22 @@ fn main() {
             let opt = astar8(&m.map, case.start, case.goal)
                 .map(|(d, _)| d)
                 .expect("solvable");
-            (opt, raw_path(&cache, m, c, 1))
+            let (raw, iterations) = raw_path(&cache, m, c, 1, patience);
+            (opt, raw, iterations)
         });
+        let iterations =
+            base.iter().map(|b| f64::from(b.2)).sum::<f64>() / base.len().max(1) as f64;
         bases.push(base.iter().map(|b| b.1.clone()).collect::<Vec<_>>());
         for (si, &side) in sides.iter().enumerate() {
             let res: Vec<(bool, f64, f64, Budget, usize)> = base
                 .iter()
                 .enumerate()
-                .map(|(c, (opt, raw))| {
+                .map(|(c, (opt, raw, _))| {
                     let case = &m.cases[c];
                     let before = check_raw(&m.map, case.start, case.goal, raw).expect("raw valid");
-                    let cells = side * side;
-                    let (mut g, mut f) = (vec![0u32; cells], vec![0u32; cells]);
-                    let mut link = vec![0u8; cells];
-                    let (mut heap, mut pos) = (vec![0u16; cells], vec![0u16; cells]);
-                    let scratch = Scratch {
-                        g: &mut g,
-                        f: &mut f,
-                        link: &mut link,
-                        heap: &mut heap,
-                        pos: &mut pos,
-                    };
+                    let words = Scratch::words(side);
+                    let (mut a, mut b) = (vec![0u32; words], vec![0u32; words]);
+                    let scratch = Scratch::new(&mut a, &mut b);
                     let mut out = vec![Point::default(); raw.len() + side];
                     let mut b = Budget::unlimited();
                     let grid = m.map.grid();
@@ -156,7 +162,7 @@ fn main() {
             totals[si].1 += after * n;
             totals[si].2 += res.len();
             println!(
-                "| {} | {}x{} | {side} | {} | {valid} | {before:.4} | {after:.4} | {worst:.4} | {exp:.0} | {:.1} | {win:.1} | {imp:.1} |",
+                "| {} | {}x{} | {iterations:.1} | {side} | {} | {valid} | {before:.4} | {after:.4} | {worst:.4} | {exp:.0} | {:.1} | {win:.1} | {imp:.1} |",
                 m.name,
                 m.map.width(),
                 m.map.height(),
@@ -181,17 +187,9 @@ fn main() {
 
 /// Refine `raw` with a window of `side` (unlimited budget).
 fn refined(m: &LargeMap, raw: &[Point], side: usize) -> Vec<Point> {
-    let cells = side * side;
-    let (mut g, mut f) = (vec![0u32; cells], vec![0u32; cells]);
-    let mut link = vec![0u8; cells];
-    let (mut heap, mut pos) = (vec![0u16; cells], vec![0u16; cells]);
-    let scratch = Scratch {
-        g: &mut g,
-        f: &mut f,
-        link: &mut link,
-        heap: &mut heap,
-        pos: &mut pos,
-    };
+    let words = Scratch::words(side);
+    let (mut a, mut b) = (vec![0u32; words], vec![0u32; words]);
+    let scratch = Scratch::new(&mut a, &mut b);
     let mut out = vec![Point::default(); raw.len() + side];
     let k = ohaca::refine::refine(
         &m.map.grid(),

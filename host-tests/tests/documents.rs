@@ -113,9 +113,12 @@ fn postcard_len(req: &Request<'_>) -> usize {
 fn the_parameter_table_is_the_cores() {
     let text = doc("ALGORITHM.md");
     let row = |name: &str| -> Vec<String> {
+        // The last such row: the parameter table ends the document (another table may start
+        // with a parameter's name, as the warm-start one does).
         let line = text
             .lines()
-            .find(|l| l.starts_with(&format!("| `{name}` |")))
+            .filter(|l| l.starts_with(&format!("| `{name}` |")))
+            .last()
             .unwrap_or_else(|| panic!("no row for {name} in ALGORITHM.md's parameter table"));
         line.split('|').map(|c| c.trim().to_string()).collect()
     };
@@ -135,6 +138,16 @@ fn the_parameter_table_is_the_cores() {
             f32::from(p.iterations),
         ),
         ("patience", f32::from(d.patience), f32::from(p.patience)),
+        (
+            "warm_patience",
+            f32::from(d.warm_patience),
+            f32::from(p.warm_patience),
+        ),
+        (
+            "refine_patience",
+            f32::from(d.refine_patience),
+            f32::from(p.refine_patience),
+        ),
     ] {
         let r = row(name);
         assert_eq!(
@@ -164,4 +177,5 @@ fn the_parameter_table_is_the_cores() {
     let on = |b: bool| if b { "on" } else { "off" }.to_string();
     assert_eq!(words("tighten"), (on(d.tighten), on(p.tighten)));
     assert_eq!(words("prune"), (on(d.prune), on(p.prune)));
+    assert_eq!(words("refine"), (on(d.refine), on(p.refine)));
 }

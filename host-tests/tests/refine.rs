@@ -20,33 +20,21 @@ use proptest::prelude::*;
 
 /// Owned scratch for a window of `side * side` cells, filled with `fill`.
 struct Owned {
-    g: Vec<u32>,
-    f: Vec<u32>,
-    link: Vec<u8>,
-    heap: Vec<u16>,
-    pos: Vec<u16>,
+    a: Vec<u32>,
+    b: Vec<u32>,
 }
 
 impl Owned {
     fn new(side: usize, fill: u32) -> Self {
-        let n = side * side;
+        let n = Scratch::words(side);
         Owned {
-            g: vec![fill; n],
-            f: vec![fill.rotate_left(7); n],
-            link: vec![fill as u8; n],
-            heap: vec![fill as u16; n],
-            pos: vec![(fill >> 16) as u16; n],
+            a: vec![fill; n],
+            b: vec![fill.rotate_left(7); n],
         }
     }
 
     fn scratch(&mut self) -> Scratch<'_> {
-        Scratch {
-            g: &mut self.g,
-            f: &mut self.f,
-            link: &mut self.link,
-            heap: &mut self.heap,
-            pos: &mut self.pos,
-        }
+        Scratch::new(&mut self.a, &mut self.b)
     }
 }
 

@@ -195,6 +195,10 @@ pub struct ParamArgs {
     #[arg(long, value_name = "N", allow_negative_numbers = true,
           help = preset_help("The patience of a warm replan (PlanWarm / `ohaca replan`); 0 = the same as --patience", |p| p.warm_patience.to_string()))]
     pub warm_patience: Option<u16>,
+    /// The patience of a run that refines its path (large maps, --refine); 0 = the same as --patience
+    #[arg(long, value_name = "N", allow_negative_numbers = true,
+          help = preset_help("The patience of a run that refines its path (large maps, --refine); 0 = the same as --patience", |p| p.refine_patience.to_string()))]
+    pub refine_patience: Option<u16>,
     /// What an ant does at a dead end: backtrack or die (the paper)
     #[arg(long, value_name = "RULE", value_parser = parse_name::<DeadEnd>,
           help = preset_help("What an ant does at a dead end: backtrack or die (the paper)", |p| p.dead_end.name().to_string()))]
@@ -211,6 +215,10 @@ pub struct ParamArgs {
     #[arg(long, value_name = "BOOL", value_parser = parse_bool, action = clap::ArgAction::Set,
           help = preset_help("Prune the cells no shortest path needs before the ants run (not in the paper)", |p| p.prune.to_string()))]
     pub prune: Option<bool>,
+    /// Replace the raw path's pieces by exact shortest paths in windows around them, on maps of more than 1,024 cells (not in the paper)
+    #[arg(long, value_name = "BOOL", value_parser = parse_bool, action = clap::ArgAction::Set,
+          help = preset_help("Replace the raw path's pieces by exact shortest paths in windows around them, on maps of more than 1,024 cells (not in the paper)", |p| p.refine.to_string()))]
+    pub refine: Option<bool>,
 }
 
 impl ParamArgs {
@@ -234,10 +242,12 @@ impl ParamArgs {
             tau_max: self.tau_max.unwrap_or(base.tau_max),
             patience: self.patience.unwrap_or(base.patience),
             warm_patience: self.warm_patience.unwrap_or(base.warm_patience),
+            refine_patience: self.refine_patience.unwrap_or(base.refine_patience),
             dead_end: self.dead_end.unwrap_or(base.dead_end),
             smoothing: self.smoothing.unwrap_or(base.smoothing),
             tighten: self.tighten.unwrap_or(base.tighten),
             prune: self.prune.unwrap_or(base.prune),
+            refine: self.refine.unwrap_or(base.refine),
         }
     }
 }
@@ -301,11 +311,15 @@ mod tests {
             "0",
             "--warm-patience",
             "5",
+            "--refine-patience",
+            "4",
             "--dead-end",
             "die",
             "--smoothing",
             "greedy",
             "--tighten",
+            "false",
+            "--refine",
             "false",
         ])
         .unwrap();
@@ -326,11 +340,13 @@ mod tests {
                 tau_max: 10.0,
                 patience: 0,
                 warm_patience: 5,
+                refine_patience: 4,
                 seed: u64::MAX,
                 dead_end: DeadEnd::Die,
                 smoothing: SmoothingKind::Greedy,
                 tighten: false,
                 prune: true,
+                refine: false,
             }
         );
     }

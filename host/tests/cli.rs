@@ -70,7 +70,7 @@ const FOUND_KEYS: [&str; 11] = [
     "waypoints",
 ];
 
-const PARAM_KEYS: [&str; 19] = [
+const PARAM_KEYS: [&str; 21] = [
     "a",
     "algorithm",
     "alpha",
@@ -81,6 +81,8 @@ const PARAM_KEYS: [&str; 19] = [
     "patience",
     "prune",
     "q",
+    "refine",
+    "refine_patience",
     "rho",
     "seed",
     "smoothing",

@@ -573,6 +573,7 @@ impl Soak {
             tau_max: 100.0,
             patience: r.range(0, 4) as u16,
             warm_patience: r.range(0, 3) as u16,
+            refine_patience: r.range(0, 4) as u16,
             seed: r.next(),
             dead_end: if r.chance(0.2) {
                 DeadEnd::Die
@@ -586,6 +587,7 @@ impl Soak {
             ][r.below(3)],
             tighten: r.chance(0.5),
             prune: r.chance(0.5),
+            refine: r.chance(0.5),
         };
         if r.chance(0.04) {
             // Now and then slower plans, so that the queue fills and Cancel and new maps catch

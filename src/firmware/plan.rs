@@ -1,5 +1,6 @@
-//! The planning task: takes plan requests from the queue and runs them one iteration at a time,
-//! yielding to the executor after every iteration so frames keep arriving and `Cancel` works.
+//! The planning task: takes plan requests from the queue and runs them a piece at a time (each
+//! piece of the setup, each iteration, each piece of the local search and the smoothing),
+//! yielding to the executor after every piece so frames keep arriving and `Cancel` works.
 //! A path is streamed into the UART as it is encoded ([`PathStream`]), a piece at a time: no
 //! buffer for a whole frame (up to 5 KiB). The planner reads the map in place: it holds
 //! [`MAP`]'s lock from `Run::new` to `Run::finish`, and a writer (a map upload, a cell update)
@@ -111,6 +112,15 @@ async fn plan(
         }
     }
     let t_finish = Instant::now();
+    // The local search and the smoothing a piece at a time too (each piece a fraction of an
+    // iteration on a 256 x 256 map).
+    while run.polish_step() {
+        yield_now().await;
+        if state::cancelled(job.generation) {
+            defmt::info!("plan {} cancelled while finishing", job.id);
+            return Err(cancelled());
+        }
+    }
     let plan = run.finish()?;
     let t_end = Instant::now();
     // The path is in `storage`: the map is free for writers while it is sent.

@@ -49,9 +49,10 @@ impl Algorithm {
 ///
 /// Two presets: [`Params::default`] is this project's setting (the paper's `alpha`, `beta`, `rho`,
 /// `Q`, `a`, `xi`, `M` and `N`, plus backtracking ants, path tightening, dead-end pruning, early
-/// stopping after 10 stale iterations and shortest smoothing); [`Params::paper`] is the paper's
-/// algorithm as written (ants die at dead ends, no tightening, no pruning, always all `N`
-/// iterations, greedy smoothing).
+/// stopping after 10 stale iterations (3 with the local search of large maps, 2 for a warm
+/// replan), the local search and shortest smoothing); [`Params::paper`] is the paper's algorithm
+/// as written (ants die at dead ends, no tightening, no pruning, always all `N` iterations, no
+/// local search, greedy smoothing).
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
@@ -85,6 +86,10 @@ pub struct Params {
     /// [`Params::patience`] for a warm start ([`crate::planner::Run::warm`]), whose colony
     /// already holds the previous plan's trail; 0 = the same as `patience`.
     pub warm_patience: u16,
+    /// [`Params::patience`] for a run that refines its result ([`Params::refine`], large maps):
+    /// the local search straightens the path, so the colony only has to find the corridor;
+    /// 0 = the same as `patience`. A warm start's `warm_patience` comes first.
+    pub refine_patience: u16,
     /// Seed of the random generator.
     pub seed: u64,
     /// What an ant does at a dead end.
@@ -97,6 +102,10 @@ pub struct Params {
     /// Prune the cells no shortest path needs before the ants run ([`crate::prune`]); not in the
     /// paper, off for faithful comparisons.
     pub prune: bool,
+    /// On maps of more than [`crate::pheromone::BLOCKS`] cells, OHACA replaces each piece of the
+    /// best raw path by the exact shortest path inside a window around it before smoothing
+    /// ([`crate::refine`]); not in the paper, off for faithful comparisons.
+    pub refine: bool,
 }
 
 impl Default for Params {
@@ -122,27 +131,31 @@ impl Params {
         tau_max: 100.0,
         patience: 10,
         warm_patience: 2,
+        refine_patience: 3,
         seed: 1,
         dead_end: DeadEnd::Backtrack,
         smoothing: SmoothingKind::Shortest,
         tighten: true,
         prune: true,
+        refine: true,
     };
 
     /// The paper's setting as written: `alpha = 1`, `beta = 2`, `rho = 0.1`, `Q = 1`, `a = 0.05`,
     /// `xi = 1`, `M = 50` ants, always the full `N = 100` iterations (`patience = 0`), ants that
-    /// die at dead ends, no path tightening, no dead-end pruning and the paper's greedy smoothing
-    /// (section 4.3). The constants, the pheromone bounds and the seed are [`Params::default`]'s
+    /// die at dead ends, no path tightening, no dead-end pruning, no local search and the paper's
+    /// greedy smoothing (section 4.3). The constants, the pheromone bounds and the seed are [`Params::default`]'s
     /// (the paper gives `delta = 0.01` and no initial value). Use it for faithful comparisons;
     /// `docs/ALGORITHM.md` lists where the default differs and why.
     pub const fn paper() -> Self {
         Params {
             patience: 0,
             warm_patience: 0,
+            refine_patience: 0,
             dead_end: DeadEnd::Die,
             smoothing: SmoothingKind::Greedy,
             tighten: false,
             prune: false,
+            refine: false,
             ..Params::DEFAULT
         }
     }

@@ -1,20 +1,23 @@
-//! A planning run as a state machine: [`Run::new`] validates and prepares, [`Run::step`] runs one
-//! iteration (walk every ant, update the pheromone, record the iteration), [`Run::finish`] turns
-//! the best path into a [`Plan`].
+//! A planning run as a state machine: [`Run::new`] validates and prepares, [`Run::setup_step`]
+//! does the setup a piece at a time, [`Run::step`] runs one iteration (walk every ant, update the
+//! pheromone, record the iteration), [`Run::polish_step`] refines and smooths the best path a
+//! piece at a time, and [`Run::finish`] turns it into a [`Plan`].
 //!
-//! The firmware yields to its executor between steps, so it can answer other requests and cancel
-//! a plan by dropping (or finishing) the run.
+//! The firmware yields to its executor between pieces, so it can answer other requests and cancel
+//! a plan by dropping (or finishing) the run. How the work is cut never changes the result:
+//! `step` and `finish` alone do every piece that is left.
 
 use crate::ant::{Ant, DeadEnd, Lost, Walk};
 use crate::error::{Endpoint, Error};
 use crate::geometry::{polyline_length, steps_length, turns};
-use crate::grid::{Dir, Grid, Moves, Point, Reach};
+use crate::grid::{direction, is_diagonal, Dir, Grid, Moves, Point, Reach};
 use crate::heuristic::Heuristic;
 use crate::pheromone::{Blocks, Table};
 use crate::prune::prune;
 use crate::rng::Xoshiro128pp;
-use crate::route::{self, Route};
-use crate::smoothing::{smooth, SmoothingKind};
+use crate::refine::{self, Budget, Refiner, Scratch};
+use crate::route::{self, Route, GUIDE_BLOCKS};
+use crate::smoothing::{Smoother, SmoothingKind};
 use crate::tighten::tighten;
 use crate::update::{deposit, wolves};
 
@@ -57,6 +60,34 @@ struct Iteration {
     arrived: u32,
 }
 
+/// Window side of the local search ([`Params::refine`]). Its scratch is the links and the coarse
+/// route's words, free after the last iteration: two slices of [`Scratch::words`]`(52)` = 4,056
+/// words each, which the device's and the host's storage both lend (at least [`GUIDE_BLOCKS`]
+/// words each on maps with a route). Measured on the 20 longest scenarios of the 20 large Moving
+/// AI maps (`refine_large` example): mean raw/opt8 1.0009 at 52, 1.0011 at 48, 1.0007 at 64.
+pub const REFINE_SIDE: usize = 52;
+const REFINE_WORDS: usize = Scratch::words(REFINE_SIDE);
+const _: () = assert!(REFINE_WORDS <= GUIDE_BLOCKS);
+/// Cells the local search expands between two yields of [`Run::polish_step`] (a window expands
+/// at most `REFINE_SIDE^2` = 2,704).
+const REFINE_SLICE: u64 = 8192;
+/// Raw cells of the smoothing DP between two yields of [`Run::polish_step`] (each tests at most
+/// [`crate::smoothing::LOOKBACK`] segments).
+const SMOOTH_SLICE: usize = 48;
+
+/// The work after the last iteration, in order ([`Run::polish_step`]).
+#[derive(Clone, Copy, Debug)]
+enum Polish {
+    /// Not started: the best path is only the best tour's directions.
+    Start,
+    /// The local search on the raw path in `points`, a budget at a time.
+    Refine(Refiner),
+    /// The smoothing of the raw path in `points`, a stretch at a time.
+    Smooth(Smoother),
+    /// Done: `points[..waypoints]` are the waypoints.
+    Done { waypoints: usize },
+}
+
 /// A planning run in progress. See the module docs.
 pub struct Run<'g, 'a> {
     grid: &'g Grid<'g>,
@@ -77,6 +108,8 @@ pub struct Run<'g, 'a> {
     routed: bool,
     warm: bool,
     setup: Setup,
+    refines: bool,
+    polish: Polish,
     no_path: bool,
     done: bool,
 }
@@ -200,6 +233,13 @@ impl<'g, 'a> Run<'g, 'a> {
         }
         ws.delta.fill([0.0; 4]);
         let heuristic = Heuristic::new(goal, params.attraction(), params.beta);
+        // The local search: OHACA on large maps, when the workspace can lend its scratch (every
+        // `Storage` with at least 4,096 links, and `HeapStorage`; like the coarse route).
+        let refines = params.refine
+            && params.algorithm == Algorithm::Ohaca
+            && blocks.shift() > 0
+            && ws.links.len() >= REFINE_WORDS
+            && ws.guide.len() >= REFINE_WORDS;
         crate::fmt::debug!(
             "plan: {} cells, ants {}, iterations {}",
             cells,
@@ -225,6 +265,8 @@ impl<'g, 'a> Run<'g, 'a> {
             routed: false,
             warm: warm.is_some(),
             setup: Setup::Reach,
+            refines,
+            polish: Polish::Start,
             no_path: false,
             done: false,
         })
@@ -488,6 +530,8 @@ impl<'g, 'a> Run<'g, 'a> {
         let p = &self.params;
         let patience = if self.warm && p.warm_patience > 0 {
             p.warm_patience
+        } else if self.refines && p.refine_patience > 0 {
+            p.refine_patience
         } else {
             p.patience
         };
@@ -495,13 +539,102 @@ impl<'g, 'a> Run<'g, 'a> {
         self.done = self.no_path || self.iteration >= p.iterations || early;
     }
 
-    /// Stop now and turn the best path found so far into the result (smoothed for OHACA).
-    /// Fails with [`Error::NoAntArrived`] if no ant has reached the goal (only possible with
+    /// Do the next piece of the work after the last iteration, if any is left: lay the best path
+    /// out as cells, the local search ([`Params::refine`], large maps) on at most 8,192 expanded
+    /// cells, the smoothing DP on at most 48 raw cells. Returns `true` while work remains; does
+    /// nothing before the run is done ([`Run::is_done`]) or when it found no path. On a
+    /// 256 x 256 map each piece costs a fraction of an iteration, so the firmware yields between
+    /// them; [`Run::finish`] does whatever is left itself.
+    pub fn polish_step(&mut self) -> bool {
+        let Some(best) = self.best else {
+            return false;
+        };
+        if !self.done || self.no_path {
+            return false;
+        }
+        let grid = self.grid;
+        let ws = &mut self.ws;
+        let kind = if self.params.algorithm == Algorithm::Ohaca {
+            self.params.smoothing
+        } else {
+            SmoothingKind::None
+        };
+        let dist = ws.delta.as_flattened_mut();
+        self.polish = match self.polish {
+            Polish::Start => {
+                // Expand the tour into cells.
+                let n = best.steps.saturating_add(1);
+                let tour = ws.best.get(..best.steps).unwrap_or_default();
+                for (slot, p) in ws.points.iter_mut().zip(RawPath::new(self.start, tour)) {
+                    *slot = p;
+                }
+                let refiner = self
+                    .refines
+                    .then(|| Refiner::in_place(grid, ws.points, n, refine::DEFAULT_PASSES).ok())
+                    .flatten();
+                match refiner {
+                    Some(r) => Polish::Refine(r),
+                    None => Polish::Smooth(Smoother::new(kind, n, dist, ws.links)),
+                }
+            }
+            Polish::Refine(mut r) => {
+                let a = ws.links.get_mut(..REFINE_WORDS).unwrap_or_default();
+                let b = ws.guide.get_mut(..REFINE_WORDS).unwrap_or_default();
+                let mut budget = Budget::new(REFINE_SLICE);
+                if r.resume(grid, ws.points, &mut Scratch::new(a, b), &mut budget) {
+                    let n = r.finish(ws.points);
+                    // The refined path becomes the run's raw path: its directions replace the
+                    // best tour (never longer, at most as many cells as `points` holds).
+                    let raw = ws.points.get(..n).unwrap_or_default();
+                    let (mut straight, mut diagonal) = (0u32, 0u32);
+                    for (slot, pair) in ws.best.iter_mut().zip(raw.windows(2)) {
+                        if let (Some(&p), Some(&q)) = (pair.first(), pair.get(1)) {
+                            let d = direction(p, q).unwrap_or(0);
+                            *slot = d;
+                            if is_diagonal(d) {
+                                diagonal = diagonal.saturating_add(1);
+                            } else {
+                                straight = straight.saturating_add(1);
+                            }
+                        }
+                    }
+                    self.best = Some(Best {
+                        steps: n.saturating_sub(1).min(ws.best.len()),
+                        straight,
+                        diagonal,
+                    });
+                    Polish::Smooth(Smoother::new(kind, n, dist, ws.links))
+                } else {
+                    Polish::Refine(r)
+                }
+            }
+            Polish::Smooth(mut sm) => {
+                if sm.resume(grid, ws.points, dist, ws.links, SMOOTH_SLICE) {
+                    Polish::Smooth(sm)
+                } else {
+                    Polish::Done {
+                        waypoints: sm.finish(grid, ws.points, dist, ws.links),
+                    }
+                }
+            }
+            done @ Polish::Done { .. } => done,
+        };
+        !matches!(self.polish, Polish::Done { .. })
+    }
+
+    /// Stop now and turn the best path found so far into the result: refined (large maps) and
+    /// smoothed for OHACA, doing whatever [`Run::polish_step`] left. Fails with
+    /// [`Error::NoAntArrived`] if no ant has reached the goal (only possible with
     /// [`crate::DeadEnd::Die`], or before the first iteration), and with [`Error::NoPath`] if an
-    /// ant proved the goal unreachable.
-    pub fn finish(self) -> Result<Plan<'a>, Error> {
+    /// unreachable goal ended the run.
+    pub fn finish(mut self) -> Result<Plan<'a>, Error> {
+        if self.no_path {
+            return Err(Error::NoPath);
+        }
+        self.best.ok_or(Error::NoAntArrived)?;
+        self.done = true;
+        while self.polish_step() {}
         let Run {
-            grid,
             start,
             params,
             ws,
@@ -511,39 +644,27 @@ impl<'g, 'a> Run<'g, 'a> {
             moves,
             pruned,
             warm,
-            no_path,
+            polish,
             ..
         } = self;
-        if no_path {
-            return Err(Error::NoPath);
-        }
         let best = best.ok_or(Error::NoAntArrived)?;
+        let Polish::Done { waypoints: k } = polish else {
+            return Err(Error::NoPath);
+        };
         let Workspace {
             best: best_tour,
             points,
-            delta,
-            links,
             curve,
             ..
         } = ws;
-        // The increment table is all zeros between iterations and unused from here on: lend it
-        // to the smoothing as its distance scratch (4 floats per entry).
-        let dist = delta.as_flattened_mut();
         let tour: &'a [Dir] = best_tour.get(..best.steps).ok_or(Error::NoPath)?;
-        // Expand the tour into cells.
-        let n = best.steps.checked_add(1).ok_or(Error::NoPath)?;
-        let pts = points.get_mut(..n).ok_or(Error::NoPath)?;
-        for (slot, p) in pts.iter_mut().zip(RawPath::new(start, tour)) {
-            *slot = p;
-        }
+        let pts: &'a [Point] = points;
+        let waypoints = pts.get(..k).ok_or(Error::NoPath)?;
         let kind = if params.algorithm == Algorithm::Ohaca {
             params.smoothing
         } else {
             SmoothingKind::None
         };
-        let k = smooth(grid, kind, pts, n, dist, links);
-        let pts: &'a [Point] = points;
-        let waypoints = pts.get(..k).ok_or(Error::NoPath)?;
         // Without smoothing the waypoints are the raw path's corners: report the exact step-count
         // length rather than re-summing it (which can differ in the last bit).
         let length = if kind == SmoothingKind::None {

@@ -2,7 +2,9 @@
 
 use super::*;
 use crate::error::{Endpoint, Param};
-use crate::grid::Point;
+use crate::grid::{Dir, Point};
+use alloc::boxed::Box;
+use alloc::vec::Vec;
 
 /// Storage for maps of up to 64 cells.
 type S64 = Storage<2, 64, 128, 64>;
@@ -160,6 +162,8 @@ fn paper_preset_differs_from_default_only_where_documented() {
             tighten: false,
             prune: false,
             warm_patience: 0,
+            refine_patience: 0,
+            refine: false,
             ..d
         }
     );
@@ -351,4 +355,173 @@ fn a_warm_start_after_a_change_that_cuts_the_goal_off_ends_with_no_path() {
     assert!(!run.step());
     assert_eq!(run.moves(), 0);
     assert_eq!(run.finish().err(), Some(Error::NoPath));
+}
+
+/// Storage for the large test map: 64 x 48 = 3,072 cells (more than `BLOCKS`: the coarse route
+/// and the local search apply), the device's 4,096 links.
+type SLarge = Storage<{ crate::bitmap::words(3072) }, 3073, 4096>;
+/// The same with 3,584 links: enough for the route (3,072 blocks of one cell), too few to lend
+/// the local search its scratch.
+type SLargeFewLinks = Storage<{ crate::bitmap::words(3072) }, 3073, 3584>;
+
+/// A 64 x 48 map: rows of wall segments with random gaps, and random single obstacles, so the
+/// colony's raw paths wander. Start (0, 0) and goal (63, 47) are free.
+fn large_map(seed: u64) -> (Vec<u8>, u16, u16) {
+    let (w, h) = (64usize, 48usize);
+    let mut rng = crate::rng::Xoshiro128pp::from_u64(seed);
+    let mut b = vec![0u8; (w * h).div_ceil(8)];
+    let mut block = |x: usize, y: usize| b[(y * w + x) / 8] |= 1 << ((y * w + x) % 8);
+    for y in (6..h - 2).step_by(8) {
+        for x in 0..w {
+            if rng.next_unit() < 0.8 {
+                block(x, y);
+            }
+        }
+    }
+    for _ in 0..250 {
+        let (x, y) = (rng.next_word() as usize % w, rng.next_word() as usize % h);
+        if (x, y) != (0, 0) && (x, y) != (w - 1, h - 1) {
+            block(x, y);
+        }
+    }
+    (b, w as u16, h as u16)
+}
+
+/// Panics unless `plan`'s raw path runs from `s` to `goal` along allowed moves.
+fn assert_raw_valid(g: &Grid<'_>, plan: &Plan<'_>, s: Point, goal: Point) {
+    let raw: Vec<Point> = plan.raw().collect();
+    assert_eq!((raw[0], *raw.last().unwrap()), (s, goal));
+    for (pair, &d) in raw.windows(2).zip(plan.directions()) {
+        assert_eq!(g.step(pair[0], d), Some(pair[1]));
+    }
+    let diagonal = plan.directions().iter().filter(|&&d| d & 1 == 1).count() as u32;
+    let straight = plan.directions().len() as u32 - diagonal;
+    assert_eq!(
+        plan.raw_length,
+        crate::geometry::steps_length(straight, diagonal)
+    );
+}
+
+/// Plan on the large map (`None` if this seed's map has no path).
+fn large_plan(seed: u64, p: &Params) -> Option<(Vec<Dir>, Vec<Point>, f32, u16, u16)> {
+    let (b, w, h) = large_map(seed);
+    let g = Grid::new(w, h, &b).unwrap();
+    let (s, goal) = (Point::new(0, 0), Point::new(63, 47));
+    let mut st = Box::new(SLarge::new());
+    let plan = plan(&g, s, goal, p, st.workspace()).ok()?;
+    assert_raw_valid(&g, &plan, s, goal);
+    Some((
+        plan.directions().to_vec(),
+        plan.waypoints().to_vec(),
+        plan.raw_length,
+        plan.iterations,
+        plan.best_iteration,
+    ))
+}
+
+#[test]
+fn the_local_search_shortens_large_map_paths_and_never_lengthens_them() {
+    // Same patience both ways, so the colonies are the same and only the local search differs.
+    // The default colony finds the optimum on a map this small; a weak one (a weak heuristic, no
+    // tightening, few ants) leaves bulges to shorten.
+    let on = Params {
+        refine_patience: 0,
+        tighten: false,
+        beta: 0.5,
+        ants: 5,
+        iterations: 3,
+        ..Params::default()
+    };
+    let off = Params {
+        refine: false,
+        ..on
+    };
+    let (mut planned, mut shorter) = (0, 0);
+    for seed in 1..=8 {
+        let (Some(a), Some(b)) = (large_plan(seed, &on), large_plan(seed, &off)) else {
+            continue;
+        };
+        planned += 1;
+        assert_eq!(a.3, b.3, "seed {seed}: the same colony");
+        assert!(a.2 <= b.2, "seed {seed}: {} > {}", a.2, b.2);
+        shorter += usize::from(a.2 < b.2);
+    }
+    assert!(planned >= 6, "{planned}");
+    assert_eq!(shorter, planned, "the local search shortened {shorter} of {planned}");
+}
+
+#[test]
+fn small_maps_keep_the_colonys_path() {
+    // Maps of at most `BLOCKS` cells: no local search, whatever `refine` says.
+    let (b, w, h) = grid(&ROWS);
+    let g = Grid::new(w, h, &b).unwrap();
+    for seed in 1..=5 {
+        let p = Params {
+            seed,
+            ..Params::default()
+        };
+        let mut s1: S64 = Storage::new();
+        let mut s2: S64 = Storage::new();
+        let a = plan(&g, Point::new(0, 0), Point::new(7, 5), &p, s1.workspace()).unwrap();
+        let off = Params { refine: false, ..p };
+        let b = plan(&g, Point::new(0, 0), Point::new(7, 5), &off, s2.workspace()).unwrap();
+        assert_eq!(a.directions(), b.directions());
+        assert_eq!(a.waypoints(), b.waypoints());
+        assert_eq!(a.iterations, b.iterations);
+    }
+}
+
+#[test]
+fn refining_runs_stop_after_the_refine_patience() {
+    for (refine, refine_patience, stale) in [(true, 2u16, 2u16), (true, 0, 10), (false, 2, 10)] {
+        let p = Params {
+            refine,
+            refine_patience,
+            ..Params::default()
+        };
+        let (_, _, _, iterations, best) = large_plan(1, &p).expect("seed 1 has a path");
+        assert_eq!(iterations, best + stale + 1, "{refine} {refine_patience}");
+    }
+}
+
+#[test]
+fn the_polish_runs_in_pieces_and_equals_finish() {
+    let (b, w, h) = large_map(1);
+    let g = Grid::new(w, h, &b).unwrap();
+    let (s, goal) = (Point::new(0, 0), Point::new(63, 47));
+    let p = Params::default();
+    let mut st1 = Box::new(SLarge::new());
+    let mut run = Run::new(&g, s, goal, &p, st1.workspace()).unwrap();
+    assert!(!run.polish_step(), "nothing to polish before the run is done");
+    assert!(run.step());
+    assert!(!run.polish_step(), "nor while it runs");
+    while run.step() {}
+    let mut pieces = 1;
+    while run.polish_step() {
+        pieces += 1;
+    }
+    assert!(pieces >= 3, "{pieces}");
+    let a = run.finish().unwrap();
+    let mut st2 = Box::new(SLarge::new());
+    let b = plan(&g, s, goal, &p, st2.workspace()).unwrap();
+    assert_eq!(a.directions(), b.directions());
+    assert_eq!(a.waypoints(), b.waypoints());
+    assert_eq!((a.raw_length, a.length), (b.raw_length, b.length));
+}
+
+#[test]
+fn a_workspace_too_small_for_the_scratch_skips_the_local_search() {
+    let (b, w, h) = large_map(1);
+    let g = Grid::new(w, h, &b).unwrap();
+    let (s, goal) = (Point::new(0, 0), Point::new(63, 47));
+    let mut st = Box::new(SLargeFewLinks::new());
+    let a = plan(&g, s, goal, &Params::default(), st.workspace()).unwrap();
+    assert_raw_valid(&g, &a, s, goal);
+    let off = Params {
+        refine: false,
+        ..Params::default()
+    };
+    let off = large_plan(1, &off).unwrap();
+    assert_eq!(a.directions(), &off.0[..]);
+    assert_eq!(a.waypoints(), &off.1[..]);
 }

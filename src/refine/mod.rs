@@ -45,8 +45,10 @@
 //! ground) after clearing `side * side` bytes. [`Budget`] counts the cells expanded and stops a
 //! run between windows once its limit is reached (overshooting by at most one window); a stopped
 //! [`Refiner`] resumes where it stopped, so a firmware can yield between calls. Scratch is
-//! [`Scratch::BYTES_PER_CELL`] = 13 bytes per window cell (`side = 64`: 52 KiB; `48`: 29 KiB;
-//! `128`: 208 KiB), lent for each call and free in between.
+//! [`Scratch::BYTES_PER_CELL`] = 12 bytes per window cell in two word slices (`side = 52`: 2 x
+//! 4,056 words, 32 KiB; `64`: 48 KiB; `128`: 192 KiB), lent for each call and free in between.
+//! No direction is stored: the searched path is read back from `g` alone (see
+//! `window::pred`).
 //!
 //! **Buffers.** The path is rewritten inside `out`, streaming: the pending input sits at the end
 //! of `out` and the output grows from its front, so `out` needs `path.len()` cells. A replacement
@@ -55,63 +57,90 @@
 //! (`path.len() + side`) make that practically never happen.
 
 use crate::error::Error;
-use crate::grid::{Grid, Point, DX, DY};
+use crate::grid::{direction, Grid, Point};
 
 mod window;
 
-use window::{back_step, place, search, Box2, Shape};
+use window::{place, pred, search, Box2, Shape};
 
 /// Cost of a straight step in search units.
 pub const STRAIGHT: u32 = 13860;
 /// Cost of a diagonal step in search units (`STRAIGHT * sqrt 2`, rounded, see the module docs).
 pub const DIAGONAL: u32 = 19601;
-/// The largest window side (box indices are `u16`).
-pub const MAX_SIDE: usize = 256;
+/// The largest window side (box indices and heap slots are `u16`, with `0xFFFF` kept free).
+pub const MAX_SIDE: usize = 255;
 /// The smallest window side worth searching; with less scratch the path is returned unchanged.
 pub const MIN_SIDE: usize = 8;
 /// Default pass limit of [`refine`].
 pub const DEFAULT_PASSES: u8 = 4;
 
-/// `link` bits: the direction (0..8) the cell was reached by, and two flags.
-const DIR_MASK: u8 = 0x07;
-const REACHED: u8 = 0x08;
-const CLOSED: u8 = 0x10;
-
-/// Search scratch for one window, lent for each call. The window side is the largest `side` with
-/// `side * side` no more than the shortest of the five slices (and at most [`MAX_SIDE`]).
+/// Search scratch for one window, lent for each call: two word slices, each holding one `u32`
+/// and half a `u32` per window cell (`g` and the open list in the first, `f` and the heap
+/// positions in the second; see [`Scratch::new`]).
+///
+/// Two plain `u32` slices, so that a planner can lend buffers it no longer needs (the device's
+/// coarse route and links, after the colony's last iteration) instead of setting RAM aside.
 #[derive(Debug)]
 pub struct Scratch<'a> {
-    /// Cost from the window's start, per box cell.
-    pub g: &'a mut [u32],
+    /// Cost from the window's start per box cell; [`UNREACHED`] for a cell not reached yet.
+    g: &'a mut [u32],
     /// `g` plus the octile heuristic, per box cell.
-    pub f: &'a mut [u32],
-    /// Direction reached by and search flags, per box cell.
-    pub link: &'a mut [u8],
-    /// The open list: a binary heap of box cell indices.
-    pub heap: &'a mut [u16],
-    /// Position of each box cell in `heap`.
-    pub pos: &'a mut [u16],
+    f: &'a mut [u32],
+    /// The open list: a binary heap of box cell indices, two `u16` a word.
+    heap: &'a mut [u32],
+    /// Position of each box cell in `heap` ([`CLOSED`] once expanded), two `u16` a word.
+    pos: &'a mut [u32],
 }
 
-impl Scratch<'_> {
+/// `g` of a cell not reached yet.
+const UNREACHED: u32 = u32::MAX;
+/// `pos` of an expanded cell (heap slots are below [`MAX_SIDE`]`^2 < 0xFFFF`).
+const CLOSED: u16 = u16::MAX;
+
+impl<'a> Scratch<'a> {
     /// Bytes of scratch per window cell.
-    pub const BYTES_PER_CELL: usize = 13;
+    pub const BYTES_PER_CELL: usize = 12;
+
+    /// Words each of the two slices needs for a window of `side x side` cells (saturating).
+    pub const fn words(side: usize) -> usize {
+        let cells = side.saturating_mul(side);
+        cells.saturating_add(cells.div_ceil(2))
+    }
+
+    /// Scratch over two word slices: the window holds the largest `cells` with
+    /// `cells + ceil(cells / 2)` words in the shorter one. Their contents do not matter.
+    pub fn new(a: &'a mut [u32], b: &'a mut [u32]) -> Self {
+        let words = a.len().min(b.len());
+        // cells + ceil(cells / 2) <= words  <=>  cells <= floor(2 words / 3).
+        let mut cells = words.saturating_mul(2) / 3;
+        if cells.saturating_add(cells.div_ceil(2)) > words {
+            cells = cells.saturating_sub(1);
+        }
+        let (g, a) = a.split_at_mut(cells.min(a.len()));
+        let (f, b) = b.split_at_mut(cells.min(b.len()));
+        let half = cells.div_ceil(2);
+        Scratch {
+            g,
+            f,
+            heap: a.split_at_mut(half.min(a.len())).0,
+            pos: b.split_at_mut(half.min(b.len())).0,
+        }
+    }
 
     /// Box cells this scratch can hold.
     pub fn cells(&self) -> usize {
         self.g
             .len()
             .min(self.f.len())
-            .min(self.link.len())
-            .min(self.heap.len())
-            .min(self.pos.len())
+            .min(self.heap.len().saturating_mul(2))
+            .min(self.pos.len().saturating_mul(2))
     }
 
     /// The window side: the largest `s <= MAX_SIDE` with `s * s <= self.cells()`.
     pub fn side(&self) -> usize {
         let cells = self.cells();
         let mut s = 0usize;
-        // s <= MAX_SIDE = 256: no overflow.
+        // s <= MAX_SIDE = 255: no overflow.
         while s < MAX_SIDE && s.wrapping_add(1).wrapping_mul(s.wrapping_add(1)) <= cells {
             s = s.wrapping_add(1);
         }
@@ -119,43 +148,56 @@ impl Scratch<'_> {
     }
 }
 
-/// Statically sized scratch for a `CELLS`-cell window (a firmware puts this in a `static`).
-#[derive(Debug)]
-pub struct RefineStorage<const CELLS: usize> {
-    g: [u32; CELLS],
-    f: [u32; CELLS],
-    link: [u8; CELLS],
-    heap: [u16; CELLS],
-    pos: [u16; CELLS],
+/// Read the `i`-th `u16` of a slice of words holding two each (0 out of range).
+fn half(words: &[u32], i: usize) -> u16 {
+    let w = words.get(i / 2).copied().unwrap_or(0);
+    // Truncation keeps the wanted half.
+    (if i % 2 == 0 { w } else { w >> 16 }) as u16
 }
 
-impl<const CELLS: usize> Default for RefineStorage<CELLS> {
+/// Write the `i`-th `u16` of a slice of words holding two each (nothing out of range).
+fn set_half(words: &mut [u32], i: usize, v: u16) {
+    if let Some(w) = words.get_mut(i / 2) {
+        *w = if i % 2 == 0 {
+            (*w & 0xFFFF_0000) | u32::from(v)
+        } else {
+            (*w & 0x0000_FFFF) | (u32::from(v) << 16)
+        };
+    }
+}
+
+/// Statically sized scratch: two slices of `WORDS` words each, for a window of the largest side
+/// with [`Scratch::words`]`(side) <= WORDS` (a firmware puts this in a `static`).
+///
+/// ```
+/// use ohaca::refine::{RefineStorage, Scratch};
+/// let mut s = RefineStorage::<{ Scratch::words(48) }>::new();
+/// assert_eq!(s.scratch().side(), 48);
+/// ```
+#[derive(Debug)]
+pub struct RefineStorage<const WORDS: usize> {
+    a: [u32; WORDS],
+    b: [u32; WORDS],
+}
+
+impl<const WORDS: usize> Default for RefineStorage<WORDS> {
     fn default() -> Self {
         Self::new()
     }
 }
 
-impl<const CELLS: usize> RefineStorage<CELLS> {
+impl<const WORDS: usize> RefineStorage<WORDS> {
     /// Zeroed storage.
     pub const fn new() -> Self {
         RefineStorage {
-            g: [0; CELLS],
-            f: [0; CELLS],
-            link: [0; CELLS],
-            heap: [0; CELLS],
-            pos: [0; CELLS],
+            a: [0; WORDS],
+            b: [0; WORDS],
         }
     }
 
     /// Lend it as scratch.
     pub fn scratch(&mut self) -> Scratch<'_> {
-        Scratch {
-            g: &mut self.g,
-            f: &mut self.f,
-            link: &mut self.link,
-            heap: &mut self.heap,
-            pos: &mut self.pos,
-        }
+        Scratch::new(&mut self.a, &mut self.b)
     }
 }
 
@@ -235,13 +277,6 @@ fn octile(a: Point, b: Point) -> u32 {
         .wrapping_add(lo.wrapping_mul(DIAGONAL))
 }
 
-/// The direction of a step between 8-neighbours, if they are neighbours.
-fn dir_between(a: Point, b: Point) -> Option<u8> {
-    let dx = i32::from(b.x).wrapping_sub(i32::from(a.x));
-    let dy = i32::from(b.y).wrapping_sub(i32::from(a.y));
-    (0..8u8).find(|&d| DX.get(usize::from(d)) == Some(&dx) && DY.get(usize::from(d)) == Some(&dy))
-}
-
 /// A resumable refinement of one path, streaming inside `out` (see the module docs).
 ///
 /// The current path is `out[..w]` (committed) followed by `out[r..e]` (pending); the caller
@@ -268,6 +303,40 @@ impl Refiner {
         max_passes: u8,
     ) -> Result<Self, Error> {
         let n = path.len();
+        let start = Self::tail(n, out.len())?;
+        let tail = out.get_mut(start..).ok_or(Error::NoPath)?;
+        tail.copy_from_slice(path);
+        Self::laid_out(grid, out, start, max_passes)
+    }
+
+    /// [`Refiner::new`] for a path already in `out[..n]` (moved to the end of `out`).
+    pub fn in_place(
+        grid: &Grid<'_>,
+        out: &mut [Point],
+        n: usize,
+        max_passes: u8,
+    ) -> Result<Self, Error> {
+        let start = Self::tail(n, out.len())?;
+        out.copy_within(..n, start);
+        Self::laid_out(grid, out, start, max_passes)
+    }
+
+    /// Where a path of `n` cells starts when laid out at the end of `cap` cells.
+    fn tail(n: usize, cap: usize) -> Result<usize, Error> {
+        cap.checked_sub(n).ok_or(Error::MapTooLarge {
+            cells: u32::try_from(n).unwrap_or(u32::MAX),
+            capacity: u32::try_from(cap).unwrap_or(u32::MAX),
+        })
+    }
+
+    /// Check the path in `out[start..]` and start refining it.
+    fn laid_out(
+        grid: &Grid<'_>,
+        out: &mut [Point],
+        start: usize,
+        max_passes: u8,
+    ) -> Result<Self, Error> {
+        let path = out.get(start..).ok_or(Error::NoPath)?;
         let first = *path.first().ok_or(Error::NoPath)?;
         if !grid.is_free(first) {
             return Err(Error::NoPath);
@@ -276,23 +345,15 @@ impl Refiner {
             let (Some(&a), Some(&b)) = (pair.first(), pair.get(1)) else {
                 return Err(Error::NoPath);
             };
-            let ok = dir_between(a, b).and_then(|d| grid.step(a, d)) == Some(b);
+            let ok = direction(a, b).and_then(|d| grid.step(a, d)) == Some(b);
             if !ok {
                 return Err(Error::NoPath);
             }
         }
-        let cap = out.len();
-        let too_small = Error::MapTooLarge {
-            cells: u32::try_from(n).unwrap_or(u32::MAX),
-            capacity: u32::try_from(cap).unwrap_or(u32::MAX),
-        };
-        let start = cap.checked_sub(n).ok_or(too_small)?;
-        let tail = out.get_mut(start..).ok_or(too_small)?;
-        tail.copy_from_slice(path);
         let mut me = Refiner {
             w: 0,
             r: start,
-            e: cap,
+            e: out.len(),
             passes: 0,
             max_passes,
             improved: false,
@@ -478,7 +539,7 @@ impl Refiner {
             budget.windows = budget.windows.saturating_add(1);
             if let Some(cost) = search(grid, &bbox, ps, pt, scratch, budget) {
                 if cost < old {
-                    replaced = self.replace(out, scratch, &bbox, s, t, pt);
+                    replaced = self.replace(grid, out, scratch, &bbox, s, t, pt);
                 }
             }
         }
@@ -509,8 +570,10 @@ impl Refiner {
 
     /// Write the searched path from `P[s]` to `P[t]` over the piece; false (nothing written) if
     /// it does not fit before the pending cells after `t`.
+    #[allow(clippy::too_many_arguments)] // one call site; the window's whole state
     fn replace(
         &mut self,
+        grid: &Grid<'_>,
         out: &mut [Point],
         scratch: &Scratch<'_>,
         bbox: &Box2,
@@ -530,16 +593,10 @@ impl Refiner {
         let mut i = ti;
         let mut p = target;
         while p != start {
-            let Some(&l) = scratch.link.get(i) else {
-                return false;
-            };
-            if l & REACHED == 0 || steps >= cells {
+            if steps >= cells {
                 return false;
             }
-            let Some(q) = back_step(p, l) else {
-                return false;
-            };
-            let Some(qi) = bbox.local(q) else {
+            let Some((q, qi)) = pred(grid, bbox, scratch, p, i) else {
                 return false;
             };
             p = q;
@@ -563,9 +620,9 @@ impl Refiner {
             if let Some(slot) = out.get_mut(k) {
                 *slot = p;
             }
-            let Some(&l) = scratch.link.get(i) else { break };
-            let Some(q) = back_step(p, l) else { break };
-            let Some(qi) = bbox.local(q) else { break };
+            let Some((q, qi)) = pred(grid, bbox, scratch, p, i) else {
+                break;
+            };
             p = q;
             i = qi;
             k = k.wrapping_sub(1); // k > s >= 0

@@ -2,6 +2,7 @@
 //! resuming, determinism.
 
 use super::*;
+use crate::grid::{DX, DY};
 
 fn grid(rows: &[&str]) -> (Vec<u8>, u16, u16) {
     crate::testutil::bits(rows)
@@ -11,32 +12,22 @@ fn open(w: usize, h: usize) -> (Vec<u8>, u16, u16) {
     (vec![0u8; (w * h).div_ceil(8)], w as u16, h as u16)
 }
 
+/// Owned scratch for a window of `cells` cells, filled with junk.
 struct Heapless {
-    g: Vec<u32>,
-    f: Vec<u32>,
-    link: Vec<u8>,
-    heap: Vec<u16>,
-    pos: Vec<u16>,
+    a: Vec<u32>,
+    b: Vec<u32>,
 }
 
 impl Heapless {
     fn new(cells: usize, fill: u8) -> Self {
+        let words = cells + cells.div_ceil(2);
         Heapless {
-            g: vec![u32::from(fill) * 0x0101_0101; cells],
-            f: vec![u32::from(fill) * 0x0101_0101; cells],
-            link: vec![fill; cells],
-            heap: vec![u16::from(fill); cells],
-            pos: vec![u16::from(fill); cells],
+            a: vec![u32::from(fill) * 0x0101_0101; words],
+            b: vec![u32::from(fill).rotate_left(5); words],
         }
     }
     fn scratch(&mut self) -> Scratch<'_> {
-        Scratch {
-            g: &mut self.g,
-            f: &mut self.f,
-            link: &mut self.link,
-            heap: &mut self.heap,
-            pos: &mut self.pos,
-        }
+        Scratch::new(&mut self.a, &mut self.b)
     }
 }
 
@@ -45,7 +36,7 @@ fn cost(g: &Grid<'_>, p: &[Point]) -> u32 {
     assert!(g.is_free(p[0]));
     p.windows(2)
         .map(|s| {
-            let d = dir_between(s[0], s[1]).expect("neighbours");
+            let d = crate::grid::direction(s[0], s[1]).expect("neighbours");
             assert_eq!(g.step(s[0], d), Some(s[1]), "illegal step {s:?}");
             step_cost(s[0], s[1])
         })

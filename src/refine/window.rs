@@ -3,14 +3,51 @@
 
 use crate::grid::{Grid, Point, DX, DY};
 
-use super::{octile, Budget, Scratch, CLOSED, DIAGONAL, DIR_MASK, MAX_SIDE, REACHED, STRAIGHT};
+use super::{
+    half, octile, set_half, Budget, Scratch, CLOSED, DIAGONAL, MAX_SIDE, STRAIGHT, UNREACHED,
+};
 
-/// The cell a `link` entry came from.
-pub(super) fn back_step(p: Point, link: u8) -> Option<Point> {
-    let d = usize::from(link & DIR_MASK);
-    let x = i32::from(p.x).wrapping_sub(*DX.get(d)?);
-    let y = i32::from(p.y).wrapping_sub(*DY.get(d)?);
-    Some(Point::new(u16::try_from(x).ok()?, u16::try_from(y).ok()?))
+/// The cell before `p` (box index `i`) on a shortest path of the last [`search`]: its first
+/// neighbour, in direction order, inside the box and reached, one allowed move away, with
+/// `g(q) + cost(q, p) = g(p)`.
+///
+/// Why this finds a path without storing directions: `g` only ever holds the cost of a real path
+/// and only decreases. Let `p` have its optimal cost, and `q` be the cell that last lowered
+/// `g(p)`, with `g(q)` then. Now `opt(q) <= g(q) <= g(q) then = g(p) - cost = opt(p) - cost <=
+/// opt(q)`: `q` qualifies and has its optimal cost too. Any other qualifying `q'` has
+/// `opt(q') <= g(q') = opt(p) - cost' <= opt(q')` as well, so the walk from the target (optimal:
+/// A* with a consistent heuristic closed it) stays on optimal costs, which fall strictly at each
+/// step, and ends at the start, the only cell of cost 0.
+pub(super) fn pred(
+    grid: &Grid<'_>,
+    bbox: &Box2,
+    scratch: &Scratch<'_>,
+    p: Point,
+    i: usize,
+) -> Option<(Point, usize)> {
+    let gp = scratch.g.get(i).copied()?;
+    if gp == UNREACHED || gp == 0 {
+        return None;
+    }
+    // Moves are symmetric (no corner cutting either way), so the mask of `p` gives the moves in.
+    let mask = grid.move_mask(p);
+    for d in 0..8u8 {
+        if mask & (1 << d) == 0 {
+            continue;
+        }
+        let du = usize::from(d);
+        let qx = i32::from(p.x).wrapping_add(DX.get(du).copied().unwrap_or(0));
+        let qy = i32::from(p.y).wrapping_add(DY.get(du).copied().unwrap_or(0));
+        // The move is allowed, so `q` is inside the map: both fit u16.
+        let q = Point::new(qx as u16, qy as u16);
+        let Some(j) = bbox.local(q) else { continue };
+        let gq = scratch.g.get(j).copied().unwrap_or(UNREACHED);
+        let cost = if d & 1 == 1 { DIAGONAL } else { STRAIGHT };
+        if gq != UNREACHED && gq.checked_add(cost) == Some(gp) {
+            return Some((q, j));
+        }
+    }
+    None
 }
 
 /// Origin of a box side of `len` cells over a piece starting at `lo` with `extent` cells, centred
@@ -119,17 +156,13 @@ impl Heap<'_, '_> {
     }
 
     fn at(&self, slot: usize) -> u16 {
-        self.s.heap.get(slot).copied().unwrap_or(0)
+        half(self.s.heap, slot)
     }
 
     fn put(&mut self, slot: usize, i: u16) {
-        if let Some(h) = self.s.heap.get_mut(slot) {
-            *h = i;
-        }
-        if let Some(p) = self.s.pos.get_mut(usize::from(i)) {
-            // slot < heap length <= 65536 cells.
-            *p = slot as u16;
-        }
+        set_half(self.s.heap, slot, i);
+        // slot < heap length <= MAX_SIDE^2 < 0xFFFF.
+        set_half(self.s.pos, usize::from(i), slot as u16);
     }
 
     fn push(&mut self, i: u16) {
@@ -140,7 +173,7 @@ impl Heap<'_, '_> {
     }
 
     fn decreased(&mut self, i: u16) {
-        let slot = usize::from(self.s.pos.get(usize::from(i)).copied().unwrap_or(0));
+        let slot = usize::from(half(self.s.pos, usize::from(i)));
         self.up(slot);
     }
 
@@ -198,7 +231,8 @@ impl Heap<'_, '_> {
     }
 }
 
-/// Exact A* from `from` to `to` inside `bbox`; returns the cost to `to` (links in `scratch`).
+/// Exact A* from `from` to `to` inside `bbox`; returns the cost to `to` (costs in `scratch`, read
+/// back by [`pred`]).
 pub(super) fn search(
     grid: &Grid<'_>,
     bbox: &Box2,
@@ -213,19 +247,16 @@ pub(super) fn search(
     }
     let si = bbox.local(from)?;
     let ti = bbox.local(to)?;
-    scratch.link.get_mut(..cells)?.fill(0);
+    scratch.g.get_mut(..cells)?.fill(UNREACHED);
     *scratch.g.get_mut(si)? = 0;
     *scratch.f.get_mut(si)? = octile(from, to);
-    *scratch.link.get_mut(si)? = REACHED;
     let mut heap = Heap { s: scratch, len: 0 };
-    // si < cells <= 65536.
+    // si < cells <= MAX_SIDE^2 < 0xFFFF.
     heap.push(si as u16);
     while let Some(i) = heap.pop() {
         let iu = usize::from(i);
         let gi = heap.s.g.get(iu).copied()?;
-        if let Some(l) = heap.s.link.get_mut(iu) {
-            *l |= CLOSED;
-        }
+        set_half(heap.s.pos, iu, CLOSED);
         budget.expanded = budget.expanded.saturating_add(1);
         if iu == ti {
             return Some(gi);
@@ -242,32 +273,20 @@ pub(super) fn search(
             // The move is allowed, so the target is inside the map: both fit u16.
             let q = Point::new(nx as u16, ny as u16);
             let Some(j) = bbox.local(q) else { continue };
-            let lj = heap.s.link.get(j).copied().unwrap_or(CLOSED);
-            if lj & CLOSED != 0 {
-                continue;
-            }
+            let gj = heap.s.g.get(j).copied().unwrap_or(0);
             let ng = gi.saturating_add(if d & 1 == 1 { DIAGONAL } else { STRAIGHT });
-            if lj & REACHED == 0 {
-                if let (Some(g), Some(f), Some(l)) = (
-                    heap.s.g.get_mut(j),
-                    heap.s.f.get_mut(j),
-                    heap.s.link.get_mut(j),
-                ) {
+            if gj == UNREACHED {
+                if let (Some(g), Some(f)) = (heap.s.g.get_mut(j), heap.s.f.get_mut(j)) {
                     *g = ng;
                     *f = ng.saturating_add(octile(q, to));
-                    *l = REACHED | d;
                 }
+                // j < cells < 0xFFFF.
                 heap.push(j as u16);
-            } else if ng < heap.s.g.get(j).copied().unwrap_or(0) {
-                if let (Some(g), Some(f), Some(l)) = (
-                    heap.s.g.get_mut(j),
-                    heap.s.f.get_mut(j),
-                    heap.s.link.get_mut(j),
-                ) {
+            } else if ng < gj && half(heap.s.pos, j) != CLOSED {
+                if let (Some(g), Some(f)) = (heap.s.g.get_mut(j), heap.s.f.get_mut(j)) {
                     let h = f.saturating_sub(*g);
                     *g = ng;
                     *f = ng.saturating_add(h);
-                    *l = REACHED | d;
                 }
                 heap.decreased(j as u16);
             }

@@ -172,6 +172,10 @@ fn params_fields(p: &Params) -> Vec<(String, Vec<u8>)> {
             format!("  warm_patience = {}", p.warm_patience),
             ser(&p.warm_patience),
         ),
+        (
+            format!("  refine_patience = {}", p.refine_patience),
+            ser(&p.refine_patience),
+        ),
         (format!("  seed = {}", p.seed), ser(&p.seed)),
         (
             format!("  dead_end = {:?}", p.dead_end),
@@ -183,6 +187,7 @@ fn params_fields(p: &Params) -> Vec<(String, Vec<u8>)> {
         ),
         (format!("  tighten = {}", p.tighten), ser(&p.tighten)),
         (format!("  prune = {}", p.prune), ser(&p.prune)),
+        (format!("  refine = {}", p.refine), ser(&p.refine)),
     ]
 }
 

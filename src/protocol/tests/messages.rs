@@ -52,6 +52,7 @@ fn largest_messages_fit_their_limits() {
         iterations: u16::MAX,
         patience: u16::MAX,
         warm_patience: u16::MAX,
+        refine_patience: u16::MAX,
         ..Params::default()
     };
     encode_request(u32::MAX, &Request::SetParams(p), &mut buf).unwrap();

@@ -93,11 +93,13 @@ fn params() -> Params {
         tau_max: 1e30,
         patience: 0,
         warm_patience: 7,
+        refine_patience: 300,
         seed: u64::MAX,
         dead_end: DeadEnd::Die,
         smoothing: SmoothingKind::Greedy,
         tighten: false,
         prune: true,
+        refine: true,
     }
 }
 
