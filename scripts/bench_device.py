@@ -4,7 +4,8 @@
 Run through scripts/bench-device.sh (which builds the firmware first). Boots the QEMU firmware
 with `-icount shift=0` (1 guest instruction = 1 ns of virtual time; SysTick counts that time, so
 a plan's `ticks` (us) x 1000 = instructions from `Run::new` to the result), uploads a map, plans
-seeds 1..=N with the default parameters (early stop) and with `patience 0` (every iteration),
+seeds 1..=N with the default parameters (early stop) and with `patience 0` and
+`refine_patience 0` (every iteration),
 and reads the firmware's defmt log for where the instructions went (Run::new, the iterations,
 Run::finish = smoothing). Then boots it again without -icount and times Hello round trips over
 the emulated UART (wall clock). Prints Markdown tables.
@@ -124,7 +125,7 @@ def main():
         expect(dev.set_map(w, h, bits), "Ack")
         early = plans(dev, start, goal, seeds)
         if not args.default_only:
-            expect(dev.call(req_set_params(dict(defaults, patience=0))), "Ack")
+            expect(dev.call(req_set_params(dict(defaults, patience=0, refine_patience=0))), "Ack")
             full = plans(dev, start, goal, seeds)
             expect(dev.call(req_set_params(defaults)), "Ack")
     finally:
@@ -177,7 +178,7 @@ def main():
     print("| --- | --- | --- | --- | --- | --- | --- | " + " | ".join("---" for _ in CLOCKS_MHZ)
           + " |")
     n = len(seeds)
-    print(summary_row(f"default (patience {defaults['patience']})", early, parts[:n]))
+    print(summary_row(f"default (patience {defaults['patience']}, {defaults['refine_patience']} with the local search)", early, parts[:n]))
     print(summary_row(f"full {a}x{defaults['iterations']} (patience 0)", full, parts[n:]))
     print()
     print("Time estimates = instructions / clock, assuming about one instruction per cycle on "

@@ -9,8 +9,8 @@
 //! ```
 //!
 //! For each map: the `N` (default 20) scenarios of largest optimum (as in the `large` example),
-//! the exact optimum by the reference A*, the default plan (seed 1; `--patience` overrides the
-//! early stop), then `refine` of its raw path
+//! the exact optimum by the reference A*, the default plan without the planner's own local search
+//! (seed 1, `refine` off; `--patience` overrides the early stop), then `refine` of its raw path
 //! with a window of each side. Raw paths are cached in `DIR` (default
 //! `target/refine-large-cache`), so that trying other window sides does not re-plan. Prints one
 //! Markdown row per map and side: every refined path checked valid, mean raw/opt8 before and
@@ -37,7 +37,7 @@ use ohaca_host_tests::reference::astar8;
 fn raw_path(cache: &Path, m: &LargeMap, c: usize, seed: u64, patience: u16) -> (Vec<Point>, u16) {
     let case = &m.cases[c];
     let file = cache.join(format!(
-        "{}-{}-{}-{}-{}-s{seed}-p{patience}.txt",
+        "{}-{}-{}-{}-{}-s{seed}-p{patience}-colony.txt",
         m.name, case.start.x, case.start.y, case.goal.x, case.goal.y
     ));
     if let Ok(text) = std::fs::read_to_string(&file) {
@@ -57,9 +57,11 @@ fn raw_path(cache: &Path, m: &LargeMap, c: usize, seed: u64, patience: u16) -> (
     }
     let mut st = ohaca_host_tests::heap::storage(m.map.cells());
     let grid = m.map.grid();
+    // The colony's own raw path: the planner's local search off, `patience` as given.
     let p = Params {
         seed,
         patience,
+        refine: false,
         ..Params::default()
     };
     let pl = plan(&grid, case.start, case.goal, &p, st.workspace()).expect("a plan");

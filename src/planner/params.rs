@@ -49,7 +49,7 @@ impl Algorithm {
 ///
 /// Two presets: [`Params::default`] is this project's setting (the paper's `alpha`, `beta`, `rho`,
 /// `Q`, `a`, `xi`, `M` and `N`, plus backtracking ants, path tightening, dead-end pruning, early
-/// stopping after 10 stale iterations (3 with the local search of large maps, 2 for a warm
+/// stopping after 10 stale iterations (2 with the local search of large maps or for a warm
 /// replan), the local search and shortest smoothing); [`Params::paper`] is the paper's algorithm
 /// as written (ants die at dead ends, no tightening, no pruning, always all `N` iterations, no
 /// local search, greedy smoothing).
@@ -131,7 +131,7 @@ impl Params {
         tau_max: 100.0,
         patience: 10,
         warm_patience: 2,
-        refine_patience: 3,
+        refine_patience: 2,
         seed: 1,
         dead_end: DeadEnd::Backtrack,
         smoothing: SmoothingKind::Shortest,
