@@ -76,7 +76,8 @@ fn main() {
             match r {
                 Err(e) => (false, 0.0, 0.0, 0, 0, time, astar, format!("{e}")),
                 Ok(pl) => {
-                    let ok = check_plan(&m.map, case.start, case.goal, &pl, usize::MAX).is_ok();
+                    let check = check_plan(&m.map, case.start, case.goal, &pl, usize::MAX);
+                    let ok = check.is_ok();
                     (
                         ok,
                         f64::from(pl.raw_length) / opt,
@@ -85,7 +86,7 @@ fn main() {
                         u64::from(pl.iterations),
                         time,
                         astar,
-                        String::new(),
+                        check.err().unwrap_or_default(),
                     )
                 }
             }

@@ -267,11 +267,24 @@ pub fn check_plan(
             p.iterations
         ));
     }
-    let early = p.patience > 0 && u32::from(its) == u32::from(best_it) + 1 + u32::from(p.patience);
+    // The patience that applies: a warm replan's, a refining run's (OHACA with the local search on
+    // a map of more than `BLOCKS` cells; every storage of these tests lends its scratch), or the
+    // plain one.
+    let refines = p.refine
+        && p.algorithm == Algorithm::Ohaca
+        && map.cells() > ohaca::pheromone::BLOCKS;
+    let patience = if plan.warm && p.warm_patience > 0 {
+        p.warm_patience
+    } else if refines && p.refine_patience > 0 {
+        p.refine_patience
+    } else {
+        p.patience
+    };
+    let early = patience > 0 && u32::from(its) == u32::from(best_it) + 1 + u32::from(patience);
     if its != p.iterations && !early {
         return Err(format!(
-            "stopped after {its} of {} iterations (best at {best_it}, patience {})",
-            p.iterations, p.patience
+            "stopped after {its} of {} iterations (best at {best_it}, patience {patience})",
+            p.iterations
         ));
     }
     if early && its > p.iterations {
@@ -283,6 +296,15 @@ pub fn check_plan(
         return Err(format!(
             "curve has {} points for {its} iterations",
             curve.len()
+        ));
+    }
+    // The local search never lengthens the colony's path, and runs only where it applies.
+    if plan.raw_length > plan.colony_length
+        || (!refines && plan.raw_length.to_bits() != plan.colony_length.to_bits())
+    {
+        return Err(format!(
+            "raw_length {} against the colony's {} (local search {refines})",
+            plan.raw_length, plan.colony_length
         ));
     }
     let mut best_so_far = f32::INFINITY;
@@ -300,13 +322,13 @@ pub fn check_plan(
             return Err(format!("curve[{i}]: mean {} below best {}", c.mean, c.best));
         }
         let first_best = i == usize::from(best_it);
-        if first_best && c.best_so_far.to_bits() != plan.raw_length.to_bits() {
+        if first_best && c.best_so_far.to_bits() != plan.colony_length.to_bits() {
             return Err(format!(
                 "curve[{i}] (best_iteration) has best_so_far {}, plan says {}",
-                c.best_so_far, plan.raw_length
+                c.best_so_far, plan.colony_length
             ));
         }
-        if i < usize::from(best_it) && c.best_so_far <= plan.raw_length {
+        if i < usize::from(best_it) && c.best_so_far <= plan.colony_length {
             return Err(format!(
                 "curve[{i}] already reached {} before best_iteration {best_it}",
                 c.best_so_far

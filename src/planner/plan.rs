@@ -25,8 +25,12 @@ pub struct Plan<'a> {
     pub(super) start: Point,
     pub(super) tour: &'a [Dir],
     pub(super) waypoints: &'a [Point],
-    /// Length of the raw 8-connected path, in cell units.
+    /// Length of the raw 8-connected path, in cell units: the colony's best path, shortened by the
+    /// local search where it ran ([`Params::refine`]).
     pub raw_length: f32,
+    /// Length of the colony's best raw path (the convergence curve's last `best_so_far`): equal to
+    /// `raw_length` unless the local search shortened it.
+    pub colony_length: f32,
     /// Length of the output path through [`Plan::waypoints`] (smoothed for OHACA).
     pub length: f32,
     /// Turns (inflection points) along the waypoints.

@@ -110,6 +110,8 @@ pub struct Run<'g, 'a> {
     setup: Setup,
     refines: bool,
     polish: Polish,
+    /// The colony's best path length, kept when the local search replaces the best path.
+    colony: Option<Best>,
     no_path: bool,
     done: bool,
 }
@@ -267,6 +269,7 @@ impl<'g, 'a> Run<'g, 'a> {
             setup: Setup::Reach,
             refines,
             polish: Polish::Start,
+            colony: None,
             no_path: false,
             done: false,
         })
@@ -598,6 +601,7 @@ impl<'g, 'a> Run<'g, 'a> {
                             }
                         }
                     }
+                    self.colony = Some(best);
                     self.best = Some(Best {
                         steps: n.saturating_sub(1).min(ws.best.len()),
                         straight,
@@ -645,6 +649,7 @@ impl<'g, 'a> Run<'g, 'a> {
             pruned,
             warm,
             polish,
+            colony,
             ..
         } = self;
         let best = best.ok_or(Error::NoAntArrived)?;
@@ -681,6 +686,7 @@ impl<'g, 'a> Run<'g, 'a> {
             tour,
             waypoints,
             raw_length: best.length(),
+            colony_length: colony.unwrap_or(best).length(),
             length,
             turns: turns(waypoints),
             iterations: iteration,
