@@ -60,12 +60,20 @@ pub fn segment_clear(grid: &Grid<'_>, a: Point, b: Point) -> bool {
     // instead of a walk over every row. Half-way first, then the quarters, then the eighths.
     let span = a.x.abs_diff(b.x).max(a.y.abs_diff(b.y));
     if span >= 8 {
-        // With centres at c + 1/2: floor(((8 - k)(a + 1/2) + k (b + 1/2)) / 8); every term is
-        // below 2^21, so no u32 wraps.
+        // With centres at c + 1/2: floor(((8 - k)(a + 1/2) + k (b + 1/2)) / 8), for k in 1..8;
+        // every term is below 2^21, so nothing wraps.
         let at = |k: u32, ua: u16, ub: u16| {
-            (2 * (8 - k) * u32::from(ua) + 2 * k * u32::from(ub) + 8) / 16
+            let wa = 8u32.wrapping_sub(k).wrapping_mul(2);
+            wa.wrapping_mul(u32::from(ua))
+                .wrapping_add(k.wrapping_mul(2).wrapping_mul(u32::from(ub)))
+                .wrapping_add(8)
+                >> 4
         };
-        let samples: &[u32] = if span >= 24 { &[4, 2, 6, 1, 3, 5, 7] } else { &[4, 2, 6] };
+        let samples: &[u32] = if span >= 24 {
+            &[4, 2, 6, 1, 3, 5, 7]
+        } else {
+            &[4, 2, 6]
+        };
         for &k in samples {
             // Between two cells on the map: on the map too.
             if grid.blocked_xy(at(k, a.x, b.x) as i32, at(k, a.y, b.y) as i32) {

@@ -270,9 +270,8 @@ pub fn check_plan(
     // The patience that applies: a warm replan's, a refining run's (OHACA with the local search on
     // a map of more than `BLOCKS` cells; every storage of these tests lends its scratch), or the
     // plain one.
-    let refines = p.refine
-        && p.algorithm == Algorithm::Ohaca
-        && map.cells() > ohaca::pheromone::BLOCKS;
+    let refines =
+        p.refine && p.algorithm == Algorithm::Ohaca && map.cells() > ohaca::pheromone::BLOCKS;
     let patience = if plan.warm && p.warm_patience > 0 {
         p.warm_patience
     } else if refines && p.refine_patience > 0 {

@@ -117,8 +117,8 @@ fn the_parameter_table_is_the_cores() {
         // with a parameter's name, as the warm-start one does).
         let line = text
             .lines()
-            .filter(|l| l.starts_with(&format!("| `{name}` |")))
-            .last()
+            .rev()
+            .find(|l| l.starts_with(&format!("| `{name}` |")))
             .unwrap_or_else(|| panic!("no row for {name} in ALGORITHM.md's parameter table"));
         line.split('|').map(|c| c.trim().to_string()).collect()
     };

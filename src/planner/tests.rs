@@ -402,8 +402,12 @@ fn assert_raw_valid(g: &Grid<'_>, plan: &Plan<'_>, s: Point, goal: Point) {
     );
 }
 
+/// What the large-map tests compare: directions, waypoints, raw length, iterations, best
+/// iteration.
+type Outcome = (Vec<Dir>, Vec<Point>, f32, u16, u16);
+
 /// Plan on the large map (`None` if this seed's map has no path).
-fn large_plan(seed: u64, p: &Params) -> Option<(Vec<Dir>, Vec<Point>, f32, u16, u16)> {
+fn large_plan(seed: u64, p: &Params) -> Option<Outcome> {
     let (b, w, h) = large_map(seed);
     let g = Grid::new(w, h, &b).unwrap();
     let (s, goal) = (Point::new(0, 0), Point::new(63, 47));
@@ -447,7 +451,10 @@ fn the_local_search_shortens_large_map_paths_and_never_lengthens_them() {
         shorter += usize::from(a.2 < b.2);
     }
     assert!(planned >= 6, "{planned}");
-    assert_eq!(shorter, planned, "the local search shortened {shorter} of {planned}");
+    assert_eq!(
+        shorter, planned,
+        "the local search shortened {shorter} of {planned}"
+    );
 }
 
 #[test]
@@ -492,7 +499,10 @@ fn the_polish_runs_in_pieces_and_equals_finish() {
     let p = Params::default();
     let mut st1 = Box::new(SLarge::new());
     let mut run = Run::new(&g, s, goal, &p, st1.workspace()).unwrap();
-    assert!(!run.polish_step(), "nothing to polish before the run is done");
+    assert!(
+        !run.polish_step(),
+        "nothing to polish before the run is done"
+    );
     assert!(run.step());
     assert!(!run.polish_step(), "nor while it runs");
     while run.step() {}
