@@ -82,3 +82,45 @@ fn seeds_are_accepted() {
 fn planner_inputs() {
     replay("regressions/planner", ohaca_fuzz::fuzz_planner);
 }
+
+/// Pseudo-random planner inputs (a fixed xorshift stream, so the same every run), long enough to
+/// reach the trailing fields: the local search, its patience and the map tiling that makes maps
+/// large enough for it (more than 1,024 cells). Each input runs as decoded and again with valid
+/// parameters and the local search on (random parameters are rarely valid). A quick stand-in
+/// for `scripts/fuzz.sh planner`.
+#[test]
+fn random_planner_inputs_keep_every_promise() {
+    let mut state = 0x9E37_79B9_7F4A_7C15u64;
+    let mut large = 0;
+    for _ in 0..600 {
+        let data: Vec<u8> = (0..200)
+            .map(|_| {
+                state ^= state << 13;
+                state ^= state >> 7;
+                state ^= state << 17;
+                (state >> 24) as u8
+            })
+            .collect();
+        let mut u = arbitrary::Unstructured::new(&data);
+        let Ok(mut input) = <ohaca_fuzz::PlannerInput as arbitrary::Arbitrary>::arbitrary(&mut u)
+        else {
+            continue;
+        };
+        ohaca_fuzz::check_planner(&input);
+        let cells = usize::from(input.width) * usize::from(input.height);
+        large += usize::from(cells > ohaca::pheromone::BLOCKS);
+        input.params = ohaca::Params {
+            seed: input.params.seed,
+            ants: 8,
+            iterations: 6,
+            refine: true,
+            refine_patience: input.params.refine_patience,
+            ..ohaca::Params::default()
+        };
+        ohaca_fuzz::check_planner(&input);
+    }
+    assert!(
+        large >= 50,
+        "only {large} inputs large enough for the local search"
+    );
+}
