@@ -143,7 +143,7 @@ SMOOTHING = ["none", "greedy", "shortest"]
 ERRORS = {
     1: "BadMap", 2: "MapTooLarge", 3: "StartOutOfBounds", 4: "GoalOutOfBounds",
     5: "StartBlocked", 6: "GoalBlocked", 7: "BadParam", 8: "NoPath", 9: "Cancelled",
-    10: "NoAntArrived", 16: "BadCrc", 17: "Undecodable", 18: "TooLarge", 19: "NoMap",
+    10: "NoAntArrived", 11: "PathTooLong", 16: "BadCrc", 17: "Undecodable", 18: "TooLarge", 19: "NoMap",
     20: "Busy", 21: "BadChunk", 22: "Internal", 23: "BadRle", 24: "OutsideMap",
 }
 PARAM_FIELDS = [

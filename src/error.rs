@@ -62,6 +62,15 @@ pub enum Error {
     /// The goal is reachable, but no ant reached it: with [`crate::DeadEnd::Die`] every ant
     /// died at a dead end (or the run was finished before its first iteration).
     NoAntArrived,
+    /// The goal is reachable, but no ant reached it and some ants were dropped because their
+    /// paths grew longer than the workspace keeps (`Workspace::steps`; 1,023 steps on the
+    /// device): the way to the goal is longer than that, or the ants wandered that far.
+    PathTooLong {
+        /// Ants dropped over the run.
+        ants: u32,
+        /// The longest path the workspace keeps, in steps.
+        limit: u32,
+    },
     /// The run was cancelled before it finished.
     Cancelled,
 }
@@ -132,6 +141,11 @@ impl fmt::Display for Error {
             Error::NoAntArrived => {
                 f.write_str("no ant reached the goal (every ant died at a dead end)")
             }
+            Error::PathTooLong { ants, limit } => write!(
+                f,
+                "no ant reached the goal within {limit} steps ({ants} ants dropped: the path is \
+                 longer than the planner keeps)"
+            ),
         }
     }
 }

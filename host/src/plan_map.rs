@@ -71,10 +71,11 @@ pub fn plan_map_in(
             Some(0),
             t0.elapsed(),
         )),
-        // Only with `DeadEnd::Die`: the goal is reachable but no ant got there.
-        Err(Error::NoAntArrived) => Ok(PlanReport::not_found(
+        // With `DeadEnd::Die`, or ants dropped for paths longer than the workspace keeps: the goal
+        // is reachable but no ant got there.
+        Err(e @ (Error::NoAntArrived | Error::PathTooLong { .. })) => Ok(PlanReport::not_found(
             params,
-            format_args!("{} in {iterations} iterations", Error::NoAntArrived),
+            format_args!("{e} in {iterations} iterations"),
             Some(iterations),
             t0.elapsed(),
         )),

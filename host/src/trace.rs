@@ -65,11 +65,12 @@ pub fn plan_traced(
             Vec::new(),
             0,
         ),
-        // Only with `DeadEnd::Die`: no ant ever arrived, so the best so far was never finite.
-        Err(Error::NoAntArrived) => (
+        // With `DeadEnd::Die`, or ants dropped for paths longer than the workspace keeps: no ant
+        // ever arrived, so the best so far was never finite.
+        Err(e @ (Error::NoAntArrived | Error::PathTooLong { .. })) => (
             PlanReport::not_found(
                 params,
-                format_args!("{} in {iterations} iterations", Error::NoAntArrived),
+                format_args!("{e} in {iterations} iterations"),
                 Some(iterations),
                 t0.elapsed(),
             ),

@@ -1511,3 +1511,38 @@ fn a_cell_update_during_a_plan_cancels_it() {
     assert_eq!((st.cancelled, st.plans), (2, 1), "{st:?}");
     assert_eq!(link.stray_count(), 0, "{:?}", link.take_strays());
 }
+
+/// A plan whose only way is longer than the device keeps (a serpentine of 64-cell rows: about
+/// 2,000 steps, over the firmware's 1,023) ends with `PathTooLong`, giving the ants dropped and
+/// the step limit, not the old, misleading `NoAntArrived`; the device keeps serving, and a goal
+/// within reach on the same map is planned.
+#[test]
+fn a_path_longer_than_the_device_keeps_is_path_too_long() {
+    need_qemu!();
+    let q = Qemu::tcp();
+    let mut link = q.link();
+    let defaults = link.hello().expect("hello").defaults;
+    // Walls on every odd row, open at the right end on rows 1, 5, 9, ... and at the left on 3,
+    // 7, 11, ...: the way from the top left to the bottom left runs the whole width every two rows.
+    let map = Map::from_fn(64, 63, |x, y| {
+        y % 2 == 1 && if y % 4 == 1 { x != 63 } else { x != 0 }
+    });
+    link.set_map(&map).expect("upload");
+    let params = Params {
+        ants: 4,
+        iterations: 2,
+        ..defaults
+    };
+    link.set_params(&params).expect("set params");
+    let e = error_code(link.plan(Point::new(0, 0), Point::new(0, 62), None));
+    assert_eq!(e, ErrorReply::with(ErrorCode::PathTooLong, 8, 1023));
+    assert_eq!(
+        e.to_string(),
+        "path longer than the device keeps (8 ants dropped, limit 1023 steps)"
+    );
+    let near = link
+        .plan(Point::new(0, 0), Point::new(0, 8), None)
+        .expect("a goal within reach");
+    assert!(near.raw_cells > 1);
+    assert_eq!(link.stray_count(), 0, "{:?}", link.take_strays());
+}

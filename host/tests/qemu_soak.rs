@@ -413,6 +413,7 @@ fn from_planner(r: &Response) -> bool {
                 | NoPath
                 | Cancelled
                 | NoAntArrived
+                | PathTooLong
                 | Internal
         ),
         _ => false,

@@ -33,8 +33,10 @@ pub const MAX_CELLS: usize = MAX_WIDTH as usize * MAX_HEIGHT as usize;
 pub const MAP_BYTES: usize = MAX_CELLS.div_ceil(8);
 /// Most cells of a map the planner plans on: every map the device holds, at full resolution.
 pub const PLAN_CELLS: usize = MAX_CELLS;
-/// Longest ant path the planner keeps, in steps (an ant whose path grows longer is dropped; a
-/// 256 x 256 map's shortest paths are at most 510 steps).
+/// Longest ant path the planner keeps, in steps (an ant whose path grows longer is dropped, and a
+/// plan no ant finishes that way is `Error PathTooLong`). A 256 x 256 map's straight-line paths
+/// are at most 510 steps, but a maze's can be far longer: the longest scenario of
+/// `maps/large/maze-128-128-2` has 1,379 steps (BENCHMARKS.md, section 4).
 pub const PLAN_STEPS: usize = 1023;
 /// The planner's storage: two bits a map cell (tabu list, pruned cells), the pheromone budget,
 /// the coarse route, four ant paths of [`PLAN_STEPS`] steps, links, and the move table for maps of

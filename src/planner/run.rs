@@ -113,6 +113,8 @@ pub struct Run<'g, 'a> {
     /// The colony's best path length, kept when the local search replaces the best path.
     colony: Option<Best>,
     no_path: bool,
+    /// Ants dropped so far because their paths outgrew the workspace ([`Error::PathTooLong`]).
+    dropped: u32,
     done: bool,
 }
 
@@ -271,6 +273,7 @@ impl<'g, 'a> Run<'g, 'a> {
             polish: Polish::Start,
             colony: None,
             no_path: false,
+            dropped: 0,
             done: false,
         })
     }
@@ -438,7 +441,11 @@ impl<'g, 'a> Run<'g, 'a> {
                     self.no_path = true;
                     break;
                 }
-                Err(Lost::Died | Lost::Overflow) => continue,
+                Err(Lost::Died) => continue,
+                Err(Lost::Overflow) => {
+                    self.dropped = self.dropped.saturating_add(1);
+                    continue;
+                }
             };
             self.moves = self.moves.saturating_add(u64::from(walk.moves));
             let walk = if p.tighten && walk.may_tighten {
@@ -626,16 +633,32 @@ impl<'g, 'a> Run<'g, 'a> {
         !matches!(self.polish, Polish::Done { .. })
     }
 
+    /// The error of a run no ant finished: [`Error::PathTooLong`] when ants were dropped for
+    /// their length (the likelier cause, and the one a caller can act on), else
+    /// [`Error::NoAntArrived`].
+    fn no_arrival(&self) -> Error {
+        if self.dropped == 0 {
+            return Error::NoAntArrived;
+        }
+        Error::PathTooLong {
+            ants: self.dropped,
+            limit: u32::try_from(self.ws.steps()).unwrap_or(u32::MAX),
+        }
+    }
+
     /// Stop now and turn the best path found so far into the result: refined (large maps) and
     /// smoothed for OHACA, doing whatever [`Run::polish_step`] left. Fails with
     /// [`Error::NoAntArrived`] if no ant has reached the goal (only possible with
-    /// [`crate::DeadEnd::Die`], or before the first iteration), and with [`Error::NoPath`] if an
-    /// unreachable goal ended the run.
+    /// [`crate::DeadEnd::Die`], or before the first iteration), with [`Error::PathTooLong`] instead
+    /// if ants were dropped for paths longer than the workspace keeps, and with [`Error::NoPath`]
+    /// if an unreachable goal ended the run.
     pub fn finish(mut self) -> Result<Plan<'a>, Error> {
         if self.no_path {
             return Err(Error::NoPath);
         }
-        self.best.ok_or(Error::NoAntArrived)?;
+        if self.best.is_none() {
+            return Err(self.no_arrival());
+        }
         self.done = true;
         while self.polish_step() {}
         let Run {

@@ -116,6 +116,44 @@ fn errors() {
     );
 }
 
+/// A goal reachable only by a path longer than the workspace keeps is `PathTooLong` (every ant
+/// dropped, the limit reported), not `NoAntArrived`; the same plan on a larger workspace succeeds.
+#[test]
+fn a_path_longer_than_the_workspace_keeps_is_path_too_long() {
+    let (b, w, h) = grid(&[
+        "........", //
+        "#######.", //
+        "........", //
+        ".#######", //
+        "........", //
+    ]);
+    let g = Grid::new(w, h, &b).unwrap();
+    let (start, goal) = (Point::new(0, 0), Point::new(7, 4));
+    let p = Params {
+        iterations: 3,
+        ..Params::default()
+    };
+    let mut small: Storage<2, 12, 128, 64> = Storage::new();
+    let limit = small.workspace().steps();
+    assert!(
+        limit < 25,
+        "the shortest path has 25 steps (no corner cutting)"
+    );
+    let e = plan(&g, start, goal, &p, small.workspace())
+        .map(|_| ())
+        .unwrap_err();
+    assert_eq!(
+        e,
+        Error::PathTooLong {
+            ants: u32::from(p.ants) * u32::from(p.iterations),
+            limit: limit as u32,
+        }
+    );
+    let mut big: S64 = Storage::new();
+    let plan = plan(&g, start, goal, &p, big.workspace()).unwrap();
+    assert!(plan.raw().count() > limit + 1);
+}
+
 #[test]
 fn start_equals_goal() {
     let (b, w, h) = grid(&ROWS);

@@ -42,7 +42,8 @@ impl ErrorReply {
 }
 
 /// The one mapping between the planner's errors and the wire: each [`Error`] is an [`ErrorCode`]
-/// from 1 to 10 with its numbers (`MapTooLarge`: cells and capacity; `BadParam`: the parameter's
+/// from 1 to 11 with its numbers (`MapTooLarge`: cells and capacity; `PathTooLong`: ants dropped
+/// and the step limit; `BadParam`: the parameter's
 /// [`Param`] index). [`TryFrom<ErrorReply>`](#impl-TryFrom%3CErrorReply%3E-for-Error) is its
 /// inverse.
 impl From<Error> for ErrorReply {
@@ -60,11 +61,14 @@ impl From<Error> for ErrorReply {
             Error::NoPath => ErrorReply::new(ErrorCode::NoPath),
             Error::Cancelled => ErrorReply::new(ErrorCode::Cancelled),
             Error::NoAntArrived => ErrorReply::new(ErrorCode::NoAntArrived),
+            Error::PathTooLong { ants, limit } => {
+                ErrorReply::with(ErrorCode::PathTooLong, ants, limit)
+            }
         }
     }
 }
 
-/// The planner error a reply stands for (codes 1 to 10), so a host can show the core's own
+/// The planner error a reply stands for (codes 1 to 11), so a host can show the core's own
 /// message; the reply itself back when it is one of the protocol's own codes, or a `BadParam`
 /// whose `detail` names no parameter.
 impl TryFrom<ErrorReply> for Error {
@@ -85,6 +89,10 @@ impl TryFrom<ErrorReply> for Error {
             ErrorCode::NoPath => Error::NoPath,
             ErrorCode::Cancelled => Error::Cancelled,
             ErrorCode::NoAntArrived => Error::NoAntArrived,
+            ErrorCode::PathTooLong => Error::PathTooLong {
+                ants: r.detail,
+                limit: r.limit,
+            },
             ErrorCode::BadCrc
             | ErrorCode::Undecodable
             | ErrorCode::TooLarge
@@ -115,12 +123,17 @@ impl fmt::Display for ErrorReply {
             ErrorCode::BadParam => write!(f, " (parameter #{})", self.detail),
             ErrorCode::BadRle => write!(f, " ({} of {} cells)", self.detail, self.limit),
             ErrorCode::OutsideMap => write!(f, " (cell {}, {})", self.detail, self.limit),
+            ErrorCode::PathTooLong => write!(
+                f,
+                " ({} ants dropped, limit {} steps)",
+                self.detail, self.limit
+            ),
             _ => Ok(()),
         }
     }
 }
 
-/// Error codes on the wire (one byte). 1 to 10 are the planner's [`Error`]s (mapped by
+/// Error codes on the wire (one byte). 1 to 11 are the planner's [`Error`]s (mapped by
 /// `From<Error> for ErrorReply` and back by `TryFrom<ErrorReply> for Error`); 16 and up are the
 /// protocol's own. `detail` / `limit` of the [`ErrorReply`] are given where they mean
 /// something.
@@ -148,8 +161,11 @@ pub enum ErrorCode {
     /// The plan was cancelled (by [`Request::Cancel`] or a new map).
     Cancelled = 9,
     /// The goal is reachable but no ant reached it (every ant died at a dead end with
-    /// [`crate::DeadEnd::Die`]).
+    /// [`crate::DeadEnd::Die`]; ants dropped for long paths give [`ErrorCode::PathTooLong`]).
     NoAntArrived = 10,
+    /// The goal is reachable but no ant reached it, and ants were dropped for paths longer than
+    /// the device keeps: `detail` = ants dropped, `limit` = the longest path kept, in steps.
+    PathTooLong = 11,
     /// The frame's CRC did not match (id: [`UNKNOWN_ID`]).
     BadCrc = 16,
     /// The frame was not valid COBS, or too short, or its message did not decode (id: the
@@ -176,7 +192,7 @@ pub enum ErrorCode {
 
 impl ErrorCode {
     /// Every code, in numeric order.
-    pub const ALL: [ErrorCode; 19] = [
+    pub const ALL: [ErrorCode; 20] = [
         ErrorCode::BadMap,
         ErrorCode::MapTooLarge,
         ErrorCode::StartOutOfBounds,
@@ -187,6 +203,7 @@ impl ErrorCode {
         ErrorCode::NoPath,
         ErrorCode::Cancelled,
         ErrorCode::NoAntArrived,
+        ErrorCode::PathTooLong,
         ErrorCode::BadCrc,
         ErrorCode::Undecodable,
         ErrorCode::TooLarge,
@@ -221,6 +238,7 @@ impl ErrorCode {
             ErrorCode::NoPath => "no path",
             ErrorCode::Cancelled => "cancelled",
             ErrorCode::NoAntArrived => "no ant reached the goal",
+            ErrorCode::PathTooLong => "path longer than the device keeps",
             ErrorCode::BadCrc => "bad CRC",
             ErrorCode::Undecodable => "undecodable frame",
             ErrorCode::TooLarge => "too large",

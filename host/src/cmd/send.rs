@@ -447,7 +447,7 @@ impl Sender {
                         PlanReport::not_found(&params, err, Some(0), round_trip),
                         None,
                     ),
-                    Some(err @ Error::NoAntArrived) => {
+                    Some(err @ (Error::NoAntArrived | Error::PathTooLong { .. })) => {
                         Outcome::found(PlanReport::not_found(&params, err, None, round_trip), None)
                     }
                     Some(err @ (Error::OutOfBounds(_) | Error::Blocked(_))) => {

@@ -185,6 +185,13 @@ fn error_codes_map_the_planner_errors_both_ways() {
         (Error::NoPath, 8),
         (Error::Cancelled, 9),
         (Error::NoAntArrived, 10),
+        (
+            Error::PathTooLong {
+                ants: 5000,
+                limit: 1023,
+            },
+            11,
+        ),
     ];
     for (e, code) in all {
         let reply = ErrorReply::from(e);

@@ -1,0 +1,147 @@
+#!/usr/bin/env python3
+"""The firmware's default plan per map size: instructions under QEMU, map memory, upload.
+
+    cargo build --release && python3 scripts/bench_sizes.py [--seeds 3]
+
+For each size (32^2 .. 512^2) one public Moving AI map of `maps/` and its longest scenario (the
+largest optimum in the map's `.scen`): boots the release firmware with `-icount shift=0` (1 tick
+= 1 us = 1000 instructions), uploads the map over the emulated UART in raw 128-byte chunks,
+plans seeds 1..=N with the device's default parameters and prints one Markdown row per map: the
+map's bytes in the device's one map buffer, the bytes a raw upload's frames put on the wire and
+their time at 115200 8N1, the iterations, the instructions of the plan
+(from `Run::new` to the smoothed path; `Path.ticks`), its split (with defmt-print), and the raw
+length against the `.scen` optimum. A plan that fails shows its error (a path longer than the
+1,023 steps the device keeps is `PathTooLong`). A map beyond the device's capacity (Hello's `cells`) is
+uploaded all the same: its row shows the device's refusal and what the map would need.
+The planner's storage does not grow with the map (`BENCHMARKS.md` section 5).
+"""
+
+import argparse
+import math
+import os
+import statistics
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from bench_device import ROOT, Qemu, mi, split_log  # noqa: E402
+from ohaca_client import (Device, expect, frame, load_map, raw_cells,  # noqa: E402
+                          req_hello, req_plan, req_set_map, varint)
+
+# One map per size: (size class, map, scenario file), all in the repository.
+MAPS = [
+    ("32 x 32", "maps/movingai/random-32-32-20.map", "maps/movingai/random-32-32-20-random-1.scen"),
+    ("64 x 64", "maps/large/random-64-64-10.map", "maps/large/random-64-64-10-random-1.scen"),
+    ("128 x 128", "maps/large/maze-128-128-10.map", "maps/large/maze-128-128-10-random-1.scen"),
+    ("128 x 128", "maps/large/maze-128-128-2.map", "maps/large/maze-128-128-2-random-1.scen"),
+    ("256 x 256", "maps/large/Boston_0_256.map", "maps/large/Boston_0_256-random-1.scen"),
+    ("512 x 512", "maps/large/NewYork_0_512.map", "maps/large/NewYork_0_512.map.scen"),
+]
+CHUNK = 128
+BAUD_BYTES = 115200 / 10  # 8N1: ten bits a byte
+
+
+def longest(scen):
+    """(start, goal, optimum) of the scenario with the largest optimum."""
+    best = None
+    for line in open(os.path.join(ROOT, scen)).read().splitlines()[1:]:
+        f = line.split("\t")
+        if len(f) < 9:
+            continue
+        case = ((int(f[4]), int(f[5])), (int(f[6]), int(f[7])), float(f[8]))
+        if best is None or case[2] > best[2]:
+            best = case
+    return best
+
+
+def wire_bytes(w, h, bits):
+    """Bytes on the wire of a raw upload's request frames (delimiters included; the `Ack`s travel
+    the other way at the same time), as `docs/PROTOCOL.md` counts them."""
+    total = 0
+    for n, off in enumerate(range(0, len(bits), CHUNK)):
+        body = req_set_map(w, h, off, len(bits), bits[off:off + CHUNK])
+        total += len(frame(varint(n + 1) + body))
+    return total
+
+
+def raw_length(start, dirs):
+    cells = raw_cells(start, dirs)
+    return sum(math.hypot(b[0] - a[0], b[1] - a[1]) for a, b in zip(cells, cells[1:]))
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--seeds", type=int, default=3)
+    args = ap.parse_args()
+    seeds = list(range(1, args.seeds + 1))
+
+    rows = []
+    q = Qemu(icount=True)
+    plans_done = 0
+    try:
+        dev = Device("127.0.0.1", q.port)
+        hello = expect(dev.call(req_hello()), "Hello")
+        cap = hello["capacity"]
+        for size, path, scen in MAPS:
+            w, h, bits, _ = load_map(os.path.join(ROOT, path))
+            start, goal, opt = longest(scen)
+            wire = wire_bytes(w, h, bits)
+            up = dev.set_map(w, h, bits, chunk=CHUNK)
+            row = {"size": size, "map": os.path.basename(path), "start": start, "goal": goal,
+                   "opt": opt, "bytes": len(bits), "wire": wire}
+            if up["kind"] != "Ack":
+                row["refused"] = up
+                rows.append(row)
+                continue
+            runs = [dev.call(req_plan(start, goal, seed=s)) for s in seeds]
+            failed = [p for p in runs if p["kind"] != "Path"]
+            if failed:  # e.g. PathTooLong: a path longer than the device keeps
+                row["failed"] = failed[0]
+            row["runs"] = runs
+            row["first_plan"] = plans_done
+            plans_done += len(runs) - len(failed)  # the firmware logs the split of a Path only
+            rows.append(row)
+    finally:
+        log = q.stop()
+    parts = split_log(log)
+    if len(parts) != plans_done:
+        parts = []
+
+    print(f"Firmware `{hello['board']}` {hello['firmware_version']}: one map buffer of "
+          f"{cap['cells']:,} cells ({cap['cells'] // 8:,} B, at most {cap['max_width']} x "
+          f"{cap['max_height']}); default parameters; seeds 1..={len(seeds)}; "
+          f"`qemu-system-arm -icount shift=0`.\n")
+    print("| size | map | longest scenario (opt8) | map in RAM | raw upload on the wire, at 115200 "
+          "| iterations | instructions, mean (min-max) | `Run::new` / iterations / `finish` "
+          "| raw/opt8 |")
+    print("| --- | --- | --- | ---: | --- | --- | --- | --- | --- |")
+    for r in rows:
+        head = (f"| {r['size']} | `{r['map']}` | {r['start']} -> {r['goal']} ({r['opt']:.2f}) | "
+                f"{r['bytes']:,} B | {r['wire']:,} B, {r['wire'] / BAUD_BYTES:.1f} s | ")
+        if "refused" in r:
+            e = r["refused"]
+            print(head + f"refused: `{e.get('name')}` (detail {e.get('detail'):,}, limit "
+                  f"{e.get('limit'):,}) | | | |")
+            continue
+        if "failed" in r:
+            e = r["failed"]
+            print(head + f"every plan: `{e.get('name')}` (detail {e.get('detail'):,}, limit "
+                  f"{e.get('limit'):,}) | | | |")
+            continue
+        runs = r["runs"]
+        ticks = [p["ticks"] for p in runs]
+        its = [p["iterations"] for p in runs]
+        ratio = statistics.mean(raw_length(r["start"], p["directions"]) / r["opt"] for p in runs)
+        split = ""
+        if parts:
+            mine = parts[r["first_plan"]:r["first_plan"] + len(runs)]
+            split = " / ".join(f"{mi(statistics.mean(p[i] for p in mine)):.1f}" for i in range(3))
+            split += " M"
+        print(head + f"{min(its)}-{max(its)} (mean {statistics.mean(its):.1f}) | "
+              f"**{mi(statistics.mean(ticks)):.2f} M** ({mi(min(ticks)):.2f}-"
+              f"{mi(max(ticks)):.2f}) | {split} | {ratio:.4f} |")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
