@@ -72,7 +72,7 @@ pub fn three(bits: &[u32], i: usize) -> u32 {
 }
 
 /// The set's members among the eight neighbours of cell `i` of a map `width` cells wide, as a
-/// direction mask (bit `d`: the neighbour in direction `d` of [`crate::grid`]). `i` must not lie
+/// direction mask (bit `d`: the neighbour in direction `d` of [`crate::dir`]). `i` must not lie
 /// on the map's border (its neighbours' indices are taken as `i +- 1`, `i +- width`).
 #[inline]
 pub fn around(bits: &[u32], i: usize, width: usize) -> u8 {
@@ -88,7 +88,7 @@ pub fn around(bits: &[u32], i: usize, width: usize) -> u8 {
 /// a direction mask (bit `d` = the neighbour in direction `d`; the centre is left out).
 #[allow(clippy::indexing_slicing, clippy::arithmetic_side_effects)]
 static RING9: [u8; 512] = {
-    use crate::grid::{DX, DY};
+    use crate::dir::{DX, DY};
     let mut t = [0u8; 512];
     let mut nb = 0usize;
     while nb < 512 {
@@ -150,7 +150,7 @@ mod tests {
 
     #[test]
     fn around_reads_the_eight_neighbours() {
-        use crate::grid::{DX, DY};
+        use crate::dir::{DX, DY};
         let (w, h) = (37usize, 5usize);
         let mut x = 12345u32;
         let mut b = vec![0u32; words(w * h)];

@@ -5,7 +5,7 @@
 //! This is also the layout the wire protocol sends. `x` grows to the right, `y` grows downwards
 //! (as in Moving AI maps: `(0, 0)` is the first character of the first row).
 //!
-//! Moves: the 8 neighbours. A diagonal move is allowed only when both orthogonally adjacent cells
+//! Moves: the 8 neighbours ([`crate::dir`]). A diagonal move is allowed only when both orthogonally adjacent cells
 //! are free, so a path never squeezes between two obstacles that touch at a corner.
 //!
 //! The grid borrows its bits, so it costs nothing to build over a `static` buffer on the device or
@@ -38,26 +38,7 @@ impl Point {
     }
 }
 
-/// One of the eight moves, `0..8` clockwise from east (with `y` pointing down): E, SE, S, SW, W,
-/// NW, N, NE. Odd directions are diagonal.
-pub type Dir = u8;
-
-/// Column offset of each direction.
-pub const DX: [i32; 8] = [1, 1, 0, -1, -1, -1, 0, 1];
-/// Row offset of each direction.
-pub const DY: [i32; 8] = [0, 1, 1, 1, 0, -1, -1, -1];
-
-/// True for the four diagonal directions.
-#[inline]
-pub const fn is_diagonal(d: Dir) -> bool {
-    d & 1 == 1
-}
-
-/// The direction that undoes `d`.
-#[inline]
-pub const fn opposite(d: Dir) -> Dir {
-    d.wrapping_add(4) & 7
-}
+pub use crate::dir::{is_diagonal, opposite, Dir, DX, DY};
 
 /// A borrowed occupancy grid. See the module docs for the bit layout.
 #[derive(Clone, Copy, Debug)]

@@ -11,7 +11,8 @@
 //!
 //! | module | owns |
 //! | --- | --- |
-//! | [`grid`] | the occupancy map, cells, the 8 moves and the no-corner-cutting rule, reachability |
+//! | [`dir`] | the eight moves: direction codes and their offsets |
+//! | [`grid`] | the occupancy map, cells, the no-corner-cutting rule, reachability |
 //! | [`bitmap`] | sets of cells at one bit per cell (tabu lists, pruned cells) |
 //! | [`prune`] | dead-end pruning: the cells no shortest path needs |
 //! | [`route`] | the coarse route whose sub-goals the potential field pulls towards on large maps |
@@ -97,6 +98,7 @@ mod named;
 
 pub mod ant;
 pub mod bitmap;
+pub mod dir;
 pub mod error;
 pub mod geometry;
 pub mod grid;

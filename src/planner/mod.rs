@@ -18,7 +18,7 @@
 //! | --- | --- |
 //! | `params` | [`Algorithm`], [`Params`] and their ranges |
 //! | `workspace` | [`Workspace`], [`Buffers`], [`Storage`]: every buffer, one layout |
-//! | `run` | [`Run`]: the loop as a state machine (walk, update, record) |
+//! | `run` | [`Run`]: the loop as a state machine (setup, walk + update + record, polish) |
 //! | `plan` | [`Plan`], [`RawPath`], [`CurvePoint`]: the result |
 //! | `warm` | [`Memory`], [`Area`]: warm starts after map changes, and the pheromone repair |
 //!

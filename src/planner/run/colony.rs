@@ -1,0 +1,215 @@
+//! One iteration of the colony: every ant walks on the same pheromone and deposits into the
+//! increment table, the wolves rule rewards the iteration's best path and punishes its worst, the
+//! pheromone evaporates and takes the increments, and the run records its best path, the
+//! convergence curve and whether to stop early.
+
+use crate::ant::{Ant, Lost, Walk};
+use crate::geometry::steps_length;
+use crate::grid::{Dir, Moves};
+use crate::pheromone::Table;
+use crate::route::Route;
+use crate::tighten::tighten;
+use crate::update::{deposit, wolves};
+
+use crate::planner::plan::CurvePoint;
+use crate::planner::workspace::Workspace;
+
+use super::Run;
+
+/// The best path of an iteration or of the run, as step counts (exact length comparison).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) struct Best {
+    pub(super) steps: usize,
+    pub(super) straight: u32,
+    pub(super) diagonal: u32,
+}
+
+impl Best {
+    pub(super) fn of(w: &Walk) -> Self {
+        Best {
+            steps: w.steps,
+            straight: w.straight,
+            diagonal: w.diagonal,
+        }
+    }
+    pub(super) fn length(&self) -> f32 {
+        steps_length(self.straight, self.diagonal)
+    }
+    pub(super) fn same_length(&self, o: &Best) -> bool {
+        self.straight == o.straight && self.diagonal == o.diagonal
+    }
+}
+
+/// What the ants of one iteration found: the shortest and the longest path (with how many ants
+/// took a path of that length) and the sum of the lengths, for the update and the record.
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct Iteration {
+    best: Option<(Best, u32)>,
+    worst: Option<(Best, u32)>,
+    sum: f32,
+    arrived: u32,
+}
+
+impl Run<'_, '_> {
+    /// Every ant walks start -> goal on `tau(t)` and deposits `Q / L` into the increment table;
+    /// the iteration's best and worst paths are kept for the wolves rule.
+    pub(super) fn walk_ants(&mut self, mut on_tour: impl FnMut(&[Dir])) -> Iteration {
+        let p = self.params;
+        let Workspace {
+            tau,
+            delta,
+            tabu,
+            dead,
+            moves,
+            tour,
+            iter_best,
+            iter_worst,
+            points,
+            links,
+            guide,
+            ..
+        } = &mut self.ws;
+        let moves = Moves::new(*self.grid, moves);
+        let route = Route::new(
+            self.guide_blocks,
+            guide,
+            self.goal,
+            self.grid.width(),
+            self.grid.height(),
+        );
+        let tau = Table::new(self.blocks, tau);
+        let mut delta = Table::new(self.blocks, delta);
+        let ant = Ant {
+            moves: &moves,
+            start: self.start,
+            goal: self.goal,
+            tau: &tau,
+            heuristic: &self.heuristic,
+            alpha: p.alpha,
+            dead_end: p.dead_end,
+            dead,
+            route: self.routed.then_some(&route),
+        };
+        let mut it = Iteration::default();
+        for _ in 0..p.ants {
+            let walk = match ant.walk(&mut self.rng, tabu, tour) {
+                Ok(w) => w,
+                Err(Lost::Exhausted) => {
+                    // Only possible when the flood fill could not decide: now it is decided.
+                    self.no_path = true;
+                    break;
+                }
+                Err(Lost::Died) => continue,
+                Err(Lost::Overflow) => {
+                    self.dropped = self.dropped.saturating_add(1);
+                    continue;
+                }
+            };
+            self.moves = self.moves.saturating_add(u64::from(walk.moves));
+            let walk = if p.tighten && walk.may_tighten {
+                tighten(&moves, self.start, walk, tour, points, links, tabu)
+            } else {
+                walk
+            };
+            let Some(path) = tour.get(..walk.steps) else {
+                continue;
+            };
+            on_tour(path);
+            let b = Best::of(&walk);
+            let len = b.length();
+            it.sum += len;
+            it.arrived = it.arrived.saturating_add(1);
+            deposit(&mut delta, self.grid, self.start, path, p.q / len);
+            match &mut it.best {
+                Some((cur, n)) if cur.same_length(&b) => *n = n.saturating_add(1),
+                Some((cur, _)) if len >= cur.length() => {}
+                _ => {
+                    copy_tour(iter_best, path);
+                    it.best = Some((b, 1));
+                }
+            }
+            match &mut it.worst {
+                Some((cur, n)) if cur.same_length(&b) => *n = n.saturating_add(1),
+                Some((cur, _)) if len <= cur.length() => {}
+                _ => {
+                    copy_tour(iter_worst, path);
+                    it.worst = Some((b, 1));
+                }
+            }
+        }
+        it
+    }
+
+    /// The wolves rule (HACA, OHACA), then `tau = clamp((1 - rho) tau + delta)`.
+    pub(super) fn update(&mut self, it: &Iteration) {
+        let p = self.params;
+        let ws = &mut self.ws;
+        let mut tau = Table::new(self.blocks, ws.tau);
+        let mut delta = Table::new(self.blocks, ws.delta);
+        if let (true, Some((b, nb)), Some((w, nw))) = (p.algorithm.wolves(), it.best, it.worst) {
+            if let (Some(bt), Some(wt)) =
+                (ws.iter_best.get(..b.steps), ws.iter_worst.get(..w.steps))
+            {
+                wolves(
+                    &mut delta,
+                    self.grid,
+                    self.start,
+                    p.q,
+                    (bt, b.length(), nb),
+                    (wt, w.length(), nw),
+                );
+            }
+        }
+        tau.evaporate_and_merge(&mut delta, p.rho, p.tau_min, p.tau_max);
+    }
+
+    /// Track the run's best, append to the curve, decide whether to stop.
+    pub(super) fn record(&mut self, it: &Iteration) {
+        let improved = match (it.best, self.best) {
+            (Some((b, _)), None) => Some(b),
+            (Some((b, _)), Some(g)) if b.length() < g.length() => Some(b),
+            _ => None,
+        };
+        if let Some(b) = improved {
+            if let Some(src) = self.ws.iter_best.get(..b.steps) {
+                copy_tour(self.ws.best, src);
+            }
+            self.best = Some(b);
+            self.best_iteration = self.iteration;
+            self.stale = 0;
+        } else {
+            self.stale = self.stale.saturating_add(1);
+        }
+        let inf = f32::INFINITY;
+        let point = CurvePoint {
+            best: it.best.map_or(inf, |(b, _)| b.length()),
+            mean: if it.arrived > 0 {
+                it.sum / it.arrived as f32
+            } else {
+                inf
+            },
+            best_so_far: self.best.map_or(inf, |b| b.length()),
+            arrived: u16::try_from(it.arrived).unwrap_or(u16::MAX),
+        };
+        if let Some(slot) = self.ws.curve.get_mut(usize::from(self.iteration)) {
+            *slot = point;
+        }
+        self.iteration = self.iteration.saturating_add(1);
+        let p = &self.params;
+        let patience = if self.warm && p.warm_patience > 0 {
+            p.warm_patience
+        } else if self.refines && p.refine_patience > 0 {
+            p.refine_patience
+        } else {
+            p.patience
+        };
+        let early = patience > 0 && self.best.is_some() && self.stale >= patience;
+        self.done = self.no_path || self.iteration >= p.iterations || early;
+    }
+}
+
+fn copy_tour(dst: &mut [Dir], src: &[Dir]) {
+    if let Some(d) = dst.get_mut(..src.len()) {
+        d.copy_from_slice(src);
+    }
+}

@@ -1,0 +1,130 @@
+//! The work after the last iteration, a piece at a time: the best tour laid out as cells, the
+//! local search on large maps ([`Params::refine`]) a budget of expanded cells at a time, then the
+//! smoothing a stretch of raw cells at a time. The firmware yields between pieces.
+
+use crate::grid::{direction, is_diagonal};
+use crate::refine::{self, Budget, Refiner, Scratch};
+use crate::route::GUIDE_BLOCKS;
+use crate::smoothing::{Smoother, SmoothingKind};
+
+use crate::planner::params::Algorithm;
+#[cfg(doc)]
+use crate::planner::params::Params;
+use crate::planner::plan::RawPath;
+
+use super::colony::Best;
+use super::Run;
+
+/// Window side of the local search ([`Params::refine`]). Its scratch is the links and the coarse
+/// route's words, free after the last iteration: two slices of [`Scratch::words`]`(52)` = 4,056
+/// words each, which the device's and the host's storage both lend (at least [`GUIDE_BLOCKS`]
+/// words each on maps with a route). Measured on the 20 longest scenarios of the 20 large Moving
+/// AI maps (`refine_large` example): mean raw/opt8 1.0009 at 52, 1.0011 at 48, 1.0007 at 64.
+pub const REFINE_SIDE: usize = 52;
+pub(super) const REFINE_WORDS: usize = Scratch::words(REFINE_SIDE);
+const _: () = assert!(REFINE_WORDS <= GUIDE_BLOCKS);
+/// Cells the local search expands between two yields of [`Run::polish_step`] (a window expands
+/// at most `REFINE_SIDE^2` = 2,704).
+const REFINE_SLICE: u64 = 8192;
+/// Raw cells of the smoothing DP between two yields of [`Run::polish_step`] (each tests at most
+/// [`crate::smoothing::LOOKBACK`] segments).
+const SMOOTH_SLICE: usize = 48;
+
+/// The work after the last iteration, in order ([`Run::polish_step`]).
+#[derive(Clone, Copy, Debug)]
+pub(super) enum Polish {
+    /// Not started: the best path is only the best tour's directions.
+    Start,
+    /// The local search on the raw path in `points`, a budget at a time.
+    Refine(Refiner),
+    /// The smoothing of the raw path in `points`, a stretch at a time.
+    Smooth(Smoother),
+    /// Done: `points[..waypoints]` are the waypoints.
+    Done { waypoints: usize },
+}
+
+impl Run<'_, '_> {
+    /// Do the next piece of the work after the last iteration, if any is left: lay the best path
+    /// out as cells, the local search ([`Params::refine`], large maps) on at most 8,192 expanded
+    /// cells, the smoothing DP on at most 48 raw cells. Returns `true` while work remains; does
+    /// nothing before the run is done ([`Run::is_done`]) or when it found no path. On a
+    /// 256 x 256 map each piece costs a fraction of an iteration, so the firmware yields between
+    /// them; [`Run::finish`] does whatever is left itself.
+    pub fn polish_step(&mut self) -> bool {
+        let Some(best) = self.best else {
+            return false;
+        };
+        if !self.done || self.no_path {
+            return false;
+        }
+        let grid = self.grid;
+        let ws = &mut self.ws;
+        let kind = if self.params.algorithm == Algorithm::Ohaca {
+            self.params.smoothing
+        } else {
+            SmoothingKind::None
+        };
+        let dist = ws.delta.as_flattened_mut();
+        self.polish = match self.polish {
+            Polish::Start => {
+                // Expand the tour into cells.
+                let n = best.steps.saturating_add(1);
+                let tour = ws.best.get(..best.steps).unwrap_or_default();
+                for (slot, p) in ws.points.iter_mut().zip(RawPath::new(self.start, tour)) {
+                    *slot = p;
+                }
+                let refiner = self
+                    .refines
+                    .then(|| Refiner::in_place(grid, ws.points, n, refine::DEFAULT_PASSES).ok())
+                    .flatten();
+                match refiner {
+                    Some(r) => Polish::Refine(r),
+                    None => Polish::Smooth(Smoother::new(kind, n, dist, ws.links)),
+                }
+            }
+            Polish::Refine(mut r) => {
+                let a = ws.links.get_mut(..REFINE_WORDS).unwrap_or_default();
+                let b = ws.guide.get_mut(..REFINE_WORDS).unwrap_or_default();
+                let mut budget = Budget::new(REFINE_SLICE);
+                if r.resume(grid, ws.points, &mut Scratch::new(a, b), &mut budget) {
+                    let n = r.finish(ws.points);
+                    // The refined path becomes the run's raw path: its directions replace the
+                    // best tour (never longer, at most as many cells as `points` holds).
+                    let raw = ws.points.get(..n).unwrap_or_default();
+                    let (mut straight, mut diagonal) = (0u32, 0u32);
+                    for (slot, pair) in ws.best.iter_mut().zip(raw.windows(2)) {
+                        if let (Some(&p), Some(&q)) = (pair.first(), pair.get(1)) {
+                            let d = direction(p, q).unwrap_or(0);
+                            *slot = d;
+                            if is_diagonal(d) {
+                                diagonal = diagonal.saturating_add(1);
+                            } else {
+                                straight = straight.saturating_add(1);
+                            }
+                        }
+                    }
+                    self.colony = Some(best);
+                    self.best = Some(Best {
+                        steps: n.saturating_sub(1).min(ws.best.len()),
+                        straight,
+                        diagonal,
+                    });
+                    Polish::Smooth(Smoother::new(kind, n, dist, ws.links))
+                } else {
+                    Polish::Refine(r)
+                }
+            }
+            Polish::Smooth(mut sm) => {
+                if sm.resume(grid, ws.points, dist, ws.links, SMOOTH_SLICE) {
+                    Polish::Smooth(sm)
+                } else {
+                    Polish::Done {
+                        waypoints: sm.finish(grid, ws.points, dist, ws.links),
+                    }
+                }
+            }
+            done @ Polish::Done { .. } => done,
+        };
+        !matches!(self.polish, Polish::Done { .. })
+    }
+}

@@ -1,0 +1,71 @@
+//! The setup of a run before its first iteration, one piece at a time: the flood fill (is the
+//! goal reachable at all?), dead-end pruning, the coarse route of a large map. Each piece reads
+//! the whole map once, so the firmware yields between them.
+
+use crate::ant::DeadEnd;
+use crate::grid::{Moves, Reach};
+use crate::prune::prune;
+use crate::route;
+
+use super::{Run, Setup};
+
+impl Run<'_, '_> {
+    /// Do the next piece of the setup, if any is left: the flood fill (a goal found unreachable
+    /// ends the run: [`Run::finish`] gives [`crate::Error::NoPath`]), the dead-end pruning, the coarse
+    /// route. Returns `true` while setup remains. Each piece reads the whole map once (on a
+    /// 256 x 256 map about as long as an iteration), so the firmware yields between them;
+    /// [`Run::step`] does whatever setup is left itself, so other callers never need this.
+    pub fn setup_step(&mut self) -> bool {
+        let grid = self.grid;
+        let p = &self.params;
+        let ws = &mut self.ws;
+        match self.setup {
+            Setup::Reach => {
+                // A warm start with backtracking ants skips the flood fill: if a change cut the
+                // goal off, the first ant backs out of every branch and proves it
+                // (`Lost::Exhausted`, the run ends with `NoPath`) for about what the flood fill
+                // would have cost; otherwise the fill is pure overhead on a replan (4.6 M of 75 M
+                // instructions on Boston 256).
+                let proved_by_ants = self.warm && p.dead_end == DeadEnd::Backtrack;
+                if !proved_by_ants
+                    && grid.reachable(self.start, self.goal, ws.tabu, ws.links) == Reach::No
+                {
+                    self.no_path = true;
+                    self.done = true;
+                    self.setup = Setup::Done;
+                    return false;
+                }
+                self.setup = Setup::Prune;
+            }
+            Setup::Prune => {
+                self.pruned = if p.prune {
+                    let moves = Moves::new(*grid, ws.moves);
+                    prune(&moves, self.start, self.goal, ws.dead, ws.links)
+                } else {
+                    crate::bitmap::clear(ws.dead, grid.cells());
+                    0
+                };
+                self.setup = Setup::Route;
+            }
+            Setup::Route => {
+                // Large maps: the potential field pulls along a coarse route (not for ACA, which
+                // has no attraction).
+                self.routed = self.blocks.shift() > 0 && p.algorithm.attracts() && {
+                    let moves = Moves::new(*grid, ws.moves);
+                    route::build(
+                        &moves,
+                        self.guide_blocks,
+                        self.goal,
+                        ws.dead,
+                        ws.guide,
+                        ws.links,
+                    )
+                };
+                crate::fmt::debug!("plan: {} cells pruned", self.pruned);
+                self.setup = Setup::Done;
+            }
+            Setup::Done => {}
+        }
+        self.setup != Setup::Done
+    }
+}
