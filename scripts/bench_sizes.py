@@ -108,8 +108,8 @@ def main():
         parts = []
 
     print(f"Firmware `{hello['board']}` {hello['firmware_version']}: one map buffer of "
-          f"{cap['cells']:,} cells ({cap['cells'] // 8:,} B, at most {cap['max_width']} x "
-          f"{cap['max_height']}); default parameters; seeds 1..={len(seeds)}; "
+          f"{cap['cells']:,} cells ({cap['cells'] // 8:,} B, sides up to {cap['max_side']}, "
+          f"paths up to {cap['max_steps']} steps); default parameters; seeds 1..={len(seeds)}; "
           f"`qemu-system-arm -icount shift=0`.\n")
     print("| size | map | longest scenario (opt8) | map in RAM | raw upload on the wire, at 115200 "
           "| iterations | instructions, mean (min-max) | `Run::new` / iterations / `finish` "

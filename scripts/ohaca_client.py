@@ -136,7 +136,7 @@ def unframe(wire):
 
 # ---- messages --------------------------------------------------------------------------------
 
-PROTOCOL_VERSION = 5
+PROTOCOL_VERSION = 6
 ALGORITHMS = ["aca", "paca", "haca", "ohaca"]
 DEAD_ENDS = ["backtrack", "die"]
 SMOOTHING = ["none", "greedy", "shortest"]
@@ -219,7 +219,7 @@ def dec_reply(body):
         out = {"kind": "Hello", "protocol_version": r.varint(), "firmware_version": r.str(),
                "board": r.str()}
         out["capacity"] = {k: r.varint() for k in
-                           ["cells", "max_width", "max_height", "max_chunk", "max_request",
+                           ["cells", "max_side", "max_steps", "max_chunk", "max_request",
                             "plan_queue", "tick_hz"]}
         out["defaults"] = dec_params(r)
     elif tag == 1:
@@ -378,10 +378,21 @@ def selftest(dev, map_path):
         expect(dev.call(req_plan((0, 0), (1, 1))), "Error", "NoMap")
 
     # Map uploads: too large, out-of-sequence chunk, then the real one in small chunks.
-    wide = hello["capacity"]["max_width"] + 1
+    # Checks in order: chunk size, then the header (zero side, too large, total_len), then the
+    # upload's continuity.
+    cap = hello["capacity"]
+    wide = cap["max_side"] + 1
     r = expect(dev.call(req_set_map(wide, 2, 0, (wide * 2 + 7) // 8, b"\x00" * 16)), "Error",
                "MapTooLarge")
-    assert (r["detail"], r["limit"]) == (wide, wide - 1), r
+    assert (r["detail"], r["limit"]) == (wide, cap["max_side"]), r
+    long_side = cap["max_side"]
+    rows_over = cap["cells"] // long_side + 1   # within the side, over the cells
+    r = expect(dev.call(req_set_map(long_side, rows_over, 0, 1, b"\x00")), "Error", "MapTooLarge")
+    assert (r["detail"], r["limit"]) == (long_side * rows_over, cap["cells"]), r
+    r = expect(dev.call(req_set_map(0, 3, 0, 7, b"\x00")), "Error", "BadMap")
+    assert (r["detail"], r["limit"]) == (7, 0), r
+    r = expect(dev.call(req_set_map(w, h, 0, len(bits), b"")), "Error", "TooLarge")
+    assert (r["detail"], r["limit"]) == (0, cap["max_chunk"]), r
     expect(dev.call(req_set_map(w, h, 5, len(bits), b"\x00")), "Error", "BadChunk")
     r = expect(dev.call(req_set_map(w, h, 0, 200, b"\x00" * 200)), "Error", "TooLarge")
     assert (r["detail"], r["limit"]) == (200, hello["capacity"]["max_chunk"]), r
@@ -520,7 +531,7 @@ def stack_probe(dev, map_path):
         maps.append((name, *rows_to_bits(rows), start, goal))
     for name, w, h, bits, start, goal in maps:
         cap = hello["capacity"]
-        if w * h > cap["cells"] or w > cap["max_width"] or h > cap["max_height"]:
+        if w * h > cap["cells"] or max(w, h) > cap["max_side"]:
             continue
         expect(dev.set_map(w, h, bits), "Ack")
         for label, params in stack_cases(defaults):

@@ -148,7 +148,10 @@ fn floor_rem(n: i64, d: i64) -> (i64, i64) {
     (f, n.wrapping_sub(f.wrapping_mul(d)))
 }
 
-/// Total Euclidean length of a polyline through cell centres.
+/// Total Euclidean length of a polyline through cell centres. A single point (a plan from a cell
+/// to itself) or none has length `+0.0` (`Iterator::sum` of no `f32` is `-0.0`, which a peer
+/// would print as "-0"), and the sum runs left to right as before, so every other length is
+/// unchanged bit for bit.
 pub fn polyline_length(points: &[Point]) -> f32 {
     points
         .windows(2)
@@ -156,7 +159,7 @@ pub fn polyline_length(points: &[Point]) -> f32 {
             [a, b] => distance(*a, *b),
             _ => 0.0,
         })
-        .sum()
+        .fold(0.0, |acc, d| acc + d)
 }
 
 /// The bend at `b` of the polyline `a, b, c`: the cross and dot products of `b - a` and `c - b`.
@@ -195,6 +198,15 @@ pub fn turns(points: &[Point]) -> u32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_single_point_has_length_plus_zero() {
+        let p = Point::new(3, 4);
+        assert_eq!(polyline_length(&[p]).to_bits(), 0.0f32.to_bits());
+        assert_eq!(polyline_length(&[]).to_bits(), 0.0f32.to_bits());
+        let three = [Point::new(0, 0), Point::new(3, 4), Point::new(3, 5)];
+        assert_eq!(polyline_length(&three), 6.0);
+    }
 
     fn grid(rows: &[&str]) -> (Vec<u8>, u16, u16) {
         crate::testutil::bits(rows)

@@ -192,8 +192,8 @@ fn wire_frame_seeds(root: &Path) -> Result<Vec<(String, Vec<u8>)>> {
         board: "qemu-mps2-an386",
         capacity: Capacity {
             cells: 4096,
-            max_width: 4096,
-            max_height: 4096,
+            max_side: 4096,
+            max_steps: 1023,
             max_chunk: MAX_CHUNK as u16,
             max_request: MAX_REQUEST as u16,
             plan_queue: 4,

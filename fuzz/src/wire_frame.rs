@@ -29,9 +29,10 @@ use ohaca::protocol::{
 };
 use std::cell::RefCell;
 
+// Any shape of up to 512 x 512 cells with sides up to 4096 (the firmware's rule, other numbers).
 const LIMITS: MapLimits = MapLimits {
-    max_width: 512,
-    max_height: 512,
+    max_cells: 512 * 512,
+    max_side: 4096,
 };
 
 /// The device's map state for one fuzz input: the upload, the buffer, the map's size.

@@ -1109,8 +1109,8 @@ mod tests {
             board: "fake".into(),
             capacity: Capacity {
                 cells: 1024,
-                max_width: 1024,
-                max_height: 1024,
+                max_side: 1024,
+                max_steps: 1023,
                 max_chunk: 100,
                 max_request: 256,
                 plan_queue: queue,
@@ -1177,7 +1177,7 @@ mod tests {
         assert_eq!(e.code(), Some(ErrorCode::MapTooLarge));
         assert_eq!(
             e.to_string(),
-            "device refused SetMapRle: map too large (1600 cells, capacity 1024) (error code 2)"
+            "device refused SetMapRle: map too large (1600 over the limit 1024) (error code 2)"
         );
     }
 
@@ -1227,8 +1227,8 @@ mod tests {
         use std::cell::RefCell;
         use std::rc::Rc;
         let limits = MapLimits {
-            max_width: 512,
-            max_height: 512,
+            max_cells: 512 * 512,
+            max_side: 512,
         };
         let state = Rc::new(RefCell::new((
             Upload::new(),

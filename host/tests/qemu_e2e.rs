@@ -503,24 +503,43 @@ fn refusals_no_map_map_too_large_busy_and_cancel() {
     let e = error_code(link.plan(Point::new(0, 0), Point::new(1, 1), None));
     assert_eq!(e.code, ErrorCode::NoMap, "{e}");
 
-    // A map one column wider than the device holds.
-    let wide = Map::from_fn(info.capacity.max_width + 1, 2, |_, _| false);
+    // A map one cell longer than the longest side the device takes.
+    let m = info.capacity.max_side;
+    let wide = Map::from_fn(m + 1, 2, |_, _| false);
     let e = error_code(link.set_map(&wide));
-    let w = info.capacity.max_width;
     assert_eq!(
         e,
-        ErrorReply::with(ErrorCode::MapTooLarge, u32::from(w) + 1, u32::from(w))
+        ErrorReply::with(ErrorCode::MapTooLarge, u32::from(m) + 1, u32::from(m))
     );
-    // A map the device holds but plans on only if it has as many cells: a square one cell
-    // larger than `cells` is refused when planned on (and no map is left for the next check).
-    let side = (1..).find(|s: &u32| s * s > cells).expect("a side") as u16;
-    if side <= w {
-        let big = Map::from_fn(side, side, |_, _| false);
-        link.set_map(&big).expect("held");
-        let e = error_code(link.plan(Point::new(0, 0), Point::new(1, 1), None));
-        let n = u32::from(side) * u32::from(side);
-        assert_eq!(e, ErrorReply::with(ErrorCode::MapTooLarge, n, cells));
+    // Within the side but one row more cells than the device holds: refused by cells.
+    let rows = u16::try_from(cells / u32::from(m) + 1).expect("rows");
+    let e = error_code(link.set_map(&Map::from_fn(m, rows, |_, _| false)));
+    let n = u32::from(m) * u32::from(rows);
+    assert_eq!(e, ErrorReply::with(ErrorCode::MapTooLarge, n, cells));
+    // The checks' order: an empty chunk is `TooLarge` 0 before its bad header is looked at; a
+    // zero side is `BadMap` with the total_len sent and 0; neither opens an upload.
+    for (w, h, total) in [(0u16, 3u16, 7u32), (4, 3, 2)] {
+        let r = link.call(&Request::SetMap {
+            width: w,
+            height: h,
+            offset: 0,
+            total_len: total,
+            chunk: &[],
+        });
+        let want = Response::Error(ErrorReply::with(ErrorCode::TooLarge, 0, MAX_CHUNK as u32));
+        assert_eq!(r.expect("reply"), want);
     }
+    let r = link.call(&Request::SetMap {
+        width: 0,
+        height: 3,
+        offset: 0,
+        total_len: 7,
+        chunk: &[0],
+    });
+    assert_eq!(
+        r.expect("reply"),
+        Response::Error(ErrorReply::with(ErrorCode::BadMap, 7, 0))
+    );
     // An upload left unfinished: the device has no map from its first chunk on.
     let first = link.call(&Request::SetMap {
         width: 100,
@@ -1262,11 +1281,15 @@ fn set_map_chunks_are_refused_as_the_document_says() {
         Response::Error(ErrorReply::with(code, detail as u32, limit as u32))
     };
     let call = |link: &mut Link<_>, r: &Request<'_>| link.call(r).expect("reply");
-    // An empty chunk with no upload open: BadChunk, detail = 0 received, limit = total_len (the
-    // empty chunk at offset 0 opened a fresh upload first).
+    // An empty chunk: `TooLarge` 0 (chunks have 1 to MAX_CHUNK bytes), checked before anything
+    // else, and it opens no upload: the next chunk past offset 0 finds none.
     assert_eq!(
         call(&mut link, &chunk(w, h, 0, total, &[])),
-        err(ErrorCode::BadChunk, 0, total)
+        err(ErrorCode::TooLarge, 0, MAX_CHUNK)
+    );
+    assert_eq!(
+        call(&mut link, &chunk(w, h, 1, total, &map.bits[1..2])),
+        err(ErrorCode::BadChunk, 0, 0)
     );
     // The first half.
     let half = total / 2;
@@ -1282,8 +1305,14 @@ fn set_map_chunks_are_refused_as_the_document_says() {
     );
     assert_eq!(
         call(&mut link, &chunk(w, h, half, total, &[])),
-        err(ErrorCode::BadChunk, half, total),
+        err(ErrorCode::TooLarge, 0, MAX_CHUNK),
         "an empty chunk inside an upload"
+    );
+    // A new upload's refused first chunk (past its own total_len) leaves this one open.
+    assert_eq!(
+        call(&mut link, &chunk(2, 2, 0, 1, &[0, 0])),
+        err(ErrorCode::BadChunk, 0, 1),
+        "a first chunk past its total_len"
     );
     assert_eq!(
         call(&mut link, &chunk(w + 1, h, half, total, &map.bits[half..])),
@@ -1324,9 +1353,9 @@ fn set_map_chunks_are_refused_as_the_document_says() {
     });
     let host = plan_map(&map, s, g, &Params::default()).expect("host plan");
     assert_same("after the refused chunks", &host, s, &dev);
-    // A completed map leaves no upload open: an empty chunk after offset 0 finds none.
+    // A completed map leaves no upload open: a re-sent last chunk finds none.
     assert_eq!(
-        call(&mut link, &chunk(w, h, half, total, &[])),
+        call(&mut link, &chunk(w, h, half, total, &map.bits[half..])),
         err(ErrorCode::BadChunk, 0, 0)
     );
     assert_eq!(link.stray_count(), 0, "{:?}", link.take_strays());
@@ -1395,6 +1424,35 @@ fn a_256x256_map_goes_up_run_length_coded() {
     assert_eq!(e, ErrorReply::with(ErrorCode::BadRle, 0, 256));
     let st = link.stats().expect("stats");
     assert_eq!((st.map_width, st.map_height), (0, 0), "{st:?}");
+    assert_eq!(link.stray_count(), 0, "{:?}", link.take_strays());
+}
+
+/// Capacity is by cells, not by side: a 1024 x 64 corridor of offices (as many cells as
+/// 256 x 256, four times wider) goes up whole and is planned at full resolution, bit for bit as
+/// the host core plans it.
+#[test]
+fn a_map_wider_than_256_cells_is_one_map() {
+    need_qemu!();
+    let q = Qemu::tcp();
+    let mut link = q.link();
+    let info = link.hello().expect("hello");
+    let (w, h) = (1024u16, 64u16);
+    assert!(u32::from(w) * u32::from(h) <= info.capacity.cells);
+    assert!(w <= info.capacity.max_side);
+    // Rooms 32 cells wide along a corridor (rows 28..36), each with a door onto it.
+    let map = Map::from_fn(w, h, |x, y| {
+        let wall = x % 32 == 0 && !(28..36).contains(&y);
+        let side = (y == 27 || y == 36) && x % 32 != 16;
+        wall || side
+    });
+    link.set_map(&map).expect("upload");
+    let st = link.stats().expect("stats");
+    assert_eq!((st.map_width, st.map_height), (w, h), "{st:?}");
+    // From a room at the left to a room 600 cells to the right, through two doors.
+    let (s, g) = (Point::new(5, 5), Point::new(605, 60));
+    let dev = link.plan(s, g, None).expect("device plan");
+    let host = core_plan(&map, s, g, &Params::default()).expect("host plan");
+    assert_core_path("1024x64", &host, &dev);
     assert_eq!(link.stray_count(), 0, "{:?}", link.take_strays());
 }
 

@@ -228,8 +228,8 @@ struct Upload {
 
 /// The device's receive task (`src/firmware/rx.rs`, `Session`) and counters, on the host.
 struct Session {
-    max_width: u16,
-    max_height: u16,
+    max_cells: u32,
+    max_side: u16,
     frames_ok: u32,
     frames_bad: u32,
     params: Params,
@@ -302,37 +302,43 @@ impl Session {
         total_len: u32,
         chunk: &[u8],
     ) -> Want {
-        if chunk.len() > MAX_CHUNK {
+        if chunk.is_empty() || chunk.len() > MAX_CHUNK {
             return error(ErrorCode::TooLarge, chunk.len() as u32, MAX_CHUNK as u32);
         }
+        // A refused chunk changes nothing (`ohaca::protocol::Upload::accept`): a good offset-0
+        // chunk replaces the open upload, a bad header or a first chunk past its own total_len
+        // leaves it as it was.
+        let mut fresh = None;
         if offset == 0 {
-            // A bad header (`BadMap`, `MapTooLarge`) leaves an open upload as it was
-            // (`ohaca::protocol::Upload::accept`); a good one replaces it below.
             let cells = u32::from(width) * u32::from(height);
             if cells == 0 {
-                return error(ErrorCode::BadMap, 0, 0);
+                return error(ErrorCode::BadMap, total_len, 0);
             }
-            if width > self.max_width {
-                return error(ErrorCode::MapTooLarge, width.into(), self.max_width.into());
+            for side in [width, height] {
+                if side > self.max_side {
+                    return error(ErrorCode::MapTooLarge, side.into(), self.max_side.into());
+                }
             }
-            if height > self.max_height {
-                return error(
-                    ErrorCode::MapTooLarge,
-                    height.into(),
-                    self.max_height.into(),
-                );
+            if cells > self.max_cells {
+                return error(ErrorCode::MapTooLarge, cells, self.max_cells);
             }
             let want = cells.div_ceil(8);
             if total_len != want {
                 return error(ErrorCode::BadMap, total_len, want);
             }
-            self.upload = Some(Upload {
+            if chunk.len() as u32 > total_len {
+                return error(ErrorCode::BadChunk, 0, total_len);
+            }
+            fresh = Some(Upload {
                 width,
                 height,
                 total_len,
                 received: 0,
                 bits: vec![0; total_len as usize],
             });
+        }
+        if fresh.is_some() {
+            self.upload = fresh;
         }
         let Some(up) = self.upload.as_mut() else {
             return error(ErrorCode::BadChunk, 0, 0);
@@ -1134,8 +1140,8 @@ fn soak_thousands_of_valid_and_broken_frames() {
         model: Model {
             reader: Box::new(RequestReader::new()),
             session: Session {
-                max_width: cap.max_width,
-                max_height: cap.max_height,
+                max_cells: cap.cells,
+                max_side: cap.max_side,
                 frames_ok: 0,
                 frames_bad: 0,
                 params: info.defaults,

@@ -45,14 +45,14 @@ pub fn run(spawner: Spawner) {
     let (rx, tx) = board::Active::init();
     let boots = state::count_boot();
     defmt::info!(
-        "ohaca {} on {}: boot {}, maps up to {}x{} ({} bytes), plans on {} cells, storage {} bytes",
+        "ohaca {} on {}: boot {}, maps of up to {} cells ({} bytes, sides up to {}), paths of up to {} steps, storage {} bytes",
         env!("CARGO_PKG_VERSION"),
         board::Active::NAME,
         boots,
-        state::MAX_WIDTH,
-        state::MAX_HEIGHT,
-        state::MAP_BYTES,
         state::PLAN_CELLS,
+        state::MAP_BYTES,
+        state::MAX_SIDE,
+        state::PLAN_STEPS,
         PlanStorage::BYTES
     );
     defmt::info!(

@@ -18,8 +18,8 @@ use ohaca::protocol::{
 
 use super::board::{self, Board};
 use super::state::{
-    self, count, reply, Job, GENERATION, JOBS, LIMITS, MAP, MAX_CELLS, MAX_HEIGHT, MAX_WIDTH,
-    PLAN_CELLS, PLAN_QUEUE,
+    self, count, reply, Job, GENERATION, JOBS, LIMITS, MAP, MAX_CELLS, MAX_SIDE, PLAN_CELLS,
+    PLAN_QUEUE, PLAN_STEPS,
 };
 
 #[embassy_executor::task]
@@ -80,8 +80,8 @@ fn hello() -> HelloReply<'static> {
         board: board::Active::NAME,
         capacity: Capacity {
             cells: PLAN_CELLS.min(MAX_CELLS) as u32,
-            max_width: MAX_WIDTH,
-            max_height: MAX_HEIGHT,
+            max_side: MAX_SIDE,
+            max_steps: PLAN_STEPS as u32,
             max_chunk: MAX_CHUNK as u16,
             max_request: MAX_REQUEST as u16,
             plan_queue: PLAN_QUEUE as u8,

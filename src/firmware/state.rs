@@ -23,20 +23,19 @@ use ohaca::protocol::{MapLimits, Reply, StatsReply};
 use super::board::{self, Board};
 use super::stack;
 
-/// Widest map the device holds (the same on every board, so what QEMU proves holds on the chip).
-pub const MAX_WIDTH: u16 = 256;
-/// Tallest map the device holds.
-pub const MAX_HEIGHT: u16 = 256;
-/// Most cells of a map the device holds.
-pub const MAX_CELLS: usize = MAX_WIDTH as usize * MAX_HEIGHT as usize;
+/// Most cells of a map the device holds and plans on, whatever its shape (the same on every
+/// board, so what QEMU proves holds on the chip): 65,536 cells, 8 KiB at one bit a cell.
+pub const MAX_CELLS: usize = 65_536;
+/// Longest side of a map the device takes (a 4096 x 16 corridor has as many cells as 256 x 256).
+pub const MAX_SIDE: u16 = 4096;
 /// Bytes of the map buffer.
 pub const MAP_BYTES: usize = MAX_CELLS.div_ceil(8);
 /// Most cells of a map the planner plans on: every map the device holds, at full resolution.
 pub const PLAN_CELLS: usize = MAX_CELLS;
 /// Longest ant path the planner keeps, in steps (an ant whose path grows longer is dropped, and a
-/// plan no ant finishes that way is `Error PathTooLong`). A 256 x 256 map's straight-line paths
-/// are at most 510 steps, but a maze's can be far longer: the longest scenario of
-/// `maps/large/maze-128-128-2` has 1,379 steps (BENCHMARKS.md, section 4).
+/// plan no ant finishes that way is `Error PathTooLong`). A straight path across a 256 x 256 map
+/// has at most 255 steps, but a maze's or a long corridor's (4096 x 16) can be far longer: the
+/// longest scenario of `maps/large/maze-128-128-2` has 1,379 steps (BENCHMARKS.md, section 4).
 pub const PLAN_STEPS: usize = 1023;
 /// The planner's storage: two bits a map cell (tabu list, pruned cells), the pheromone budget,
 /// the coarse route, four ant paths of [`PLAN_STEPS`] steps, links, and the move table for maps of
@@ -45,8 +44,8 @@ pub type PlanStorage =
     ohaca::planner::Storage<{ ohaca::bitmap::words(PLAN_CELLS) }, { PLAN_STEPS + 1 }, 4096, 1024>;
 /// The map limits, for [`ohaca::protocol::Upload`].
 pub const LIMITS: MapLimits = MapLimits {
-    max_width: MAX_WIDTH,
-    max_height: MAX_HEIGHT,
+    max_cells: MAX_CELLS as u32,
+    max_side: MAX_SIDE,
 };
 /// Plan requests that can wait while one runs.
 pub const PLAN_QUEUE: usize = 4;

@@ -168,7 +168,9 @@ fn start_equals_goal() {
     )
     .unwrap();
     assert_eq!(plan.waypoints(), &[Point::new(3, 2)]);
-    assert_eq!(plan.raw_length, 0.0);
+    // +0, not -0 (which a peer prints as "-0"): both lengths, by their bits.
+    assert_eq!(plan.raw_length.to_bits(), 0.0f32.to_bits());
+    assert_eq!(plan.length.to_bits(), 0.0f32.to_bits());
 }
 
 #[test]

@@ -111,7 +111,9 @@ impl fmt::Display for ErrorReply {
         write!(f, "{}", self.code)?;
         match self.code {
             ErrorCode::MapTooLarge => {
-                write!(f, " ({} cells, capacity {})", self.detail, self.limit)
+                // An upload's side over `max_side` (side, max_side) or its cells over `cells`
+                // (cells, cells); a plan's map over the planner's capacity (cells, cells).
+                write!(f, " ({} over the limit {})", self.detail, self.limit)
             }
             ErrorCode::TooLarge => write!(f, " ({} bytes, limit {})", self.detail, self.limit),
             ErrorCode::BadChunk => write!(

@@ -252,21 +252,37 @@ pub struct MapChunk<'a> {
     pub chunk: &'a [u8],
 }
 
-/// The largest map a device holds.
+/// The largest map a device holds: by cells, not by side, so any shape fits that has at most
+/// `max_cells` cells and no side over `max_side` (a 604 x 307 depot is one map of 185,428 cells).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct MapLimits {
-    /// Most columns.
-    pub max_width: u16,
-    /// Most rows.
-    pub max_height: u16,
+    /// Most cells (`width * height`).
+    pub max_cells: u32,
+    /// Longest side, in cells (columns or rows).
+    pub max_side: u16,
 }
 
 impl MapLimits {
     /// Bytes of a buffer that holds the largest map.
     pub const fn bytes(&self) -> usize {
-        (self.max_width as usize)
-            .saturating_mul(self.max_height as usize)
-            .div_ceil(8)
+        (self.max_cells as usize).div_ceil(8)
+    }
+
+    /// `MapTooLarge` if a `width x height` map does not fit: a side over `max_side` (detail = that
+    /// side, width first; limit = `max_side`), else more than `max_cells` cells (detail = cells,
+    /// limit = `max_cells`).
+    pub fn check(&self, width: u16, height: u16) -> Result<(), ErrorReply> {
+        for side in [width, height] {
+            if side > self.max_side {
+                let (d, m) = (side.into(), self.max_side.into());
+                return Err(err(ErrorCode::MapTooLarge, d, m));
+            }
+        }
+        let cells = u32::from(width).saturating_mul(u32::from(height));
+        if cells > self.max_cells {
+            return Err(err(ErrorCode::MapTooLarge, cells, self.max_cells));
+        }
+        Ok(())
     }
 }
 
@@ -305,51 +321,54 @@ impl Upload {
 
     /// Check `c` without touching the map. `Ok(true)`: it starts a new upload (offset 0, a good
     /// header and a good chunk): the caller must stop using the active map before
-    /// [`Upload::write`] overwrites it. `Ok(false)`: it continues the open upload. Errors, in
-    /// this order: `TooLarge` (chunk over [`MAX_CHUNK`]: detail = its length, limit =
-    /// `MAX_CHUNK`); at offset 0 `BadMap` (a zero side: 0 / 0; raw `total_len` not
-    /// `ceil(cells / 8)`: total_len / expected; run-length `total_len` 0: 0 / 0) and
-    /// `MapTooLarge` (a side over the limits: detail = width, limit = max_width, else height /
-    /// max_height), which leave an open upload as it was; then `BadChunk` (no upload open; other
-    /// sides, total_len or encoding; `offset` past the bytes received, the chunk past
-    /// `total_len`, or an empty chunk: detail = bytes received, limit = total_len, 0 / 0 when
-    /// none is open). An offset-0 chunk with a good header opens its upload even when the chunk
-    /// itself is refused (nothing received yet: the map is untouched).
+    /// [`Upload::write`] overwrites it. `Ok(false)`: it continues the open upload.
+    ///
+    /// Errors, in this order (the first that applies is the answer):
+    /// 1. `TooLarge`: a chunk of 0 bytes or of more than [`MAX_CHUNK`] (detail = its length,
+    ///    limit = `MAX_CHUNK`);
+    /// 2. at offset 0, the header: `BadMap` for a zero side (detail = `total_len`, limit = 0: no
+    ///    map has 0 cells), `MapTooLarge` for a map over the limits ([`MapLimits::check`]),
+    ///    `BadMap` for a wrong `total_len` (raw: detail = `total_len`, limit = `ceil(cells / 8)`;
+    ///    run-length: `total_len` 0, detail 0, limit 1);
+    /// 3. `BadChunk`: no upload open (0 / 0), or a chunk that does not continue it: other sides,
+    ///    `total_len` or coding, `offset` past the bytes received, the chunk past `total_len`
+    ///    (detail = bytes received, limit = `total_len`; for a new upload's first chunk past its
+    ///    own `total_len`: 0 / `total_len`).
+    ///
+    /// **A refused chunk changes nothing**: an open upload stays open exactly as it was (a good
+    /// offset-0 chunk replaces it, a refused one does not), and the map is untouched.
     pub fn accept(&mut self, c: &MapChunk<'_>, limits: MapLimits) -> Result<bool, ErrorReply> {
         let len = u32::try_from(c.chunk.len()).unwrap_or(u32::MAX);
-        if c.chunk.len() > MAX_CHUNK {
+        if c.chunk.is_empty() || c.chunk.len() > MAX_CHUNK {
             return Err(err(ErrorCode::TooLarge, len, MAX_CHUNK as u32));
         }
         if c.offset == 0 {
             let cells = u32::from(c.width).saturating_mul(u32::from(c.height));
             if cells == 0 {
-                return Err(err(ErrorCode::BadMap, 0, 0));
+                return Err(err(ErrorCode::BadMap, c.total_len, 0));
             }
-            if c.width > limits.max_width {
-                let (w, m) = (c.width, limits.max_width);
-                return Err(err(ErrorCode::MapTooLarge, w.into(), m.into()));
-            }
-            if c.height > limits.max_height {
-                let (h, m) = (c.height, limits.max_height);
-                return Err(err(ErrorCode::MapTooLarge, h.into(), m.into()));
-            }
+            limits.check(c.width, c.height)?;
             let want = cells.div_ceil(8);
             match c.encoding {
                 Encoding::Raw if c.total_len != want => {
                     return Err(err(ErrorCode::BadMap, c.total_len, want))
                 }
-                Encoding::Rle if c.total_len == 0 => return Err(err(ErrorCode::BadMap, 0, 0)),
+                Encoding::Rle if c.total_len == 0 => return Err(err(ErrorCode::BadMap, 0, 1)),
                 _ => {}
             }
-            self.open = Some(Open {
-                encoding: c.encoding,
-                width: c.width,
-                height: c.height,
-                total_len: c.total_len,
-                received: 0,
-                rle: RleDecoder::new(cells),
-            });
-            return self.fits(c, len).map(|()| true);
+            let new = Upload {
+                open: Some(Open {
+                    encoding: c.encoding,
+                    width: c.width,
+                    height: c.height,
+                    total_len: c.total_len,
+                    received: 0,
+                    rle: RleDecoder::new(cells),
+                }),
+            };
+            new.fits(c, len)?;
+            *self = new;
+            return Ok(true);
         }
         self.fits(c, len).map(|()| false)
     }

@@ -147,13 +147,15 @@ pub struct HelloReply<'a> {
 /// The device's limits.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Capacity {
-    /// Most cells (`width * height`) of a map the device plans on; a bigger map it holds is
-    /// answered `MapTooLarge` when planned on.
+    /// Most cells (`width * height`) of a map the device holds and plans on, whatever its
+    /// shape: an upload of more cells gets `MapTooLarge` (detail = cells, limit = `cells`).
     pub cells: u32,
-    /// Widest map the device holds (a map upload over it gets `MapTooLarge`).
-    pub max_width: u16,
-    /// Tallest map the device holds.
-    pub max_height: u16,
+    /// Longest side of a map the device takes, in cells (an upload with a longer side gets
+    /// `MapTooLarge`, detail = the side, limit = `max_side`).
+    pub max_side: u16,
+    /// Longest ant path the planner keeps, in steps: a way longer than this gets
+    /// `Error PathTooLong`.
+    pub max_steps: u32,
     /// Most bytes per [`Request::SetMap`] chunk.
     pub max_chunk: u16,
     /// Largest request payload accepted ([`MAX_REQUEST`] or less).

@@ -64,8 +64,9 @@ pub use wire::{Waypoints, WAYPOINT_BYTES};
 /// Protocol version, reported in [`HelloReply::protocol_version`]. Bumped on any change to the
 /// bytes or meaning of a message (2: [`StatsReply::stack_peak`]; 3: run-length uploads, cell
 /// updates, warm plans, [`Capacity`]'s sides are the largest map held; 4: warm replies and
-/// `warm_patience`; 5: `refine_patience` and `refine`).
-pub const VERSION: u16 = 5;
+/// `warm_patience`; 5: `refine_patience` and `refine`; 6: [`Capacity`] by cells, `max_side` and
+/// `max_steps`).
+pub const VERSION: u16 = 6;
 
 /// The id of replies to frames whose request id could not be read. Hosts should not use it.
 pub const UNKNOWN_ID: u32 = 0;

@@ -6,7 +6,7 @@
 //!
 //! The map flags are `plan`'s (`--unknown`, `--inflate`, `--cell`, `--start-m`, `--goal-m`). A
 //! map goes at full resolution whenever it fits the capacity the device reports in Hello (its
-//! cells, and its widest and tallest map); only a larger one is resampled, to the smallest whole
+//! cells, and its longest side); only a larger one is resampled, to the smallest whole
 //! number of cells per coarse cell that fits (a coarse cell is blocked if any cell it covers is;
 //! [`ohaca_host::map::fit`]), unless `--cell` was given; a note on stderr says so, with the new
 //! cell size for maps with a resolution, and start, goal and output are cells of the coarse grid.
@@ -27,7 +27,7 @@ use ohaca::protocol::{ErrorCode, ErrorReply};
 use ohaca::{Error, Params, Point};
 use ohaca_host::input::{resolve_point, MapArgs};
 use ohaca_host::link::{DeviceInfo, DevicePath, Link, LinkError, PlanJob, Transport, DEFAULT_BAUD};
-use ohaca_host::map::{fit, fits, prepare, MapFrame};
+use ohaca_host::map::{fit, fits, prepare, Fitted, MapFrame};
 use ohaca_host::output::{format_us, micros, render, waypoints_csv, xy, LocatedReport, PlanReport};
 use ohaca_host::{exit, parse_point, Map, ParamArgs};
 use serde::Serialize;
@@ -127,6 +127,10 @@ struct Sender {
     jobs: Vec<PlanJob>,
     /// What to print.
     format: Format,
+    /// The map as sent when it had to be cropped or resampled to fit the device; `map`,
+    /// `metric` and the jobs' cells are then the fitted map's, and outputs go back to the
+    /// original map's cells through it.
+    fitted: Option<Fitted>,
 }
 
 /// One line of a goals file.
@@ -173,15 +177,14 @@ fn too_large(map_path: &Path, map: &Map, info: &DeviceInfo) -> String {
     let c = &info.capacity;
     format!(
         "{}: map too large for the device: {}x{} = {} cells, but {} holds at most {} cells \
-         (at most {} wide, {} high); use a smaller map",
+         (sides up to {}); use a smaller map",
         map_path.display(),
         map.width,
         map.height,
         map.cells(),
         info.board,
         c.cells,
-        c.max_width,
-        c.max_height
+        c.max_side
     )
 }
 
@@ -235,12 +238,15 @@ impl Sender {
             params,
             jobs,
             format,
+            fitted: None,
         })
     }
 
-    /// Resample the map to fit the device if it is too large and `--cell` was not given (the
-    /// jobs' cells follow); with `--cell`, a map that does not fit is an error. A map that fits
-    /// (cells and sides) goes at full resolution.
+    /// Fit the map to the device if it is too large and `--cell` was not given: crop it to its
+    /// free area, then resample it only if that is not enough, keeping every start and goal free
+    /// ([`ohaca_host::map::fit`]); the jobs' cells follow, and outputs go back to the original
+    /// cells. With `--cell`, a map that does not fit is an error. A map that fits (cells and
+    /// longest side) goes as it is.
     fn fit(&mut self, args: &Args, info: &DeviceInfo) -> Result<(), String> {
         let c = &info.capacity;
         if fits(&self.map, c) {
@@ -249,20 +255,52 @@ impl Sender {
         if args.input.cell.is_some() {
             return Err(too_large(&args.input.map, &self.map, info));
         }
-        let Some(fitted) = fit(&self.map, self.metric, c) else {
-            return Err(too_large(&args.input.map, &self.map, info));
-        };
-        eprintln!(
-            "note: {}",
-            fitted.note(&self.name, &self.map, &info.board, c)
-        );
+        // A start or goal off the map or on an obstacle is the user's, at full resolution.
+        for job in &self.jobs {
+            for (what, p) in [("start", job.start), ("goal", job.goal)] {
+                if p.x >= self.map.width || p.y >= self.map.height {
+                    return Err(format!(
+                        "{}: {what} {},{} is outside the map ({}x{})",
+                        self.name, p.x, p.y, self.map.width, self.map.height
+                    ));
+                }
+                if self.map.is_blocked(p) {
+                    return Err(format!(
+                        "{}: {what} {},{} is on an obstacle",
+                        self.name, p.x, p.y
+                    ));
+                }
+            }
+        }
+        let endpoints: Vec<Point> = self.jobs.iter().flat_map(|j| [j.start, j.goal]).collect();
+        let fitted = fit(&self.map, self.metric, c, &endpoints)
+            .map_err(|e| format!("{}: {e}", self.name))?
+            .ok_or_else(|| too_large(&args.input.map, &self.map, info))?;
+        eprintln!("note: {}", fitted.note(&self.name, &info.board, c));
         for job in &mut self.jobs {
             job.start = fitted.cell(job.start);
             job.goal = fitted.cell(job.goal);
         }
-        self.map = fitted.map;
+        self.map = fitted.map.clone();
         self.metric = fitted.metric;
+        self.fitted = Some(fitted);
         Ok(())
+    }
+
+    /// A report in the original map's cells (raw path and waypoints), when the map was fitted.
+    fn in_original(&self, report: &PlanReport) -> PlanReport {
+        let mut r = report.clone();
+        if let Some(f) = &self.fitted {
+            let back = |v: &mut Vec<[u16; 2]>| {
+                for c in v.iter_mut() {
+                    let p = f.original(Point::new(c[0], c[1]));
+                    *c = [p.x, p.y];
+                }
+            };
+            back(&mut r.raw);
+            back(&mut r.waypoints);
+        }
+        r
     }
 
     /// The waypoints in metres (rounded to a micrometre), for maps with a resolution.
@@ -274,9 +312,10 @@ impl Sender {
     /// and `device`.
     fn json_line(&self, report: &PlanReport, ticks: Option<u64>, info: &DeviceInfo) -> String {
         let metres = self.metres(&report.waypoints);
+        let original = self.in_original(report);
         let mut s = SendReport {
             report: LocatedReport {
-                report,
+                report: &original,
                 waypoints_m: metres.as_deref(),
             },
             ticks,
@@ -364,7 +403,8 @@ impl Sender {
         };
         if self.format == Format::Csv {
             let metres = self.metres(&report.waypoints);
-            print(&waypoints_csv(&report.waypoints, metres.as_deref()));
+            let original = self.in_original(&report);
+            print(&waypoints_csv(&original.waypoints, metres.as_deref()));
         } else if self.format == Format::Json {
             print(&self.json_line(&report, ticks, info));
         } else {
@@ -382,6 +422,17 @@ impl Sender {
                 info.firmware_version
             );
             s.push_str(&render(&self.map, job.start, job.goal, &report));
+            if let (Some(_), true) = (&self.fitted, report.found) {
+                let o = self.in_original(&report);
+                let pts: Vec<String> = o
+                    .waypoints
+                    .iter()
+                    .map(|[x, y]| format!("({x},{y})"))
+                    .collect();
+                s.push_str("waypoints in the original map's cells: ");
+                s.push_str(&pts.join(" "));
+                s.push('\n');
+            }
             if let (Some(m), true) = (self.metres(&report.waypoints), report.found) {
                 let pts: Vec<String> = m.iter().map(|[x, y]| format!("({x}, {y})")).collect();
                 s.push_str("waypoints in metres (map frame): ");

@@ -13,12 +13,13 @@
 //!
 //! Modules, each importing only those listed before it: [`bitmap`] (the [`Map`] type),
 //! [`error`], [`metric`] (cells <-> metres), [`text`], [`image`], [`ros`], [`ops`] (inflation,
-//! resampling, fitting a device's capacity); this file detects the format, loads and prepares.
+//! resampling), [`fit`] (cropping and resampling to a device's capacity); this file detects the format, loads and prepares.
 
 use std::path::Path;
 
 pub mod bitmap;
 pub mod error;
+pub mod fit;
 pub mod image;
 pub mod metric;
 pub mod ops;
@@ -27,11 +28,10 @@ pub mod text;
 
 pub use bitmap::{Map, MAX_SIDE};
 pub use error::{MapError, Problem};
+pub use fit::{fit, fits, free_bounds, FitError, Fitted};
 pub use image::{decode_image, image_map, load_image, read_image};
 pub use metric::{round_um, MapFrame};
-pub use ops::{
-    fit, fits, inflate, resample, resample_frame, squared_distances, Fitted, ResampleError,
-};
+pub use ops::{inflate, resample, resample_frame, squared_distances, ResampleError};
 pub use ros::{load_ros, ros_map, Mode, Occupancy, RosMeta, Unknown};
 pub use text::Format;
 

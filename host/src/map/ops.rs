@@ -10,10 +10,9 @@
 //!   the map's lower-left corner (the ROS origin), so the origin stays valid; without one, at the
 //!   top-left corner (cell `(0, 0)`). A coarse cell on the far edge that only partly covers the
 //!   map looks at the fine cells it does cover.
-//! - [`fit`] finds the smallest whole factor that makes a map fit a device's [`Capacity`] (its
-//!   cells and its widest and tallest map); a map that fits is never resampled.
+//!
+//! Fitting a map to a device (crop, then resample) is [`super::fit`].
 
-use ohaca::protocol::Capacity;
 use ohaca::Point;
 
 use super::bitmap::Map;
@@ -204,81 +203,6 @@ pub fn resample_frame(frame: &MapFrame, coarse: &Map, factor: f64) -> MapFrame {
     }
 }
 
-/// True if `map` fits `capacity`: no more cells than it holds, and no side longer than its
-/// widest or tallest map.
-pub fn fits(map: &Map, capacity: &Capacity) -> bool {
-    u32::try_from(map.cells()).is_ok_and(|n| n <= capacity.cells)
-        && map.width <= capacity.max_width
-        && map.height <= capacity.max_height
-}
-
-/// A map resampled to fit a capacity ([`fit`]).
-#[derive(Clone, Debug, PartialEq)]
-pub struct Fitted {
-    /// Fine cells per coarse cell, along each side.
-    pub factor: u16,
-    /// The coarse map.
-    pub map: Map,
-    /// The coarse map's metric frame (maps with a resolution).
-    pub metric: Option<MapFrame>,
-    /// The fine map's metric frame, for [`Fitted::cell`].
-    pub fine_metric: Option<MapFrame>,
-}
-
-/// The smallest whole number of cells per coarse cell (side) that makes `map` fit `capacity`,
-/// with the coarse map; `None` if `map` fits as it is (it is never resampled then) or if even a
-/// single coarse cell would not fit (a 0-cell device).
-pub fn fit(map: &Map, metric: Option<MapFrame>, capacity: &Capacity) -> Option<Fitted> {
-    if fits(map, capacity) {
-        return None;
-    }
-    (2..=map.width.max(map.height)).find_map(|k| {
-        let coarse = resample(map, f64::from(k), metric.is_some()).ok()?;
-        fits(&coarse, capacity).then(|| Fitted {
-            factor: k,
-            metric: metric.map(|f| resample_frame(&f, &coarse, f64::from(k))),
-            map: coarse,
-            fine_metric: metric,
-        })
-    })
-}
-
-impl Fitted {
-    /// Where cell `p` of the fine grid lies in the coarse grid: through the metric frames when
-    /// the map has them (the coarse grid is anchored at the lower-left corner), else by division
-    /// (anchored at the top-left).
-    pub fn cell(&self, p: Point) -> Point {
-        let k = self.factor.max(1);
-        let divided = Point::new(p.x / k, p.y / k);
-        match (self.fine_metric, self.metric) {
-            (Some(f), Some(c)) => c.cell(f.to_metres(p)).unwrap_or(divided),
-            _ => divided,
-        }
-    }
-
-    /// One line for the user: what was resampled to what, and the new cell size (readably, e.g.
-    /// `0.3 m`) for maps with a resolution. `name` is the map file, `fine` the map before, `board`
-    /// and `capacity` the device's.
-    pub fn note(&self, name: &str, fine: &Map, board: &str, capacity: &Capacity) -> String {
-        let k = self.factor;
-        let size = self
-            .metric
-            .map_or_else(String::new, |f| format!(" ({} m)", f.cell_size_m()));
-        format!(
-            "{name}: {}x{} cells do not fit {board} ({} cells, at most {}x{}); resampled to \
-             {}x{}, {k}x{k} cells per cell{size}; start, goal and output are cells of the coarse \
-             grid",
-            fine.width,
-            fine.height,
-            capacity.cells,
-            capacity.max_width,
-            capacity.max_height,
-            self.map.width,
-            self.map.height,
-        )
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -447,113 +371,6 @@ mod tests {
             let m = f.to_metres(Point::new(x, y));
             let c = g.cell(m).unwrap();
             assert_eq!(c, Point::new(x / 2, if y == 0 { 0 } else { 1 }), "{x},{y}");
-        }
-    }
-
-    fn capacity(cells: u32) -> Capacity {
-        Capacity {
-            cells,
-            max_width: cells.min(65535) as u16,
-            max_height: cells.min(65535) as u16,
-            max_chunk: 128,
-            max_request: 256,
-            plan_queue: 4,
-            tick_hz: 1_000_000,
-        }
-    }
-
-    #[test]
-    fn large_maps_are_resampled_by_the_smallest_factor_that_fits() {
-        // 100x75 into 1024 cells: 2 gives 50x38 = 1900, 3 gives 34x25 = 850.
-        let map = Map::from_fn(100, 75, |x, y| x == 50 && y == 10);
-        let f = fit(&map, None, &capacity(1024)).unwrap();
-        assert_eq!((f.factor, f.map.width, f.map.height), (3, 34, 25));
-        // The blocked cell (50,10) is in coarse cell (16,3).
-        assert!(f.map.is_blocked(Point::new(16, 3)));
-        let blocked = (0..f.map.height)
-            .flat_map(|y| (0..f.map.width).map(move |x| Point::new(x, y)))
-            .filter(|&p| f.map.is_blocked(p))
-            .count();
-        assert_eq!(blocked, 1);
-        assert_eq!(f.cell(Point::new(50, 10)), Point::new(16, 3));
-        // A device without cells cannot take any map.
-        assert!(fit(&map, None, &capacity(0)).is_none());
-    }
-
-    #[test]
-    fn maps_that_fit_keep_their_resolution() {
-        // Cells and both sides must fit: 100x75 = 7500 cells.
-        let map = Map::from_fn(100, 75, |_, _| false);
-        let roomy = capacity(7500);
-        assert!(fits(&map, &roomy) && fit(&map, None, &roomy).is_none());
-        let narrow = Capacity {
-            max_width: 99,
-            ..capacity(1 << 20)
-        };
-        assert!(!fits(&map, &narrow));
-        let f = fit(&map, None, &narrow).unwrap();
-        assert_eq!((f.factor, f.map.width, f.map.height), (2, 50, 38));
-        let short = Capacity {
-            max_height: 74,
-            ..capacity(1 << 20)
-        };
-        assert!(!fits(&map, &short));
-        assert!(!fits(&map, &capacity(7499)));
-    }
-
-    #[test]
-    fn the_note_gives_the_cell_size_readably() {
-        // 0.1 m * 3 is 0.30000000000000004 in f64.
-        let fine = MapFrame {
-            resolution: 0.1,
-            origin: [0.0, 0.0],
-            yaw: 0.0,
-            width: 100,
-            height: 75,
-        };
-        let map = Map::from_fn(100, 75, |_, _| false);
-        let f = fit(&map, Some(fine), &capacity(1024)).unwrap();
-        assert_eq!(f.factor, 3);
-        assert_ne!(format!("{}", 0.1 * 3.0), "0.3");
-        let note = f.note("lab.yaml", &map, "qemu", &capacity(1024));
-        assert_eq!(
-            note,
-            "lab.yaml: 100x75 cells do not fit qemu (1024 cells, at most 1024x1024); resampled \
-             to 34x25, 3x3 cells per cell (0.3 m); start, goal and output are cells of the \
-             coarse grid"
-        );
-    }
-
-    #[test]
-    fn resampled_cells_follow_the_metric_frame() {
-        // 10x9 cells of 0.1 m, origin (-1, -2): the coarse grid (factor 2) is anchored at the
-        // lower-left corner, so rows shift when the height is odd.
-        let fine = MapFrame {
-            resolution: 0.1,
-            origin: [-1.0, -2.0],
-            yaw: 0.0,
-            width: 10,
-            height: 9,
-        };
-        let map = Map::from_fn(10, 9, |_, _| false);
-        // 90 cells into 25: factor 2 gives 5x5.
-        let f = fit(&map, Some(fine), &capacity(25)).unwrap();
-        assert_eq!((f.factor, f.map.width, f.map.height), (2, 5, 5));
-        let coarse = f.metric.unwrap();
-        assert_eq!(coarse, resample_frame(&fine, &f.map, 2.0));
-        // Bottom-left fine cell (0,8) -> bottom-left coarse cell (0,4); top row 0 -> coarse 0.
-        let c = |x, y| f.cell(Point::new(x, y));
-        assert_eq!(c(0, 8), Point::new(0, 4));
-        assert_eq!(c(9, 0), Point::new(4, 0));
-        // Fine row 7 is row 1 from the bottom: coarse row 0 from the bottom, i.e. row 4.
-        assert_eq!(c(3, 7), Point::new(1, 4));
-        assert_eq!(c(3, 6), Point::new(1, 3));
-        // Every fine cell's centre lies in the coarse cell it is mapped to.
-        for y in 0..9 {
-            for x in 0..10 {
-                let m = fine.to_metres(Point::new(x, y));
-                assert_eq!(coarse.cell(m), Some(c(x, y)));
-            }
         }
     }
 }

@@ -250,12 +250,12 @@ fn reply_fields(id: u32, r: &Reply<'_>) -> Vec<(String, Vec<u8>)> {
             let c = h.capacity;
             v.push((format!("  capacity.cells = {}", c.cells), ser(&c.cells)));
             v.push((
-                format!("  capacity.max_width = {}", c.max_width),
-                ser(&c.max_width),
+                format!("  capacity.max_side = {}", c.max_side),
+                ser(&c.max_side),
             ));
             v.push((
-                format!("  capacity.max_height = {}", c.max_height),
-                ser(&c.max_height),
+                format!("  capacity.max_steps = {}", c.max_steps),
+                ser(&c.max_steps),
             ));
             v.push((
                 format!("  capacity.max_chunk = {}", c.max_chunk),

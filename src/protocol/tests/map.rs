@@ -4,8 +4,8 @@
 use super::*;
 
 pub(super) const LIMITS: MapLimits = MapLimits {
-    max_width: 512,
-    max_height: 512,
+    max_cells: 512 * 512,
+    max_side: 1024,
 };
 
 fn cell(bits: &[u8], i: usize) -> bool {
@@ -196,22 +196,40 @@ fn upload_headers_are_checked() {
     let mut up = Upload::new();
     let big = [0u8; MAX_CHUNK + 1];
     let cases: Vec<(MapChunk<'_>, ErrorReply)> = vec![
-        (chunk(Raw, 4, 3, 0, 2, &[]), e(ErrorCode::BadChunk, 0, 2)),
         (
             chunk(Rle, 4, 3, 0, 2, &big),
             e(ErrorCode::TooLarge, 129, 128),
         ),
+        // An empty chunk is refused first, whatever else is wrong.
+        (chunk(Raw, 0, 3, 0, 0, &[]), e(ErrorCode::TooLarge, 0, 128)),
+        (chunk(Raw, 4, 3, 0, 2, &[]), e(ErrorCode::TooLarge, 0, 128)),
+        // A zero side: BadMap with what was sent and the 0 bytes such a map would have.
         (chunk(Raw, 0, 3, 0, 0, &[0]), e(ErrorCode::BadMap, 0, 0)),
-        (chunk(Rle, 4, 0, 0, 1, &[0]), e(ErrorCode::BadMap, 0, 0)),
+        (chunk(Raw, 0, 3, 0, 7, &[0]), e(ErrorCode::BadMap, 7, 0)),
+        (chunk(Rle, 4, 0, 0, 1, &[0]), e(ErrorCode::BadMap, 1, 0)),
         (chunk(Raw, 4, 3, 0, 3, &[0]), e(ErrorCode::BadMap, 3, 2)),
-        (chunk(Rle, 4, 3, 0, 0, &[0]), e(ErrorCode::BadMap, 0, 0)),
+        (chunk(Rle, 4, 3, 0, 0, &[0]), e(ErrorCode::BadMap, 0, 1)),
+        // By side (width first), then by cells.
         (
-            chunk(Raw, 513, 1, 0, 65, &[0]),
-            e(ErrorCode::MapTooLarge, 513, 512),
+            chunk(Raw, 1025, 1, 0, 129, &[0]),
+            e(ErrorCode::MapTooLarge, 1025, 1024),
         ),
         (
-            chunk(Rle, 1, 600, 0, 3, &[0]),
-            e(ErrorCode::MapTooLarge, 600, 512),
+            chunk(Rle, 1, 1100, 0, 3, &[0]),
+            e(ErrorCode::MapTooLarge, 1100, 1024),
+        ),
+        (
+            chunk(Raw, 2000, 2000, 0, 500_000, &[0]),
+            e(ErrorCode::MapTooLarge, 2000, 1024),
+        ),
+        (
+            chunk(Raw, 1024, 257, 0, 32_896, &[0]),
+            e(ErrorCode::MapTooLarge, 1024 * 257, 512 * 512),
+        ),
+        // A size over the limits comes before a wrong total_len.
+        (
+            chunk(Raw, 1024, 257, 0, 1, &[0]),
+            e(ErrorCode::MapTooLarge, 1024 * 257, 512 * 512),
         ),
         // Nothing open.
         (chunk(Raw, 4, 3, 1, 2, &[0]), e(ErrorCode::BadChunk, 0, 0)),
@@ -224,13 +242,21 @@ fn upload_headers_are_checked() {
     for (c, want) in cases {
         assert_eq!(Upload::new().accept(&c, LIMITS), Err(want), "{c:?}");
     }
-    // An empty first chunk opens its upload with nothing received (the map is untouched).
+    // A refused first chunk (empty, or past its own total_len) opens nothing.
     assert!(up.accept(&chunk(Raw, 4, 3, 0, 2, &[]), LIMITS).is_err());
-    assert!(up.is_open());
+    assert!(!up.is_open());
+    assert!(up
+        .accept(&chunk(Raw, 4, 3, 0, 2, &[0, 0, 0]), LIMITS)
+        .is_err());
+    assert!(!up.is_open());
     assert_eq!(
         up.accept(&chunk(Raw, 4, 3, 1, 2, &[0]), LIMITS),
-        Err(e(ErrorCode::BadChunk, 0, 2))
+        Err(e(ErrorCode::BadChunk, 0, 0))
     );
+    // Any shape within the cells and the side: 1024 x 256 is as many cells as 512 x 512.
+    let mut wide = Upload::new();
+    let c = chunk(Raw, 1024, 256, 0, 32_768, &[0xFF]);
+    assert_eq!(wide.accept(&c, LIMITS), Ok(true));
     // A good start, then chunks that do not continue it.
     let mut up = Upload::new();
     assert_eq!(up.accept(&chunk(Rle, 4, 3, 0, 3, &[5]), LIMITS), Ok(true));
@@ -246,9 +272,17 @@ fn upload_headers_are_checked() {
         assert_eq!(up.accept(&c, LIMITS), Err(e(ErrorCode::BadChunk, 1, 3)));
         assert_eq!(up.write(&c, &mut buf), Err(e(ErrorCode::BadChunk, 1, 3)));
     }
-    // A refused new header leaves the open upload alone.
-    assert!(up.accept(&chunk(Raw, 600, 1, 0, 75, &[0]), LIMITS).is_err());
-    assert!(up.is_open());
+    // A refused new header or first chunk leaves the open upload as it was.
+    let before = up;
+    assert!(up
+        .accept(&chunk(Raw, 1100, 1, 0, 138, &[0]), LIMITS)
+        .is_err());
+    assert!(up.accept(&chunk(Raw, 4, 3, 0, 2, &[]), LIMITS).is_err());
+    assert!(up
+        .accept(&chunk(Raw, 4, 3, 0, 2, &[0, 0, 0]), LIMITS)
+        .is_err());
+    assert!(up.accept(&chunk(Rle, 4, 3, 1, 3, &[]), LIMITS).is_err());
+    assert_eq!(up, before);
     // A re-sent chunk overlapping what arrived is fine; only the new bytes count.
     let c = chunk(Rle, 4, 3, 0, 3, &[5, 1]);
     assert_eq!(up.accept(&c, LIMITS), Ok(true)); // offset 0 restarts

@@ -229,7 +229,7 @@ fn error_codes_map_the_planner_errors_both_ways() {
     assert_eq!(ErrorCode::try_from(0u8), Err(UnknownCode(0)));
     assert_eq!(
         ErrorReply::with(ErrorCode::MapTooLarge, 2000, 1024).to_string(),
-        "map too large (2000 cells, capacity 1024)"
+        "map too large (2000 over the limit 1024)"
     );
     assert_eq!(
         DecodeError::TooLarge { len: 9, max: 8 }.to_string(),

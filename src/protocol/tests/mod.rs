@@ -171,8 +171,8 @@ fn hello() -> HelloReply<'static> {
         board: "qemu-mps2-an386",
         capacity: Capacity {
             cells: 65536,
-            max_width: 256,
-            max_height: 256,
+            max_side: 4096,
+            max_steps: 1023,
             max_chunk: MAX_CHUNK as u16,
             max_request: MAX_REQUEST as u16,
             plan_queue: 4,
