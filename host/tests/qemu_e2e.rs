@@ -1013,8 +1013,9 @@ fn send_command_over_tcp() {
     assert!(err.contains("goal is on an obstacle"), "{err}");
     assert!(o.stdout.is_empty());
 
-    // A map larger than the device: resampled to fit (2x2 cells per cell), with a note on
-    // stderr; start, goal and output are cells of the coarse grid.
+    // A map larger than the device, free everywhere: nothing to crop, so resampled to fit (2x2
+    // cells per cell), with a note on stderr; start, goal and output are the original map's
+    // cells (the waypoints between them are the centres of the coarse cells).
     let big = maps().join("movingai/random-32-32-10.map");
     let dir = tempfile::tempdir().expect("tempdir");
     let huge = dir.path().join("huge.map");
@@ -1031,7 +1032,7 @@ fn send_command_over_tcp() {
     let err = String::from_utf8_lossy(&o.stderr).into_owned();
     assert_eq!(err.lines().count(), 1, "{err}");
     assert!(
-        err.starts_with("note: ") && err.contains("resampled to 150x150"),
+        err.starts_with("note: ") && err.contains("resampled, 2x2 cells per cell: 150x150"),
         "{err}"
     );
     let line = json_lines(&o).remove(0);
@@ -1039,9 +1040,86 @@ fn send_command_over_tcp() {
     assert_eq!(line["raw"][0], serde_json::json!([0, 0]), "{line}");
     assert_eq!(
         line["waypoints"].as_array().and_then(|w| w.last()),
-        Some(&serde_json::json!([149, 149])),
+        Some(&serde_json::json!([299, 299])),
         "{line}"
     );
+
+    // A ROS map shaped like Nav2's TurtleBot sandbox: 384 x 384 cells of 5 cm, unknown but an
+    // 80 x 80 known area. Cropped to the known area it fits at full resolution: no resampling,
+    // start and goal stay the free cells they are, and the path is the host's on the crop,
+    // reported in the original cells and metres.
+    let mut pgm = b"P5\n384 384\n255\n".to_vec();
+    for y in 0..384u32 {
+        for x in 0..384u32 {
+            let known = (150..230).contains(&x) && (150..230).contains(&y);
+            let wall = known && x == 190 && y < 215;
+            pgm.push(if !known {
+                205
+            } else if wall {
+                0
+            } else {
+                254
+            });
+        }
+    }
+    std::fs::write(dir.path().join("sandbox.pgm"), pgm).expect("write pgm");
+    let sandbox = dir.path().join("sandbox.yaml");
+    std::fs::write(
+        &sandbox,
+        "image: sandbox.pgm\nresolution: 0.05\norigin: [-10.0, -10.0, 0.0]\nnegate: 0\n\
+         occupied_thresh: 0.65\nfree_thresh: 0.196\n",
+    )
+    .expect("write yaml");
+    let o = ohaca(&{
+        let mut a = base(&["--start", "152,152", "--goal", "227,160", "--json"]);
+        a[4] = sandbox.display().to_string();
+        a
+    });
+    assert_eq!(o.status.code(), Some(0), "{o:?}");
+    let err = String::from_utf8_lossy(&o.stderr).into_owned();
+    assert!(
+        err.contains(
+            "cropped to its free area at full resolution: 82x82 cells from cell (149, 149)"
+        ),
+        "{err}"
+    );
+    let line = json_lines(&o).remove(0);
+    assert_eq!(line["found"], true, "{line}");
+    let way = line["waypoints"].as_array().expect("waypoints").clone();
+    assert_eq!(way.first(), Some(&serde_json::json!([152, 152])), "{line}");
+    assert_eq!(way.last(), Some(&serde_json::json!([227, 160])), "{line}");
+    // The crop's path, moved back by (149, 149), is the host core's on the crop.
+    let mut crop = String::from("type octile\nheight 82\nwidth 82\nmap\n");
+    for y in 149..231u32 {
+        for x in 149..231u32 {
+            let known = (150..230).contains(&x) && (150..230).contains(&y);
+            let wall = known && x == 190 && y < 215;
+            crop.push(if !known || wall { '@' } else { '.' });
+        }
+        crop.push('\n');
+    }
+    let crop_path = dir.path().join("crop.map");
+    std::fs::write(&crop_path, crop).expect("write crop");
+    let plan = host_json(&crop_path.display().to_string(), "3,3", "78,11", &[]);
+    let moved: Vec<Value> = plan["waypoints"]
+        .as_array()
+        .expect("host waypoints")
+        .iter()
+        .map(|p| serde_json::json!([p[0].as_u64().unwrap() + 149, p[1].as_u64().unwrap() + 149]))
+        .collect();
+    assert_eq!(way, moved, "{line}\n{plan}");
+    assert_eq!(line["length"], plan["length"]);
+    // Metres: the start's cell centre in the sandbox's frame.
+    let m = &line["waypoints_m"][0];
+    assert!(
+        (m[0].as_f64().unwrap() - (-10.0 + 152.5 * 0.05)).abs() < 1e-6,
+        "{m}"
+    );
+    assert!(
+        (m[1].as_f64().unwrap() - (-10.0 + (383.0 - 152.0 + 0.5) * 0.05)).abs() < 1e-6,
+        "{m}"
+    );
+
     // With --cell the map is taken as given: refused before the upload, exit 2.
     a.truncate(a.len() - 1);
     a.extend(strings(&["--cell", "1"]));

@@ -131,6 +131,8 @@ struct Sender {
     /// `metric` and the jobs' cells are then the fitted map's, and outputs go back to the
     /// original map's cells through it.
     fitted: Option<Fitted>,
+    /// The jobs in the original map's cells (before fitting).
+    original_jobs: Vec<PlanJob>,
 }
 
 /// One line of a goals file.
@@ -239,6 +241,7 @@ impl Sender {
             jobs,
             format,
             fitted: None,
+            original_jobs: Vec::new(),
         })
     }
 
@@ -277,6 +280,7 @@ impl Sender {
             .map_err(|e| format!("{}: {e}", self.name))?
             .ok_or_else(|| too_large(&args.input.map, &self.map, info))?;
         eprintln!("note: {}", fitted.note(&self.name, &info.board, c));
+        self.original_jobs = self.jobs.clone();
         for job in &mut self.jobs {
             job.start = fitted.cell(job.start);
             job.goal = fitted.cell(job.goal);
@@ -287,14 +291,23 @@ impl Sender {
         Ok(())
     }
 
-    /// A report in the original map's cells (raw path and waypoints), when the map was fitted.
-    fn in_original(&self, report: &PlanReport) -> PlanReport {
+    /// A report of job `i` in the original map's cells, when the map was fitted: the raw path
+    /// and the waypoints from the start and to the goal as given, through the centres of the
+    /// fitted cells between them.
+    fn in_original(&self, report: &PlanReport, i: usize) -> PlanReport {
         let mut r = report.clone();
         if let Some(f) = &self.fitted {
+            let job = self.original_jobs.get(i);
             let back = |v: &mut Vec<[u16; 2]>| {
                 for c in v.iter_mut() {
                     let p = f.original(Point::new(c[0], c[1]));
                     *c = [p.x, p.y];
+                }
+                if let (Some(j), Some(first)) = (job, v.first_mut()) {
+                    *first = [j.start.x, j.start.y];
+                }
+                if let (Some(j), Some(last)) = (job, v.last_mut()) {
+                    *last = [j.goal.x, j.goal.y];
                 }
             };
             back(&mut r.raw);
@@ -310,9 +323,15 @@ impl Sender {
 
     /// One `send --json` line: the report with `waypoints_m` (maps with a resolution), `ticks`
     /// and `device`.
-    fn json_line(&self, report: &PlanReport, ticks: Option<u64>, info: &DeviceInfo) -> String {
+    fn json_line(
+        &self,
+        report: &PlanReport,
+        i: usize,
+        ticks: Option<u64>,
+        info: &DeviceInfo,
+    ) -> String {
         let metres = self.metres(&report.waypoints);
-        let original = self.in_original(report);
+        let original = self.in_original(report, i);
         let mut s = SendReport {
             report: LocatedReport {
                 report: &original,
@@ -403,10 +422,10 @@ impl Sender {
         };
         if self.format == Format::Csv {
             let metres = self.metres(&report.waypoints);
-            let original = self.in_original(&report);
+            let original = self.in_original(&report, 0);
             print(&waypoints_csv(&original.waypoints, metres.as_deref()));
         } else if self.format == Format::Json {
-            print(&self.json_line(&report, ticks, info));
+            print(&self.json_line(&report, 0, ticks, info));
         } else {
             let p = &report.params;
             let mut s = format!(
@@ -423,7 +442,7 @@ impl Sender {
             );
             s.push_str(&render(&self.map, job.start, job.goal, &report));
             if let (Some(_), true) = (&self.fitted, report.found) {
-                let o = self.in_original(&report);
+                let o = self.in_original(&report, 0);
                 let pts: Vec<String> = o
                     .waypoints
                     .iter()
@@ -474,7 +493,7 @@ impl Sender {
                     )
                 }
             };
-            print(&self.json_line(&report, ticks, info));
+            print(&self.json_line(&report, i, ticks, info));
         })?;
         Ok(code)
     }

@@ -112,7 +112,7 @@ pub fn free_bounds(map: &Map) -> Option<(u16, u16, u16, u16)> {
 }
 
 /// Fit `map` to `capacity` (see the module docs) so that every point of `endpoints` (free cells
-/// of `map`, start first, then the goals) stays free. `Ok(None)`: the map fits as it is.
+/// of `map`: start, goal, start, goal, ...) stays free. `Ok(None)`: the map fits as it is.
 pub fn fit(
     map: &Map,
     metric: Option<MapFrame>,
@@ -148,29 +148,42 @@ pub fn fit(
     if fits_size(tw, th, capacity) {
         return Ok(Some(window(x0.into(), y0.into(), 1, tw, th)));
     }
-    // The smallest factor whose coarse grid fits with any offset (an offset adds at most one
-    // coarse cell a side).
-    let sides = |k: u16| (tw.div_ceil(k) + 1, th.div_ceil(k) + 1);
+    // The smallest factor whose grid from the free area's corner fits; a grid shifted by an
+    // offset may need one more coarse cell a side, and is tried only if it fits too. If no offset
+    // keeps every endpoint free at that factor, the next factor is tried before refusing.
+    let sides = |k: u16, dx: i32, dy: i32| {
+        let side = |t: u16, d: i32| {
+            let n = (i32::from(t) + d + i32::from(k) - 1) / i32::from(k);
+            u16::try_from(n).unwrap_or(u16::MAX)
+        };
+        (side(tw, dx), side(th, dy))
+    };
     let k = (2..=tw.max(th))
         .find(|&k| {
-            let (w, h) = sides(k);
+            let (w, h) = sides(k, 0, 0);
             fits_size(w, h, capacity)
         })
         .ok_or(FitError::NoRoom {
             cells: capacity.cells,
         })?;
-    let (w, h) = sides(k);
-    let ki = i32::from(k);
-    for (dx, dy) in offsets(k) {
-        let (ox, oy) = (i32::from(x0) - dx, i32::from(y0) - dy);
-        let free = |p: &Point| {
-            let c = to_coarse((ox, oy), k, *p);
-            block_free(map, (ox + i32::from(c.x) * ki, oy + i32::from(c.y) * ki), k)
-        };
-        if endpoints.iter().all(free) {
-            return Ok(Some(window(ox, oy, k, w, h)));
+    for k in [k, k.saturating_add(1)] {
+        let ki = i32::from(k);
+        for (dx, dy) in offsets(k) {
+            let (w, h) = sides(k, dx, dy);
+            if !fits_size(w, h, capacity) {
+                continue;
+            }
+            let (ox, oy) = (i32::from(x0) - dx, i32::from(y0) - dy);
+            let free = |p: &Point| {
+                let c = to_coarse((ox, oy), k, *p);
+                block_free(map, (ox + i32::from(c.x) * ki, oy + i32::from(c.y) * ki), k)
+            };
+            if endpoints.iter().all(free) {
+                return Ok(Some(window(ox, oy, k, w, h)));
+            }
         }
     }
+    let ki = i32::from(k);
     // Name the first endpoint that no offset keeps free (the start, if both).
     let lost = endpoints
         .iter()
@@ -189,7 +202,7 @@ pub fn fit(
         .or_else(|| endpoints.iter().enumerate().next());
     let (i, p) = lost.map_or((0, Point::new(0, 0)), |(i, p)| (i, *p));
     Err(FitError::EndpointLost {
-        which: if i == 0 { "start" } else { "goal" },
+        which: if i % 2 == 0 { "start" } else { "goal" },
         x: p.x,
         y: p.y,
         width: tw,
