@@ -13,7 +13,7 @@ const EXAMPLE_WAYPOINTS: [Point; 4] = [
 ];
 const EXAMPLE_DIRECTIONS: [u8; 4] = [0, 0, 1, 2];
 /// Ticks (µs of virtual time) the QEMU firmware reported for the example plan.
-const EXAMPLE_TICKS: u64 = 885;
+const EXAMPLE_TICKS: u64 = 1100;
 
 fn example_path() -> PathReply<'static> {
     PathReply {
@@ -34,7 +34,7 @@ fn example_path() -> PathReply<'static> {
 /// What the QEMU firmware answered to `Stats` after the example's first three requests.
 fn example_stats() -> StatsReply {
     StatsReply {
-        uptime: 22_327,
+        uptime: 47_821,
         boots: 1,
         frames_ok: 4,
         frames_bad: 0,
@@ -50,7 +50,7 @@ fn example_stats() -> StatsReply {
         map_height: 3,
         queued: 0,
         planning: false,
-        stack_peak: 1556,
+        stack_peak: 3176,
     }
 }
 
