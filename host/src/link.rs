@@ -686,6 +686,16 @@ impl<T: Transport> Link<T> {
         self.upload(map.width, map.height, &MapCode::of(map))
     }
 
+    /// [`Link::set_map`], calling `progress(bytes acknowledged, bytes in all)` after every chunk
+    /// the device acknowledged (for a progress bar).
+    pub fn set_map_with_progress(
+        &mut self,
+        map: &Map,
+        progress: impl FnMut(usize, usize),
+    ) -> Result<(), LinkError> {
+        self.upload_with(map.width, map.height, &MapCode::of(map), progress)
+    }
+
     /// [`Link::set_map`] from raw parts, always as `SetMap`: `bits` packed as [`ohaca::grid`]
     /// stores them (the device checks their length).
     pub fn set_map_bits(&mut self, width: u16, height: u16, bits: &[u8]) -> Result<(), LinkError> {
@@ -695,28 +705,44 @@ impl<T: Transport> Link<T> {
     /// Upload a map coded as `code`: its chunks, [`UPLOAD_WINDOW`] in flight. The first device
     /// error ends the upload (the replies of the chunks behind it are awaited and dropped).
     pub fn upload(&mut self, width: u16, height: u16, code: &MapCode) -> Result<(), LinkError> {
+        self.upload_with(width, height, code, |_, _| {})
+    }
+
+    /// [`Link::upload`] with a progress callback (see [`Link::set_map_with_progress`]).
+    pub fn upload_with(
+        &mut self,
+        width: u16,
+        height: u16,
+        code: &MapCode,
+        mut progress: impl FnMut(usize, usize),
+    ) -> Result<(), LinkError> {
         let chunk = self
             .info
             .as_ref()
             .map_or(MAX_CHUNK, |i| usize::from(i.capacity.max_chunk))
             .clamp(1, MAX_CHUNK);
         let bytes = code.bytes();
-        let mut in_flight: VecDeque<(u32, &'static str)> = VecDeque::new();
+        let mut in_flight: VecDeque<(u32, &'static str, usize)> = VecDeque::new();
         let mut first_error = None;
         let mut offset = 0usize;
-        // An empty map still goes out once, so the device says what is wrong with it.
+        // An empty map (a zero side) still goes out once, as one zero byte, so the device says
+        // what is wrong with it (`BadMap`; an empty chunk would be `TooLarge` 0 before that).
         loop {
             let end = (offset + chunk).min(bytes.len());
-            let req = code.request(width, height, offset, bytes.get(offset..end).unwrap_or(&[]));
-            in_flight.push_back((self.send(&req)?, request_name(&req)));
+            let piece = match bytes.get(offset..end) {
+                Some(p) if !p.is_empty() => p,
+                _ => &[0u8][..],
+            };
+            let req = code.request(width, height, offset, piece);
+            in_flight.push_back((self.send(&req)?, request_name(&req), end));
             offset = end;
             let last = offset >= bytes.len();
             while in_flight.len() >= UPLOAD_WINDOW
                 || ((last || first_error.is_some()) && !in_flight.is_empty())
             {
-                let (id, name) = in_flight.pop_front().unwrap_or((0, "SetMap"));
+                let (id, name, acked) = in_flight.pop_front().unwrap_or((0, "SetMap", 0));
                 match self.wait_for(id, name)? {
-                    Response::Ack => {}
+                    Response::Ack => progress(acked, bytes.len()),
                     other => {
                         first_error.get_or_insert(unexpected(name, other));
                     }

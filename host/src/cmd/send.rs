@@ -20,6 +20,7 @@
 //! than the device holds), a device error, a timeout or a lost connection, with one `error:`
 //! line on stderr.
 
+use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
@@ -373,7 +374,18 @@ impl Sender {
         self.fit(args, &info)?;
         let fail = |e: LinkError| self.fail(e);
         link.set_params(&self.params).map_err(fail)?;
-        link.set_map(&self.map).map_err(|e| match e {
+        // A progress bar on a terminal (never under --json or when stderr is a file or a pipe).
+        let bar = self.format != Format::Json && std::io::stderr().is_terminal();
+        let started = Instant::now();
+        let uploaded = link.set_map_with_progress(&self.map, |done, all| {
+            if bar {
+                eprint!("{}", progress_bar("map", done, all, started.elapsed()));
+            }
+        });
+        if bar {
+            eprint!("\r\x1b[K");
+        }
+        uploaded.map_err(|e| match e {
             LinkError::Device { error, .. } if error.code == ErrorCode::MapTooLarge => {
                 too_large(&args.input.map, &self.map, &info)
             }
@@ -587,6 +599,24 @@ mod tests {
     use super::*;
 
     #[test]
+    fn the_progress_bar_fills_with_the_bytes() {
+        let t = Duration::from_millis(1500);
+        assert_eq!(
+            progress_bar("map", 0, 2048, t),
+            "\rmap [                              ]   0 % 0.0 of 2.0 KiB, 1.5 s"
+        );
+        assert_eq!(
+            progress_bar("map", 1024, 2048, t),
+            "\rmap [###############               ]  50 % 1.0 of 2.0 KiB, 1.5 s"
+        );
+        assert!(
+            progress_bar("map", 2048, 2048, t).contains("[##############################] 100 %")
+        );
+        // Nothing to send divides by nothing.
+        assert!(progress_bar("map", 0, 0, t).contains("  0 %"));
+    }
+
+    #[test]
     fn goal_lines() {
         let s = Some(Point::new(1, 2));
         assert_eq!(parse_goal_line("  # nothing", None), Ok(None));
@@ -607,4 +637,21 @@ mod tests {
             assert!(parse_timeout(bad).is_err(), "{bad}");
         }
     }
+}
+
+/// One frame of a terminal progress bar (carriage return first, no newline): `map [####    ]
+/// 45 % 12.3 of 27.1 KiB, 1.2 s`.
+fn progress_bar(what: &str, done: usize, all: usize, elapsed: Duration) -> String {
+    const WIDTH: usize = 30;
+    let all = all.max(1);
+    let filled = (done.min(all) * WIDTH) / all;
+    format!(
+        "\r{what} [{}{}] {:>3} % {:.1} of {:.1} KiB, {:.1} s",
+        "#".repeat(filled),
+        " ".repeat(WIDTH - filled),
+        done.min(all) * 100 / all,
+        done as f64 / 1024.0,
+        all as f64 / 1024.0,
+        elapsed.as_secs_f64()
+    )
 }
