@@ -7,7 +7,8 @@
 //! - the parameter table of `docs/ALGORITHM.md` against `Params::default()` and `Params::paper()`.
 
 use ohaca::protocol::{
-    encode_request, Feed, Request, RequestReader, MAX_CHUNK, MAX_REQUEST, MAX_REQUEST_WIRE,
+    encode_request, Feed, Request, RequestReader, Waypoints, MAX_CHUNK, MAX_REQUEST,
+    MAX_REQUEST_WIRE, MAX_UPDATE_CELLS,
 };
 use ohaca::{DeadEnd, Params, SmoothingKind};
 
@@ -61,7 +62,23 @@ fn the_request_size_limits_are_the_documents() {
     let most = number_after(&text, "(at most");
     assert_eq!(most as usize, MAX_REQUEST + MAX_REQUEST.div_ceil(254));
     assert!(most as usize <= MAX_REQUEST_WIRE);
-    // The largest request: a SetMap with a full chunk and every number at its longest varint.
+    // The largest request: a SetCells with MAX_UPDATE_CELLS cells (with the longest id); a
+    // SetMap with a full chunk and every number at its longest varint comes next.
+    let cells = [0xffu8; 4 * MAX_UPDATE_CELLS];
+    let set_cells = Request::SetCells {
+        blocked: true,
+        cells: Waypoints::Packed(&cells),
+    };
+    let largest = number_after(
+        &text,
+        "the largest request, a `SetCells` with 60 cells and the largest id, is",
+    );
+    assert_eq!(
+        largest as usize,
+        postcard_len(&set_cells),
+        "docs/PROTOCOL.md: the largest request's size"
+    );
+    assert!(largest as usize <= MAX_REQUEST);
     let big = [0xffu8; MAX_CHUNK];
     let req = Request::SetMap {
         width: u16::MAX,
@@ -70,16 +87,11 @@ fn the_request_size_limits_are_the_documents() {
         total_len: u32::MAX,
         chunk: &big,
     };
-    let largest = number_after(
-        &text,
-        "the largest request, a `SetMap` with a full chunk, is",
-    );
     assert_eq!(
-        largest as usize,
-        postcard_len(&req),
-        "docs/PROTOCOL.md: the largest request's size"
+        number_after(&text, "(a `SetMap` with a full chunk:") as usize,
+        postcard_len(&req)
     );
-    assert!(largest as usize <= MAX_REQUEST);
+    assert!(postcard_len(&req) < largest as usize);
     let params = Request::SetParams(Params {
         seed: u64::MAX,
         ants: u16::MAX,
