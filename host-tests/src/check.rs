@@ -270,8 +270,8 @@ pub fn check_plan(
     // The patience that applies: a warm replan's, a refining run's (OHACA with the local search on
     // a map of more than `BLOCKS` cells; every storage of these tests lends its scratch), or the
     // plain one.
-    let refines =
-        p.refine && p.algorithm == Algorithm::Ohaca && map.cells() > ohaca::pheromone::BLOCKS;
+    // The local search runs for OHACA on every map (its storage here always lends the scratch).
+    let refines = p.refine && p.algorithm == Algorithm::Ohaca;
     let patience = if plan.warm && p.warm_patience > 0 {
         p.warm_patience
     } else if refines && p.refine_patience > 0 {

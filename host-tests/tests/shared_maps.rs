@@ -15,10 +15,13 @@ use ohaca::Params;
 use ohaca_host_tests::maps::scenarios;
 use ohaca_host_tests::quality::{default_seeds, prepare, run_map, summarize, Prepared, Summary};
 
-/// Mean raw length / 8-connected optimum must stay below this.
-const RAW_TARGET: f64 = 1.03;
-/// Mean smoothed length / any-angle optimum must stay below this.
-const SMOOTH_TARGET: f64 = 1.02;
+/// Mean raw length / 8-connected optimum must stay below this, per map (issue 21's target: with
+/// the local search on small maps the default preset's raw paths are the optimum, 1.0000 on every
+/// shared map; BENCHMARKS.md section 1).
+const RAW_TARGET: f64 = 1.002;
+/// Mean smoothed length / any-angle optimum must stay below this, per map (measured 1.0000 to
+/// 1.0083; issue 21's 1.003 needs a smoothing off the raw path's cells, not done yet).
+const SMOOTH_TARGET: f64 = 1.01;
 
 /// Prepared scenarios and per-map summaries, computed once per test binary.
 fn results() -> &'static (Vec<Prepared>, Vec<Summary>) {

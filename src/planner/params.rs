@@ -86,7 +86,7 @@ pub struct Params {
     /// [`Params::patience`] for a warm start ([`crate::planner::Run::warm`]), whose colony
     /// already holds the previous plan's trail; 0 = the same as `patience`.
     pub warm_patience: u16,
-    /// [`Params::patience`] for a run that refines its result ([`Params::refine`], large maps):
+    /// [`Params::patience`] for a run that refines its result ([`Params::refine`]):
     /// the local search straightens the path, so the colony only has to find the corridor;
     /// 0 = the same as `patience`. A warm start's `warm_patience` comes first.
     pub refine_patience: u16,
@@ -102,9 +102,11 @@ pub struct Params {
     /// Prune the cells no shortest path needs before the ants run ([`crate::prune`]); not in the
     /// paper, off for faithful comparisons.
     pub prune: bool,
-    /// On maps of more than [`crate::pheromone::BLOCKS`] cells, OHACA replaces each piece of the
-    /// best raw path by the exact shortest path inside a window around it before smoothing
-    /// ([`crate::refine`]); not in the paper, off for faithful comparisons.
+    /// OHACA replaces each piece of the best raw path by the exact shortest path inside a window
+    /// around it before smoothing ([`crate::refine`]; on maps of at most
+    /// [`crate::pheromone::BLOCKS`] cells the window is the whole map, so the raw path is the
+    /// optimum); not in the paper, off for faithful comparisons. A workspace that cannot lend the
+    /// scratch keeps the colony's path.
     pub refine: bool,
 }
 

@@ -32,7 +32,7 @@ use super::plan::{CurvePoint, Plan};
 use super::warm::{self, Area, Memory};
 use super::workspace::Workspace;
 use colony::Best;
-use polish::{Polish, REFINE_WORDS};
+use polish::{Polish, REFINE_WORDS, SMALL_REFINE_LINKS};
 
 /// A planning run in progress. See the module docs.
 pub struct Run<'g, 'a> {
@@ -183,13 +183,15 @@ impl<'g, 'a> Run<'g, 'a> {
         }
         ws.delta.fill([0.0; 4]);
         let heuristic = Heuristic::new(goal, params.attraction(), params.beta);
-        // The local search: OHACA on large maps, when the workspace can lend its scratch (every
-        // `Storage` with at least 4,096 links, and `HeapStorage`; like the coarse route).
-        let refines = params.refine
-            && params.algorithm == Algorithm::Ohaca
-            && blocks.shift() > 0
-            && ws.links.len() >= REFINE_WORDS
-            && ws.guide.len() >= REFINE_WORDS;
+        // The local search: OHACA on every map, when the workspace can lend its scratch (every
+        // `Storage` with at least 4,096 links, and `HeapStorage`; on large maps like the coarse
+        // route, on small ones from the links alone).
+        let scratch = if blocks.shift() > 0 {
+            ws.links.len() >= REFINE_WORDS && ws.guide.len() >= REFINE_WORDS
+        } else {
+            ws.links.len() >= SMALL_REFINE_LINKS
+        };
+        let refines = params.refine && params.algorithm == Algorithm::Ohaca && scratch;
         crate::fmt::debug!(
             "plan: {} cells, ants {}, iterations {}",
             cells,

@@ -23,6 +23,15 @@ use super::Run;
 pub const REFINE_SIDE: usize = 52;
 pub(super) const REFINE_WORDS: usize = Scratch::words(REFINE_SIDE);
 const _: () = assert!(REFINE_WORDS <= GUIDE_BLOCKS);
+/// Window side of the local search on small maps (at most [`crate::pheromone::BLOCKS`] = 1,024
+/// cells, which have no coarse route to lend): 32, a window of 1,024 cells, as large as the map.
+/// Its two slices of [`Scratch::words`]`(32)` = 1,536 words both come from the links, so a
+/// workspace needs 3,072 links for it (the device's 4,096 and `HeapStorage`'s at least
+/// [`GUIDE_BLOCKS`] have them; a smaller one keeps the colony's path, as before).
+pub const SMALL_REFINE_SIDE: usize = 32;
+pub(super) const SMALL_REFINE_WORDS: usize = Scratch::words(SMALL_REFINE_SIDE);
+/// Links a workspace needs for the local search on small maps.
+pub(super) const SMALL_REFINE_LINKS: usize = 2 * SMALL_REFINE_WORDS;
 /// Cells the local search expands between two yields of [`Run::polish_step`] (a window expands
 /// at most `REFINE_SIDE^2` = 2,704).
 const REFINE_SLICE: u64 = 8192;
@@ -83,8 +92,19 @@ impl Run<'_, '_> {
                 }
             }
             Polish::Refine(mut r) => {
-                let a = ws.links.get_mut(..REFINE_WORDS).unwrap_or_default();
-                let b = ws.guide.get_mut(..REFINE_WORDS).unwrap_or_default();
+                // Large maps: the links and the coarse route's words; small maps: two halves of
+                // the links (see `SMALL_REFINE_SIDE`).
+                let (a, b) = if self.blocks.shift() > 0 {
+                    let a = ws.links.get_mut(..REFINE_WORDS).unwrap_or_default();
+                    let b = ws.guide.get_mut(..REFINE_WORDS).unwrap_or_default();
+                    (a, b)
+                } else {
+                    let (a, rest) = ws
+                        .links
+                        .split_at_mut(SMALL_REFINE_WORDS.min(ws.links.len()));
+                    let b = rest.get_mut(..SMALL_REFINE_WORDS).unwrap_or_default();
+                    (a, b)
+                };
                 let mut budget = Budget::new(REFINE_SLICE);
                 if r.resume(grid, ws.points, &mut Scratch::new(a, b), &mut budget) {
                     let n = r.finish(ws.points);
