@@ -419,7 +419,7 @@ def selftest(dev, map_path):
     expect(dev.call(req_plan((w, 0), goal)), "Error", "StartOutOfBounds")
 
     # Busy and Cancel: a long plan, the queue filled, one more refused, then cancel them all.
-    slow = dict(defaults, iterations=2000, patience=0)
+    slow = dict(defaults, iterations=2000, patience=0, refine_patience=0)
     expect(dev.call(req_set_params(slow)), "Ack")
     queue = hello["capacity"]["plan_queue"]
     ids = [dev.send(req_plan(start, goal, seed=s)) for s in range(1, queue + 3)]
@@ -515,6 +515,7 @@ def stack_cases(defaults):
         ("ohaca greedy", dict(d, smoothing=SMOOTHING.index("greedy"))),
         ("ohaca none", dict(d, smoothing=SMOOTHING.index("none"), tighten=False)),
         ("aca full run", dict(d, algorithm=ALGORITHMS.index("aca"), patience=0)),
+        ("ohaca full run", dict(d, patience=0, refine_patience=0, iterations=30)),
         ("paca", dict(d, algorithm=ALGORITHMS.index("paca"))),
         ("haca", dict(d, algorithm=ALGORITHMS.index("haca"))),
         ("aca die", dict(d, algorithm=ALGORITHMS.index("aca"), dead_end=DEAD_ENDS.index("die"))),

@@ -30,6 +30,7 @@ fn bench_plan(c: &mut Criterion) {
                 ants: 50,
                 iterations: 100,
                 patience: 0,
+                refine_patience: 0,
                 ..Params::default()
             },
         ),

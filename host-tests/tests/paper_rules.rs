@@ -248,6 +248,7 @@ fn fork_params(algorithm: Algorithm, beta: f32, a: f32, seed: u64) -> Params {
         seed,
         iterations: 60,
         patience: 0,
+        refine_patience: 0,
         ..Params::default()
     }
 }

@@ -581,6 +581,7 @@ fn refusals_no_map_map_too_large_busy_and_cancel() {
     let slow = Params {
         iterations: 60_000,
         patience: 0,
+        refine_patience: 0,
         ..Params::default()
     };
     link.set_params(&slow).expect("set params");
@@ -672,6 +673,7 @@ fn a_new_map_cancels_running_and_queued_plans_and_later_plans_use_it() {
     let slow = Params {
         iterations: 60_000,
         patience: 0,
+        refine_patience: 0,
         ..Params::default()
     };
     link.set_params(&slow).expect("set params");
@@ -1598,6 +1600,7 @@ fn a_cell_update_during_a_plan_cancels_it() {
     let slow = Params {
         iterations: 60_000,
         patience: 0,
+        refine_patience: 0,
         ..Params::default()
     };
     link.set_params(&slow).expect("set params");

@@ -1218,6 +1218,7 @@ fn soak_thousands_of_valid_and_broken_frames() {
                     ants: 20,
                     iterations: 60_000,
                     patience: 0,
+                    refine_patience: 0,
                     ..Params::default()
                 };
                 let f = encode(soak.id(), &Request::SetParams(slow));
