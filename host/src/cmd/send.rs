@@ -593,6 +593,23 @@ impl Outcome {
     }
 }
 
+/// One frame of a terminal progress bar (carriage return first, no newline): `map [####    ]
+/// 45 % 12.3 of 27.1 KiB, 1.2 s`.
+fn progress_bar(what: &str, done: usize, all: usize, elapsed: Duration) -> String {
+    const WIDTH: usize = 30;
+    let all = all.max(1);
+    let filled = (done.min(all) * WIDTH) / all;
+    format!(
+        "\r{what} [{}{}] {:>3} % {:.1} of {:.1} KiB, {:.1} s",
+        "#".repeat(filled),
+        " ".repeat(WIDTH - filled),
+        done.min(all) * 100 / all,
+        done as f64 / 1024.0,
+        all as f64 / 1024.0,
+        elapsed.as_secs_f64()
+    )
+}
+
 #[cfg(test)]
 #[allow(clippy::unwrap_used)]
 mod tests {
@@ -637,21 +654,4 @@ mod tests {
             assert!(parse_timeout(bad).is_err(), "{bad}");
         }
     }
-}
-
-/// One frame of a terminal progress bar (carriage return first, no newline): `map [####    ]
-/// 45 % 12.3 of 27.1 KiB, 1.2 s`.
-fn progress_bar(what: &str, done: usize, all: usize, elapsed: Duration) -> String {
-    const WIDTH: usize = 30;
-    let all = all.max(1);
-    let filled = (done.min(all) * WIDTH) / all;
-    format!(
-        "\r{what} [{}{}] {:>3} % {:.1} of {:.1} KiB, {:.1} s",
-        "#".repeat(filled),
-        " ".repeat(WIDTH - filled),
-        done.min(all) * 100 / all,
-        done as f64 / 1024.0,
-        all as f64 / 1024.0,
-        elapsed.as_secs_f64()
-    )
 }

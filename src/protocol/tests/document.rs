@@ -119,7 +119,7 @@ fn protocol_doc_example_is_what_the_planner_returns() {
     use crate::planner::{plan, Storage};
     let g = Grid::new(4, 3, &MAP).unwrap();
     // The device's links (4,096), so the local search runs as on the device.
-    let mut s: Box<Storage<1, 16, 4096, 16>> = Box::new(Storage::new());
+    let mut s: Box<Storage<1, 16, 4096, 16>> = Box::default();
     let p = plan(
         &g,
         Point::new(0, 0),
