@@ -23,6 +23,7 @@
 //! | [`tighten`] | path tightening: a finished ant path straightened before the pheromone update |
 //! | [`update`] | the per-iteration pheromone update: classic deposit and the wolves rule |
 //! | [`smoothing`] | line-of-sight smoothing of the raw ant path |
+//! | [`taut`] | the smoothed path pulled taut over the cell centres around it |
 //! | [`refine`] | local search: the exact shortest path in a window sliding along a raw path |
 //! | [`planner`] | parameters, caller-provided storage, the iteration loop and the result |
 //! | `heap` | (feature `alloc`) the planner's storage on the heap, sized at run time |
@@ -114,6 +115,7 @@ pub mod refine;
 pub mod rng;
 pub mod route;
 pub mod smoothing;
+pub mod taut;
 pub mod tighten;
 pub mod update;
 

@@ -221,11 +221,16 @@ impl Smoother {
             SmoothingKind::Shortest => {
                 while self.resume(grid, pts, dist, prev, usize::MAX) {}
                 let k = trace(pts, n, prev);
-                if self.ring < n {
+                let k = if self.ring < n {
                     merge(grid, pts, k)
                 } else {
                     k
-                }
+                };
+                // Off the raw path's cells: pulled taut over the centres around it (from the
+                // waypoints without their collinear ones, so the pull starts from the DP's path
+                // as `smooth` has always returned it).
+                let k = drop_collinear(pts, k);
+                crate::taut::pull(grid, pts, k)
             }
         };
         drop_collinear(pts, k)
@@ -729,7 +734,9 @@ mod tests {
             let g = Grid::new(40, 30, &b).unwrap();
             let n = raw.len();
             let mut want = raw.clone();
+            // The old DP, then the same taut pull the new one ends with.
             let kw = old_shortest(&g, &mut want, n);
+            let kw = crate::taut::pull(&g, &mut want, kw);
             let (dn, pn) = scratch_for(n);
             assert_eq!(dn, n);
             let mut got = raw.clone();

@@ -203,8 +203,18 @@ pub fn check_plan(
     }
     let waypoints = plan.waypoints().to_vec();
     let length = check_waypoints(map, start, goal, &waypoints)?;
-    if !is_subsequence(&waypoints, &raw) {
+    // Waypoints are raw cells, except OHACA's shortest smoothing, which pulls its path taut
+    // over the cell centres around the raw path (`ohaca::taut`): then it may not be longer than
+    // the raw path (checked with the lengths below).
+    let taut = p.algorithm == Algorithm::Ohaca && p.smoothing == ohaca::SmoothingKind::Shortest;
+    if !taut && !is_subsequence(&waypoints, &raw) {
         return Err("waypoints are not a subsequence of the raw path".into());
+    }
+    if taut && f64::from(plan.length) > raw_length + length_tolerance(raw_length) {
+        return Err(format!(
+            "smoothed length {} longer than the raw path {raw_length}",
+            plan.length
+        ));
     }
     // Lengths.
     let close =

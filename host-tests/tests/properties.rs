@@ -180,9 +180,10 @@ fn check_against_references(
             prop_assert!(len >= aa - 1e-3, "smoothed {len} < any-angle {aa}");
             prop_assert!(len <= raw + 1e-4, "smoothed {len} > raw {raw}");
             if p.algorithm == Algorithm::Ohaca && p.smoothing == SmoothingKind::Shortest {
+                // The best path through raw cells, then pulled taut off them: never longer.
                 let best = best_subsequence(m, &snap.raw);
                 prop_assert!(
-                    (len - best).abs() <= 1e-4 * best.max(1.0),
+                    len <= best + 1e-4 * best.max(1.0),
                     "shortest smoothing gave {len}, best subsequence path is {best}"
                 );
             }
@@ -286,7 +287,9 @@ proptest! {
                     prop_assert_eq!(h.raw_length, o.raw_length);
                     prop_assert_eq!(h.iterations, o.iterations);
                     prop_assert_eq!(h.moves, o.moves);
-                    prop_assert!(is_subsequence(&o.waypoints, &o.raw));
+                    if smoothing != SmoothingKind::Shortest {
+                        prop_assert!(is_subsequence(&o.waypoints, &o.raw));
+                    }
                     if smoothing == SmoothingKind::None {
                         prop_assert_eq!(&h.waypoints, &o.waypoints);
                         prop_assert_eq!(h.length, o.length);
