@@ -193,7 +193,7 @@ def main():
           f"{min(rtt):.0f} us | {max(rtt):.0f} us |")
     print("\nThe round trip is mostly QEMU's: its UART model takes one received byte per main-loop "
           "turn (about 0.1 ms a byte here) and the host's scheduling adds the spread. A real "
-          "115200 8N1 link needs 8.4 ms for Hello's 8 + 89 bytes on the wire alone.")
+          "115200 8N1 link needs 8.9 ms for Hello's 8 + 94 bytes on the wire alone.")
     mean_default = statistics.mean(r["ticks"] for r in early)
     if mean_default > 20_000:
         print(f"\nNOTE: the default plan takes {mi(mean_default):.1f} M instructions on average, "
