@@ -4,8 +4,9 @@
 //! One QEMU (UART0 on TCP, `nodelay=on`), one connection. A seeded generator writes
 //! `OHACA_SOAK_FRAMES` frames (default [`DEFAULT_FRAMES`]; seed `OHACA_SOAK_SEED`, default
 //! [`DEFAULT_SEED`]): valid requests — `Hello`, `Stats`, `SetParams` (cheap: at most 6 ants and
-//! 8 iterations; some out of range), `SetMap` (maps up to 16x16, now and then up to 32x32, in one
-//! or more chunks, some chunks re-sent, some uploads refused), `Plan` (free, blocked and
+//! 8 iterations; some out of range), `SetMap` (maps up to 16x16, now and then up to 32x32 or a corridor up
+//! to 1024 cells long, in one or more chunks, some chunks re-sent, some uploads refused: a side
+//! over 4096, more cells than the device holds, an empty chunk, a bad header or chunk), `Plan` (free, blocked and
 //! out-of-bounds cells, with and without a seed), `Cancel` — mixed with duplicated requests (the
 //! same frame twice, same id), bit-flipped, truncated, oversized, empty (a lone `00`) and
 //! random-garbage frames, and frames with a good CRC around a message that does not decode.
@@ -622,7 +623,11 @@ impl Soak {
 
     fn random_map(&mut self) -> Map {
         let r = &mut self.rng;
-        let (width, height) = if r.chance(0.1) {
+        let (width, height) = if r.chance(0.01) {
+            // Now and then a long corridor: wider than the 256-cell maps of protocol v5, legal
+            // since v6 (capacity by cells, any shape).
+            (r.range(257, 1024), r.range(1, 16))
+        } else if r.chance(0.1) {
             let w = r.range(1, 32);
             (w, r.range(1, 1024 / w).min(64))
         } else {
@@ -660,17 +665,24 @@ impl Soak {
                 total_len,
                 chunk,
             };
-            return match r.below(5) {
+            return match r.below(7) {
                 0 => {
-                    // A side over the device's 512.
+                    // A side over the device's longest (4096 on every board).
                     let (w, h) = if r.chance(0.5) {
-                        (r.range(513, 2000) as u16, r.range(1, 100) as u16)
+                        (r.range(4097, 6000) as u16, r.range(1, 10) as u16)
                     } else {
-                        (r.range(1, 100) as u16, r.range(513, 2000) as u16)
+                        (r.range(1, 10) as u16, r.range(4097, 6000) as u16)
                     };
                     let t = (u32::from(w) * u32::from(h)).div_ceil(8);
                     encode(id, &req(w, h, 0, t, &chunk))
                 }
+                5 => {
+                    // Sides that fit, cells that do not (any shape: 4096 x 17 > 65,536).
+                    let (w, h) = (4096u16, r.range(17, 100) as u16);
+                    let t = (u32::from(w) * u32::from(h)).div_ceil(8);
+                    encode(id, &req(w, h, 0, t, &chunk))
+                }
+                6 => encode(id, &req(16, 16, 0, 32, &[])), // an empty chunk: TooLarge 0
                 1 => encode(id, &req(10, 10, 0, 14, &chunk)),
                 2 => encode(id, &req(0, 7, 0, 0, &chunk)),
                 3 => encode(id, &req(16, 16, r.range(1, 40) as u32, 32, &chunk)),
