@@ -50,8 +50,14 @@ pub fn pull(grid: &Grid<'_>, pts: &mut [Point], n: usize) -> usize {
                 break;
             };
             if segment_clear(grid, a, c) {
-                // Drop b: pts[i..n] moves one to the left.
-                pts.copy_within(i.wrapping_add(1)..n, i);
+                // Drop b: pts[i + 1..n] moves one to the left (by hand: no bounds panic).
+                for j in i..n.wrapping_sub(1) {
+                    if let Some(&q) = pts.get(j.wrapping_add(1)) {
+                        if let Some(slot) = pts.get_mut(j) {
+                            *slot = q;
+                        }
+                    }
+                }
                 n = n.wrapping_sub(1);
                 changed = true;
                 continue;
@@ -77,7 +83,11 @@ fn best_shift(grid: &Grid<'_>, a: Point, b: Point, c: Point) -> Option<Point> {
     let now = distance(a, b) + distance(b, c);
     let mut best: Option<(f32, Point)> = None;
     for (dx, dy) in DX.iter().zip(DY.iter()) {
-        let (x, y) = (i32::from(b.x) + dx, i32::from(b.y) + dy);
+        // u16 coordinates and offsets of -1..=1: no i32 wraps.
+        let (x, y) = (
+            i32::from(b.x).wrapping_add(*dx),
+            i32::from(b.y).wrapping_add(*dy),
+        );
         let (Ok(x), Ok(y)) = (u16::try_from(x), u16::try_from(y)) else {
             continue;
         };
