@@ -3,7 +3,7 @@
 //! The input is a raw byte stream, as it would arrive on the UART. It goes byte by byte through
 //! a [`RequestReader`] exactly as `src/firmware/rx.rs` feeds it (`push(b).into_frame(..)`), every
 //! completed frame through [`decode_request`], and the same bytes through a [`ReplyReader`] and
-//! [`decode_reply`] as the host's link does (`host/src/link.rs`), then into the host's owned
+//! [`decode_reply`] as the host's link does (`host/src/link/`), then into the host's owned
 //! [`Response`]. Checked, besides "never panics":
 //!
 //! * the readers split the stream exactly as a reference splitter (split at `0x00`, drop empty
@@ -407,7 +407,7 @@ fn run_reader<const N: usize>(
     let mut got = Vec::with_capacity(want.len());
     let mut decoded = 0;
     for &b in data {
-        // Exactly as `src/firmware/rx.rs` and `host/src/link.rs` do it.
+        // Exactly as `src/firmware/rx.rs` and `host/src/link/` do it.
         let Some(f) = reader.push(b).into_frame(N) else {
             continue;
         };

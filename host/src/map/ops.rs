@@ -1,6 +1,6 @@
-//! Operations on a loaded map, to prepare it for a robot and a device: obstacle inflation,
-//! resampling to coarser cells ([`super::prepare`] does both as the map flags ask), and fitting
-//! a device's capacity ([`fit`], for `ohaca send`).
+//! Operations on a loaded map, to prepare it for a robot and a device: obstacle inflation and
+//! resampling to coarser cells ([`super::prepare`] does both as the map flags ask); fitting a
+//! device's capacity (crop, then resample) is [`super::fit`].
 //!
 //! - [`inflate`] blocks every cell whose centre lies within a radius of a blocked cell's centre,
 //!   so a robot of that radius, planned as a point, keeps clear of obstacles. The map's border is
