@@ -69,6 +69,9 @@ pub enum Lost {
     /// [`DeadEnd::Backtrack`]: the ant backed out of every branch to the start: the goal is not
     /// reachable (a proof, since pruned cells never disconnect the start from the goal).
     Exhausted,
+    /// The walk made more moves than [`Ant::budget`] allows and was abandoned: no proof of
+    /// anything, the ant simply costs no more.
+    Budget,
 }
 
 /// Everything an ant reads; borrowed for one iteration.
@@ -91,6 +94,9 @@ pub struct Ant<'g, 't, 'h> {
     pub dead: &'t [u32],
     /// Sub-goals of the potential field on large maps ([`crate::route`]); `None`: the goal.
     pub route: Option<&'t Route<'t>>,
+    /// Most moves (forward and back) the walk may make; one that needs more is abandoned
+    /// ([`Lost::Budget`]). `u32::MAX`: no bound, the walk goes on until it arrives or exhausts.
+    pub budget: u32,
 }
 
 /// `tau^alpha` with the common exponents done without `powf`.
@@ -218,6 +224,9 @@ impl Ant<'_, '_, '_> {
                 n = n.wrapping_add(1); // at most 8, like `seen`
             }
             moves = moves.saturating_add(1);
+            if moves > self.budget {
+                return Err(Lost::Budget);
+            }
             // One visited neighbour is the cell we came from; a second one may be a shortcut.
             may_tighten |= seen > 1;
             let d = if n == 0 {
@@ -329,6 +338,19 @@ mod tests {
         seed: u64,
         a: f32,
     ) -> Option<(Walk, Vec<u8>)> {
+        let (walk, tour) = walk_on(rows, (start, goal), dead_end, seed, a, u32::MAX);
+        walk.ok().map(|w| (w, tour[..w.steps].to_vec()))
+    }
+
+    /// One walk with move budget `budget`: its result and the whole tour buffer.
+    fn walk_on(
+        rows: &[&str],
+        (start, goal): (Point, Point),
+        dead_end: DeadEnd,
+        seed: u64,
+        a: f32,
+        budget: u32,
+    ) -> (Result<Walk, Lost>, Vec<u8>) {
         let (b, w, h) = setup(rows);
         let g = Grid::new(w, h, &b).unwrap();
         let mut tau_buf = vec![[1.0f32; 4]; g.cells()];
@@ -346,13 +368,41 @@ mod tests {
             dead_end,
             dead: &dead,
             route: None,
+            budget,
         };
         let mut tabu = vec![0u32; bitmap::words(g.cells())];
         let mut tour = vec![0u8; g.cells()];
         let mut rng = Xoshiro128pp::from_u64(seed);
-        c.walk(&mut rng, &mut tabu, &mut tour)
-            .ok()
-            .map(|w| (w, tour[..w.steps].to_vec()))
+        let walk = c.walk(&mut rng, &mut tabu, &mut tour);
+        (walk, tour)
+    }
+
+    #[test]
+    fn a_walk_over_its_move_budget_is_abandoned_and_one_within_it_is_unchanged() {
+        // The pull of the goal leads into the pocket first: the walk needs backtracking moves.
+        let rows = [
+            "......", //
+            ".####.", //
+            ".#..#.", //
+            ".#..#.", //
+            ".#....", //
+        ];
+        let ends = (Point::new(2, 2), Point::new(0, 0));
+        let mut abandoned = 0;
+        for seed in 0..50 {
+            let (free, tour) = walk_on(&rows, ends, DeadEnd::Backtrack, seed, 0.05, u32::MAX);
+            let free = free.unwrap();
+            // Exactly enough: the same walk, the same tour.
+            let (exact, again) = walk_on(&rows, ends, DeadEnd::Backtrack, seed, 0.05, free.moves);
+            assert_eq!(exact, Ok(free));
+            assert_eq!(again[..free.steps], tour[..free.steps]);
+            // One move short: abandoned, whatever the seed.
+            let (short, _) = walk_on(&rows, ends, DeadEnd::Backtrack, seed, 0.05, free.moves - 1);
+            assert_eq!(short, Err(Lost::Budget));
+            abandoned += usize::from(free.moves > free.steps as u32);
+        }
+        // The pocket made some walks back out of it: the budget had backtracking to cut.
+        assert!(abandoned > 0);
     }
 
     #[test]

@@ -61,6 +61,10 @@ pub struct Run<'g, 'a> {
     no_path: bool,
     /// Ants dropped so far because their paths outgrew the workspace ([`Error::PathTooLong`]).
     dropped: u32,
+    /// Ants abandoned so far for their moves ([`colony::MOVE_BUDGET`]).
+    abandoned: u32,
+    /// The fewest moves any ant of this run made to arrive.
+    cheapest: Option<u32>,
     done: bool,
 }
 
@@ -222,6 +226,8 @@ impl<'g, 'a> Run<'g, 'a> {
             colony: None,
             no_path: false,
             dropped: 0,
+            abandoned: 0,
+            cheapest: None,
             done: false,
         })
     }
@@ -229,6 +235,12 @@ impl<'g, 'a> Run<'g, 'a> {
     /// Ant moves made so far.
     pub fn moves(&self) -> u64 {
         self.moves
+    }
+
+    /// Ants abandoned so far because they made more moves than the run's move budget allows
+    /// (runs with the local search only; see `docs/ALGORITHM.md`, "Move budget").
+    pub fn abandoned(&self) -> u32 {
+        self.abandoned
     }
 
     /// Cells pruned before the ants ran.
