@@ -99,6 +99,7 @@ mod named;
 
 pub mod ant;
 pub mod bitmap;
+pub mod corridor;
 pub mod dir;
 pub mod error;
 pub mod geometry;

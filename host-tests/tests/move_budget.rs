@@ -27,7 +27,11 @@ fn walled_in_ants_are_abandoned_after_the_first_iteration_and_the_path_stays_opt
         };
         let mut run = Run::new(&grid, case.start, case.goal, &p, st.workspace()).unwrap();
         run.step();
-        assert_eq!(run.abandoned(), 0, "seed {seed}: the first iteration has no budget");
+        assert_eq!(
+            run.abandoned(),
+            0,
+            "seed {seed}: the first iteration has no budget"
+        );
         while run.step() {}
         assert!(run.abandoned() > 0, "seed {seed}: no walk was over budget");
         moves.push(run.moves());

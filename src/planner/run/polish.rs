@@ -73,7 +73,9 @@ impl Run<'_, '_> {
         } else {
             SmoothingKind::None
         };
-        let dist = ws.delta.as_flattened_mut();
+        // The exact corridor search of small maps ([`crate::corridor`]): OHACA's default smoothing
+        // on maps whose pheromone increments lend one entry a cell.
+        let corridor = kind == SmoothingKind::Shortest && self.blocks.shift() == 0;
         self.polish = match self.polish {
             Polish::Start => {
                 // Expand the tour into cells.
@@ -88,7 +90,12 @@ impl Run<'_, '_> {
                     .flatten();
                 match refiner {
                     Some(r) => Polish::Refine(r),
-                    None => Polish::Smooth(Smoother::new(kind, n, dist, ws.links)),
+                    None => Polish::Smooth(Smoother::new(
+                        kind,
+                        n,
+                        ws.delta.as_flattened_mut(),
+                        ws.links,
+                    )),
                 }
             }
             Polish::Refine(mut r) => {
@@ -129,18 +136,35 @@ impl Run<'_, '_> {
                         straight,
                         diagonal,
                     });
-                    Polish::Smooth(Smoother::new(kind, n, dist, ws.links))
+                    Polish::Smooth(Smoother::new(
+                        kind,
+                        n,
+                        ws.delta.as_flattened_mut(),
+                        ws.links,
+                    ))
                 } else {
                     Polish::Refine(r)
                 }
             }
             Polish::Smooth(mut sm) => {
+                let dist = ws.delta.as_flattened_mut();
                 if sm.resume(grid, ws.points, dist, ws.links, SMOOTH_SLICE) {
                     Polish::Smooth(sm)
                 } else {
-                    Polish::Done {
-                        waypoints: sm.finish(grid, ws.points, dist, ws.links),
-                    }
+                    let k = sm.finish(grid, ws.points, dist, ws.links);
+                    let waypoints = if corridor {
+                        crate::corridor::shortest(
+                            grid,
+                            ws.points,
+                            k,
+                            crate::corridor::RADIUS,
+                            ws.delta,
+                            ws.links,
+                        )
+                    } else {
+                        k
+                    };
+                    Polish::Done { waypoints }
                 }
             }
             done @ Polish::Done { .. } => done,
