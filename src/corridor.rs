@@ -40,15 +40,15 @@ const MIN_GAIN: f32 = 1e-4;
 const CANDIDATE: u32 = 1;
 const CLOSED: u32 = 2;
 
-/// Per-cell scratch entry: `[g, parent index (bits), flags (bits), unused]`.
+/// Per-cell scratch entry: `[g, parent index (bits), flags (bits), h = distance to the goal]`.
 type Entry = [f32; 4];
 
 /// Replace `pts[..n]` (a valid path from its first to its last point) by the shortest path through
 /// the free cell centres within `radius` of its segments, if that is shorter; returns the new
 /// point count. `pts` beyond `n` is room for a new path of more points than the input (the
 /// planner's path buffer has the raw path's length); `cell` is scratch of one entry per map cell,
-/// `list` scratch for the corridor's cells. Any of them too short (or a corridor larger than
-/// `list`) leaves the path unchanged.
+/// `list` scratch for the corridor's cells and its open ones (at most twice the corridor's cells).
+/// Any of them too short leaves the path unchanged.
 pub fn shortest(
     grid: &Grid<'_>,
     pts: &mut [Point],
@@ -73,26 +73,43 @@ pub fn shortest(
     let Some(v) = mark(grid, path, radius, cell, list) else {
         return n;
     };
-    let list = list.get(..v).unwrap_or_default();
-    let (s, t) = (grid.index(start), grid.index(goal));
-    if let Some(e) = cell.get_mut(s) {
-        e[0] = 0.0;
+    // `list[..v]`: the corridor's cells; the rest holds the open ones (those with a finite `g`
+    // that are not closed yet), so picking the next one scans only them.
+    let (list, open) = list.split_at_mut(v.min(list.len()));
+    for &c in list.iter() {
+        let q = unpack(c);
+        if let Some(e) = cell.get_mut(grid.index(q)) {
+            e[3] = distance(q, goal);
+        }
     }
-    // A*: expand the open candidate of least g + h (the first one on ties) until the goal closes.
-    loop {
+    let (s, t) = (grid.index(start), grid.index(goal));
+    let Some(e) = cell.get_mut(s) else {
+        return n;
+    };
+    e[0] = 0.0;
+    let Some(slot) = open.first_mut() else {
+        return n;
+    };
+    *slot = s as u32;
+    let mut open_len = 1usize;
+    // A*: expand the open cell of least g + h (the first one on ties) until the goal closes.
+    while open_len > 0 {
         let mut best: Option<(usize, f32)> = None;
-        for &c in list {
-            let c = c as usize;
-            let Some(e) = cell.get(c) else { continue };
-            if e[2].to_bits() & CLOSED != 0 || e[0] == f32::INFINITY {
-                continue;
-            }
-            let f = e[0] + distance(grid.point(c), goal);
+        for (k, &c) in open.iter().enumerate().take(open_len) {
+            let f = cell.get(c as usize).map_or(f32::INFINITY, |e| e[0] + e[3]);
             if best.is_none_or(|(_, bf)| f < bf) {
-                best = Some((c, f));
+                best = Some((k, f));
             }
         }
-        let Some((i, _)) = best else { break };
+        let Some((k, _)) = best else { break };
+        // Take it out of the open list: the last open cell fills its place.
+        open_len = open_len.wrapping_sub(1); // > 0: the loop's condition
+        let i = open.get(k).copied().unwrap_or(0) as usize;
+        if let Some(&last) = open.get(open_len) {
+            if let Some(slot) = open.get_mut(k) {
+                *slot = last;
+            }
+        }
         let Some(e) = cell.get_mut(i) else { break };
         e[2] = f32::from_bits(e[2].to_bits() | CLOSED);
         let gi = e[0];
@@ -101,18 +118,38 @@ pub fn shortest(
         }
         let p = grid.point(i);
         let limit = cell.get(t).map_or(bound, |e| e[0].min(bound));
-        for &j in list {
-            let j = j as usize;
+        for &c in list.iter() {
+            let q = unpack(c);
+            let j = grid.index(q);
             let Some(e) = cell.get(j) else { continue };
             if e[2].to_bits() & CLOSED != 0 {
                 continue;
             }
-            let q = grid.point(j);
+            // Lower bounds of the Euclidean distance (Chebyshev, and the octile diagonal's): most
+            // candidates fail one of the two tests without a square root.
+            let (dx, dy) = (p.x.abs_diff(q.x), p.y.abs_diff(q.y));
+            let cheb = f32::from(dx.max(dy));
+            let diag = (f32::from(dx) + f32::from(dy)) * core::f32::consts::FRAC_1_SQRT_2;
+            // (Not `f32::max`: on the Cortex-M4F that is a call to `fmaxf`.)
+            let low = gi + if cheb > diag { cheb } else { diag };
+            if low >= e[0] || low + e[3] >= limit {
+                continue;
+            }
             let nd = gi + distance(p, q);
-            if nd < e[0] && nd + distance(q, goal) < limit && segment_clear(grid, p, q) {
+            if nd < e[0] && nd + e[3] < limit && segment_clear(grid, p, q) {
+                let first = e[0] == f32::INFINITY;
                 if let Some(e) = cell.get_mut(j) {
                     e[0] = nd;
                     e[1] = f32::from_bits(i as u32);
+                }
+                if first {
+                    // A cell opens once (closed cells are never relaxed), so the open list never
+                    // holds more than the corridor's cells; no room left: stop improving.
+                    let Some(slot) = open.get_mut(open_len) else {
+                        return n;
+                    };
+                    *slot = j as u32;
+                    open_len = open_len.wrapping_add(1);
                 }
             }
         }
@@ -143,6 +180,16 @@ pub fn shortest(
         c = cell.get(c).map_or(s, |e| e[1].to_bits() as usize);
     }
     drop_collinear(pts, m)
+}
+
+/// A cell as one word in the corridor's list (`x` high, `y` low): no division to get it back.
+fn pack(p: Point) -> u32 {
+    (u32::from(p.x) << 16) | u32::from(p.y)
+}
+
+/// [`pack`] undone.
+fn unpack(c: u32) -> Point {
+    Point::new((c >> 16) as u16, c as u16)
 }
 
 /// Mark every free cell within `radius` of `path`'s segments as a candidate and list it; returns
@@ -189,7 +236,7 @@ fn mark(
                         continue;
                     }
                     e[2] = f32::from_bits(CANDIDATE);
-                    *list.get_mut(v)? = c as u32;
+                    *list.get_mut(v)? = pack(q);
                     v = v.wrapping_add(1); // < list.len(): the slot existed
                 }
             }
@@ -209,7 +256,7 @@ mod tests {
         let mut pts: Vec<Point> = path.iter().map(|&(x, y)| Point::new(x, y)).collect();
         let before = polyline_length(&pts);
         let mut cell = vec![[0.0f32; 4]; g.cells()];
-        let mut list = vec![0u32; g.cells()];
+        let mut list = vec![0u32; 2 * g.cells()];
         let n = shortest(&g, &mut pts, path.len(), radius, &mut cell, &mut list);
         pts.truncate(n);
         for s in pts.windows(2) {

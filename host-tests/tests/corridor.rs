@@ -34,7 +34,7 @@ fn corridor(m: &Map, input: &[Point], radius: u16) -> Vec<Point> {
     let mut pts = input.to_vec();
     pts.resize(m.cells(), Point::new(0, 0));
     let mut cell = vec![[0.0f32; 4]; m.cells()];
-    let mut list = vec![0u32; m.cells()];
+    let mut list = vec![0u32; 2 * m.cells()];
     let n = shortest(
         &m.grid(),
         &mut pts,
