@@ -605,7 +605,14 @@ mod tests {
             let g0 = Grid::new(w as u16, h as u16, &b).unwrap();
             let mut words = vec![0u32; GUIDE_BLOCKS];
             let mut heap = vec![0u32; GUIDE_BLOCKS];
-            assert!(build(&Moves::new(g0, &[]), blocks, goal, &dead, &mut words, &mut heap));
+            assert!(build(
+                &Moves::new(g0, &[]),
+                blocks,
+                goal,
+                &dead,
+                &mut words,
+                &mut heap
+            ));
             let mut kept = vec![0f32; stash_len(blocks)];
             assert!(stash(blocks, &words, &mut kept));
             // Scribble over the words, as the local search does with its scratch.
@@ -626,24 +633,34 @@ mod tests {
                         }
                     }
                 }
-                (Point::new(x0 as u16, y0 as u16), Point::new(x1 as u16, y1 as u16))
+                (
+                    Point::new(x0 as u16, y0 as u16),
+                    Point::new(x1 as u16, y1 as u16),
+                )
             });
             let g1 = Grid::new(w as u16, h as u16, &b).unwrap();
             assert!(unstash(blocks, &kept, &mut words));
             let m1 = Moves::new(g1, &[]);
-            assert!(repair(&m1, blocks, goal, &dead, &mut words, &mut heap, area));
+            assert!(repair(
+                &m1, blocks, goal, &dead, &mut words, &mut heap, area
+            ));
             let mut fresh = vec![0u32; GUIDE_BLOCKS];
             assert!(build(&m1, blocks, goal, &dead, &mut fresh, &mut heap));
             let n = blocks.count();
             assert_eq!(words[..n], fresh[..n], "round {round}: {w} x {h}, {area:?}");
         }
-        assert!(shifts[0] > 20 && shifts[1] > 20 && shifts[2] > 10, "{shifts:?}");
+        assert!(
+            shifts[0] > 20 && shifts[1] > 20 && shifts[2] > 10,
+            "{shifts:?}"
+        );
     }
 
     #[test]
     fn stash_keeps_the_links_only() {
         let blocks = blocks(256, 256);
-        let words: Vec<u32> = (0..GUIDE_BLOCKS as u32).map(|i| i.wrapping_mul(2654435761)).collect();
+        let words: Vec<u32> = (0..GUIDE_BLOCKS as u32)
+            .map(|i| i.wrapping_mul(2654435761))
+            .collect();
         let mut kept = vec![0f32; stash_len(blocks)];
         assert_eq!(kept.len(), 2048);
         assert!(stash(blocks, &words, &mut kept));
