@@ -211,8 +211,8 @@ pub fn unstash(blocks: Blocks, kept: &[f32], words: &mut [u32]) -> bool {
     for (pair, slot) in words.chunks_mut(2).zip(kept) {
         // An integer below 2^16 (see `stash`): the cast is exact.
         let v = *slot as u32;
-        for (k, w) in pair.iter_mut().enumerate() {
-            *w = (v >> (8 * k as u32)) & 0xFF;
+        for (w, byte) in pair.iter_mut().zip([v & 0xFF, (v >> 8) & 0xFF]) {
+            *w = byte;
         }
     }
     true

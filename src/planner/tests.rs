@@ -591,7 +591,6 @@ fn warm_starts_that_repair_the_marks_and_the_route_plan_what_rebuilding_ones_do(
         let mut st_plain = Box::new(SLarge::new());
         let (mut mem_keep, mut mem_plain) = (Memory::new(), Memory::new());
         let mut start = Point::new(0, 0);
-        let mut raw: Vec<Point> = Vec::new();
         for leg in 0..3 {
             let g = Grid::new(w, h, &b).unwrap();
             let mut outcomes = Vec::new();
@@ -631,7 +630,7 @@ fn warm_starts_that_repair_the_marks_and_the_route_plan_what_rebuilding_ones_do(
             let Some(Some(o)) = outcomes.pop() else {
                 return;
             };
-            raw = o.0;
+            let raw = o.0;
             // Drive a third of the way, then a wall of 5 cells across the path 4 cells ahead
             // (leg 0), or the wall opens again (leg 1).
             start = raw[raw.len() / 3];

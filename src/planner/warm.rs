@@ -10,7 +10,7 @@
 //! | pheromone, away from the changes | kept, clamped into the current `[tau_min, tau_max]` |
 //! | pheromone within [`REPAIR_RADIUS`] cells of a change | set back to `tau0`, as in a cold start |
 //! | pheromone on edges into new obstacles | kept: ants are never offered a blocked move, so it is inert |
-//! | pruned cells, the coarse route | rebuilt from scratch: they depend on the start, which moved |
+//! | pruned cells, the coarse route | repaired around the changes and the two starts when the last run kept them ([`super::Run::keep`]): [`crate::prune::repair`], [`crate::route::repair`], bit for bit what a rebuild gives; else rebuilt |
 //! | reachability | not checked up front with backtracking ants: the first ant proves a cut-off goal |
 //! | the early stop | after [`Params::warm_patience`] stale iterations instead of [`Params::patience`] |
 //!
