@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# Warm against cold replanning on the firmware under `qemu-system-arm -icount shift=0`: the six
+# Warm against cold replanning on the firmware under `qemu-system-arm -icount shift=0`: the seven
 # scenarios of BENCHMARKS.md ("Replanning") -- complex-26, Boston_0_256 and the lab ROS map, each
-# with a wall appearing across the path and with a door opening -- driven by `ohaca replan
+# with a wall appearing across the path and with a door opening, and Paris_1_256 with a street
+# closed (`scenarios/city-wall.json`: 15 cells across the path) -- driven by `ohaca replan
 # --compare` over the emulated UART for seeds 1..=N. Prints a Markdown table: the replan's
 # instructions (ticks x 1000), iterations and raw length over the exact optimum, warm and cold.
 #
@@ -35,6 +36,8 @@ if [ "$host" = 0 ]; then
 fi
 c26=(--map maps/complex-26.map --start 0,0 --goal 25,25)
 boston=(--map maps/large/Boston_0_256.map --start 184,0 --goal 8,254)
+# Paris: the longest scenario of its .scen file (optimum 435.96).
+paris=(--map maps/large/Paris_1_256.map --start 156,255 --goal 18,15)
 lab=(--map host/assets/ros/lab.yaml --start-m -1.2,-0.8 --goal-m 7.25,3.7 --inflate 0.2)
 out=$(mktemp)
 run() { # name, events, map args...
@@ -48,6 +51,7 @@ run "complex-26, wall" scenarios/wall.json "${c26[@]}"
 run "complex-26, door opens" scenarios/complex-26-gap.json "${c26[@]}"
 run "Boston_0_256, wall" scenarios/wall.json "${boston[@]}"
 run "Boston_0_256, door opens" scenarios/boston-256-gap.json "${boston[@]}"
+run "Paris_1_256, city wall" scenarios/city-wall.json "${paris[@]}"
 run "lab.yaml 5 cm, wall" scenarios/wall.json "${lab[@]}"
 run "lab.yaml 5 cm, door opens" scenarios/lab-gap.json "${lab[@]}"
 python3 - "$out" "$host" <<'PY'

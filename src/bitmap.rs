@@ -28,6 +28,14 @@ pub fn set(bits: &mut [u32], i: usize) {
     }
 }
 
+/// Remove cell `i` from the set.
+#[inline]
+pub fn unset(bits: &mut [u32], i: usize) {
+    if let Some(w) = bits.get_mut(i >> 5) {
+        *w &= !(1 << (i & 31));
+    }
+}
+
 /// Add cell `i`; returns true if it was not in the set before.
 #[inline]
 pub fn insert(bits: &mut [u32], i: usize) -> bool {

@@ -112,6 +112,204 @@ pub fn prune(
     }
 }
 
+/// A rectangle of cells, corners included: `(top-left, bottom-right)`.
+pub type Rect = (Point, Point);
+
+/// What [`repair`] changed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Repaired {
+    /// Cells marked now (all of them, as [`prune`] returns).
+    pub pruned: u32,
+    /// A rectangle holding every cell whose mark may differ from before (`None`: none does).
+    pub touched: Option<Rect>,
+    /// True if the local repair ran out of stack and pruned the whole map again instead.
+    pub rebuilt: bool,
+}
+
+/// Repair the marks [`prune`] left in `dead` for `old_start` and `goal` after the map changed
+/// inside `changed` (or nowhere) and the start moved to `start`, so that `dead` ends equal to
+/// `prune(moves, start, goal, ..)` on the map as it is now, bit for bit, without a pass over
+/// the map.
+///
+/// Pruning is the least set closed under the local rule (a cell goes when its remaining
+/// neighbours are a clique; see the module docs), which only ever looks at a cell's 3 x 3
+/// neighbourhood of the map and of the marks. So:
+///
+/// 1. **Un-prune** every marked cell within one cell of `changed` (its neighbourhood changed)
+///    and the new start (now exempt), and then every marked cell 8-connected to one un-pruned:
+///    a connected group of marks that touches none of these was derived from the unchanged
+///    map and from marks of its own group only, so it is still derivable; any other mark may
+///    not be, and is dropped.
+/// 2. **Re-prune** from the local rule, as [`prune`] does, on the candidates: the un-pruned
+///    cells, the cells within one cell of `changed`, the old start (no longer exempt), and the
+///    neighbours of every cell pruned here. Any other cell was not prunable before with at
+///    least as many marks around it and an unchanged neighbourhood, so it is not now.
+///
+/// Both steps are exact (a property test compares them with [`prune`] on random maps with random
+/// changes). `stack` is scratch: the un-pruned cells and the re-pruning's stack. If it is too
+/// short, the whole map is pruned again ([`Repaired::rebuilt`]), with the same result.
+pub fn repair(
+    moves: &Moves<'_>,
+    (old_start, start, goal): (Point, Point, Point),
+    changed: Option<Rect>,
+    dead: &mut [u32],
+    stack: &mut [u32],
+) -> Repaired {
+    let grid = *moves.grid();
+    let cells = grid.cells();
+    let rebuild = |dead: &mut [u32], stack: &mut [u32]| {
+        let pruned = prune(moves, start, goal, dead, stack);
+        let last = grid.point(cells.saturating_sub(1));
+        Repaired {
+            pruned,
+            touched: Some((Point::new(0, 0), last)),
+            rebuilt: true,
+        }
+    };
+    if dead.len() < bitmap::words(cells) || cells == 0 {
+        return rebuild(dead, stack);
+    }
+    let offsets = grid.offsets();
+    let (si, gi) = (grid.index(start), grid.index(goal));
+    // The cells within one cell of the changes, clamped to the map.
+    let near = changed.map(|(lo, hi)| {
+        let max = grid.point(cells.wrapping_sub(1));
+        (
+            Point::new(lo.x.saturating_sub(1), lo.y.saturating_sub(1)),
+            Point::new(
+                hi.x.saturating_add(1).min(max.x),
+                hi.y.saturating_add(1).min(max.y),
+            ),
+        )
+    });
+    let mut touched = Bounds::default();
+    // 1. Un-prune: `stack[..n]` lists the cells un-pruned, and is also the flood's queue.
+    let mut n = 0usize;
+    let mut full = false;
+    let mut unprune = |dead: &mut [u32], stack: &mut [u32], n: &mut usize, ci: usize| {
+        if !bitmap::get(dead, ci) {
+            return;
+        }
+        bitmap::unset(dead, ci);
+        touched.add(grid.point(ci));
+        match stack.get_mut(*n) {
+            Some(s) => {
+                *s = ci as u32; // a cell index: < 2^32
+                *n = n.wrapping_add(1);
+            }
+            None => full = true,
+        }
+    };
+    if let Some((lo, hi)) = near {
+        for y in lo.y..=hi.y {
+            for x in lo.x..=hi.x {
+                unprune(dead, stack, &mut n, grid.index(Point::new(x, y)));
+            }
+        }
+    }
+    unprune(dead, stack, &mut n, si);
+    let mut i = 0usize;
+    while i < n {
+        let Some(&ci) = stack.get(i) else { break };
+        i = i.wrapping_add(1);
+        let p = grid.point(ci as usize);
+        for d in 0..8u8 {
+            if let Some(q) = grid.step(p, d) {
+                unprune(dead, stack, &mut n, grid.index(q));
+            }
+        }
+    }
+    if full {
+        return rebuild(dead, stack);
+    }
+    // 2. Re-prune from the candidates, with the rest of `stack` as the cascade's stack.
+    let (list, rest) = stack.split_at_mut(n.min(stack.len()));
+    let mut settle = Settle {
+        moves,
+        offsets: &offsets,
+        si,
+        gi,
+        stack: rest,
+        full: false,
+        touched: &mut touched,
+    };
+    for &ci in list.iter() {
+        settle.at(dead, ci as usize);
+    }
+    if let Some((lo, hi)) = near {
+        for y in lo.y..=hi.y {
+            for x in lo.x..=hi.x {
+                settle.at(dead, grid.index(Point::new(x, y)));
+            }
+        }
+    }
+    if grid.contains(old_start) {
+        settle.at(dead, grid.index(old_start));
+    }
+    if settle.full {
+        return rebuild(dead, stack);
+    }
+    Repaired {
+        pruned: bitmap::count(dead, cells),
+        touched: touched.rect(),
+        rebuilt: false,
+    }
+}
+
+/// The bounding box of some cells.
+#[derive(Clone, Copy, Debug, Default)]
+struct Bounds(Option<Rect>);
+
+impl Bounds {
+    fn add(&mut self, p: Point) {
+        self.0 = Some(match self.0 {
+            None => (p, p),
+            Some((lo, hi)) => (
+                Point::new(lo.x.min(p.x), lo.y.min(p.y)),
+                Point::new(hi.x.max(p.x), hi.y.max(p.y)),
+            ),
+        });
+    }
+    fn rect(self) -> Option<Rect> {
+        self.0
+    }
+}
+
+/// The re-pruning of [`repair`]: the local rule at a cell, then depth-first over the neighbours
+/// of every cell it prunes.
+struct Settle<'m, 's> {
+    moves: &'m Moves<'m>,
+    offsets: &'m [isize; 8],
+    si: usize,
+    gi: usize,
+    stack: &'s mut [u32],
+    /// The stack was too short for some neighbours.
+    full: bool,
+    touched: &'s mut Bounds,
+}
+
+impl Settle<'_, '_> {
+    fn at(&mut self, dead: &mut [u32], ci: usize) {
+        let grid = *self.moves.grid();
+        let (m, o, si, gi) = (self.moves, self.offsets, self.si, self.gi);
+        if !try_prune(m, o, si, gi, dead, ci, grid.point(ci)) {
+            return;
+        }
+        self.touched.add(grid.point(ci));
+        let mut top = 0usize;
+        self.full |= push_neighbours(m, o, ci, self.stack, &mut top);
+        while top > 0 {
+            top = top.wrapping_sub(1);
+            let Some(&u) = self.stack.get(top) else { break };
+            let u = u as usize;
+            if try_prune(m, o, si, gi, dead, u, grid.point(u)) {
+                self.touched.add(grid.point(u));
+                self.full |= push_neighbours(m, o, u, self.stack, &mut top);
+            }
+        }
+    }
+}
+
 /// Prune cell `ci` (at `p`) if it is prunable; true if it was pruned now.
 #[inline]
 fn try_prune(
@@ -365,6 +563,245 @@ mod tests {
                 "stack {s}"
             );
         }
+    }
+
+    /// Marks of `rows` pruned from scratch for `s`, `g`, as rows of `x` / `.` / `#`.
+    fn show(g: &Grid<'_>, dead: &[u32]) -> Vec<String> {
+        (0..g.height())
+            .map(|y| {
+                (0..g.width())
+                    .map(|x| {
+                        let p = Point::new(x, y);
+                        if !g.is_free(p) {
+                            '#'
+                        } else if bitmap::get(dead, g.index(p)) {
+                            'x'
+                        } else {
+                            '.'
+                        }
+                    })
+                    .collect()
+            })
+            .collect()
+    }
+
+    /// Prune `before` for `(s0, goal)`, then repair for `after` (the same size) and `s1`, with
+    /// the changed cells' rectangle `changed`; returns the repaired marks, the from-scratch marks
+    /// on `after` and what `repair` said.
+    fn repaired(
+        before: &[&str],
+        after: &[&str],
+        (s0, s1, goal): (Point, Point, Point),
+        changed: Option<Rect>,
+        stack: usize,
+    ) -> (Vec<String>, Vec<String>, Repaired) {
+        let (b0, w, h) = grid_from(before);
+        let (b1, _, _) = grid_from(after);
+        let g0 = Grid::new(w, h, &b0).unwrap();
+        let g1 = Grid::new(w, h, &b1).unwrap();
+        let mut dead = vec![0u32; bitmap::words(g0.cells())];
+        let mut st = vec![0u32; stack];
+        prune(&Moves::new(g0, &[]), s0, goal, &mut dead, &mut st);
+        let r = repair(
+            &Moves::new(g1, &[]),
+            (s0, s1, goal),
+            changed,
+            &mut dead,
+            &mut st,
+        );
+        let mut fresh = vec![0u32; bitmap::words(g1.cells())];
+        let n = prune(&Moves::new(g1, &[]), s1, goal, &mut fresh, &mut st);
+        assert_eq!(r.pruned, n);
+        (show(&g1, &dead), show(&g1, &fresh), r)
+    }
+
+    #[test]
+    fn repair_revives_a_dead_end_that_a_change_opened() {
+        // The corridor along the bottom is a dead end (pruned whole) until the wall at its right
+        // end opens: then it is a way to the goal, and every one of its cells must come back,
+        // also the ones far from the change (the un-pruning follows the connected marks).
+        let before = [
+            "......#", //
+            ".####.#", //
+            ".#....#", //
+            ".######", //
+            "......#", //
+        ];
+        let after = [
+            "......#", //
+            ".####.#", //
+            ".#....#", //
+            ".######", //
+            ".......", //
+        ];
+        let (s, g) = (Point::new(0, 0), Point::new(6, 4));
+        let changed = Some((Point::new(6, 4), Point::new(6, 4)));
+        let (got, want, r) = repaired(&before, &after, (s, s, g), changed, 64);
+        assert_eq!(got, want);
+        assert_eq!(&got[4][..6], "......", "{got:?}");
+        assert!(!r.rebuilt);
+    }
+
+    #[test]
+    fn repair_prunes_the_branch_the_old_start_kept() {
+        // The start at the end of a dead-end branch keeps the branch; once the robot has left
+        // it, the whole branch is prunable, starting from the old start (no longer exempt).
+        let rows = [
+            "#########", //
+            "........#", //
+            "#######.#", //
+            "........#", //
+        ];
+        let (s0, s1, g) = (Point::new(0, 1), Point::new(7, 2), Point::new(0, 3));
+        let (got, want, r) = repaired(&rows, &rows, (s0, s1, g), None, 64);
+        assert_eq!(got, want);
+        assert_eq!(&got[1][..7], "xxxxxxx", "{got:?}");
+        assert!(!r.rebuilt);
+        let (lo, hi) = r.touched.unwrap();
+        assert!(
+            lo.x == 0 && hi.x >= 6 && lo.y <= 1 && hi.y >= 1,
+            "{:?}",
+            r.touched
+        );
+    }
+
+    #[test]
+    fn repair_revives_the_branch_of_the_new_start() {
+        // The reverse: the robot is put down inside a branch that was pruned; the new start is
+        // exempt, and the cells between it and the rest of the map come back with it.
+        let rows = [
+            "#########", //
+            "........#", //
+            "#######.#", //
+            "........#", //
+        ];
+        let (s0, s1, g) = (Point::new(7, 2), Point::new(1, 1), Point::new(0, 3));
+        let (got, want, r) = repaired(&rows, &rows, (s0, s1, g), None, 64);
+        assert_eq!(got, want);
+        assert_eq!(&got[1][1..7], "......", "{got:?}");
+        assert!(!r.rebuilt);
+    }
+
+    #[test]
+    fn repair_with_a_short_stack_prunes_again() {
+        // The revived corridor of the first test is 6 cells: a list of 2 cannot hold them.
+        let before = ["......#", ".####.#", ".#....#", ".######", "......#"];
+        let after = ["......#", ".####.#", ".#....#", ".######", "......."];
+        let (s, g) = (Point::new(0, 0), Point::new(6, 4));
+        let changed = Some((Point::new(6, 4), Point::new(6, 4)));
+        let (got, want, r) = repaired(&before, &after, (s, s, g), changed, 2);
+        assert_eq!(got, want);
+        assert!(r.rebuilt);
+    }
+
+    #[test]
+    fn repair_equals_pruning_from_scratch_on_random_maps_with_random_changes() {
+        let mut x = 0x9e37_79b9u32;
+        let mut rnd = move || {
+            x ^= x << 13;
+            x ^= x >> 17;
+            x ^= x << 5;
+            x
+        };
+        let (mut local, mut unpruned) = (0, 0);
+        for round in 0..3000 {
+            let (w, h) = (3 + rnd() % 14, 3 + rnd() % 12);
+            let cells = (w * h) as usize;
+            let density = [8u32, 16, 28, 40][round % 4];
+            let mut b = vec![0u8; cells.div_ceil(8)];
+            for i in 0..cells {
+                if rnd() % 100 < density {
+                    b[i / 8] |= 1 << (i % 8);
+                }
+            }
+            let free = |b: &[u8]| -> Vec<usize> {
+                (0..cells)
+                    .filter(|&i| b[i / 8] >> (i % 8) & 1 == 0)
+                    .collect()
+            };
+            let f0 = free(&b);
+            if f0.len() < 3 {
+                continue;
+            }
+            let pt = |i: usize| Point::new((i % w as usize) as u16, (i / w as usize) as u16);
+            let (s0, goal) = (
+                pt(f0[rnd() as usize % f0.len()]),
+                pt(f0[rnd() as usize % f0.len()]),
+            );
+            let g0 = Grid::new(w as u16, h as u16, &b).unwrap();
+            let mut dead = vec![0u32; bitmap::words(cells)];
+            let mut st = vec![0u32; [2usize, 9, 40, 400][round % 4]];
+            prune(&Moves::new(g0, &[]), s0, goal, &mut dead, &mut st);
+            let before = dead.clone();
+            // Change a random rectangle (some rounds none): block or clear each of its cells at
+            // random, never the goal.
+            let mut after = b.clone();
+            let changed = (round % 5 != 0).then(|| {
+                let (cw, ch) = (1 + rnd() % 3, 1 + rnd() % 3);
+                let (x0, y0) = (rnd() % w, rnd() % h);
+                let (x1, y1) = ((x0 + cw - 1).min(w - 1), (y0 + ch - 1).min(h - 1));
+                for y in y0..=y1 {
+                    for x in x0..=x1 {
+                        let i = (y * w + x) as usize;
+                        if Point::new(x as u16, y as u16) != goal {
+                            if rnd() % 2 == 0 {
+                                after[i / 8] |= 1 << (i % 8);
+                            } else {
+                                after[i / 8] &= !(1 << (i % 8));
+                            }
+                        }
+                    }
+                }
+                (
+                    Point::new(x0 as u16, y0 as u16),
+                    Point::new(x1 as u16, y1 as u16),
+                )
+            });
+            // The robot moved somewhere free (often near where it was).
+            let f1 = free(&after);
+            let s1 = if round % 3 == 0 {
+                s0
+            } else {
+                pt(f1[rnd() as usize % f1.len()])
+            };
+            if !f1.contains(&((s1.y as usize) * w as usize + s1.x as usize)) {
+                continue;
+            }
+            let g1 = Grid::new(w as u16, h as u16, &after).unwrap();
+            let r = repair(
+                &Moves::new(g1, &[]),
+                (s0, s1, goal),
+                changed,
+                &mut dead,
+                &mut st,
+            );
+            let mut fresh = vec![0u32; bitmap::words(cells)];
+            let n = prune(&Moves::new(g1, &[]), s1, goal, &mut fresh, &mut st);
+            assert_eq!(
+                show(&g1, &dead),
+                show(&g1, &fresh),
+                "round {round}: {s0:?} -> {s1:?}, goal {goal:?}, changed {changed:?}\nbefore\n{:#?}",
+                show(&g0, &before)
+            );
+            assert_eq!(r.pruned, n, "round {round}");
+            // Every mark that moved lies in `touched`.
+            for i in 0..cells {
+                if bitmap::get(&before, i) != bitmap::get(&fresh, i) {
+                    let (lo, hi) = r.touched.expect("a mark moved");
+                    let p = pt(i);
+                    assert!(
+                        (lo.x..=hi.x).contains(&p.x) && (lo.y..=hi.y).contains(&p.y),
+                        "round {round}: {p:?} outside {:?}",
+                        r.touched
+                    );
+                }
+            }
+            if !r.rebuilt {
+                local += 1;
+                unpruned += usize::from(r.touched.is_some());
+            }
+        }
+        assert!(local > 1000 && unpruned > 500, "{local} {unpruned}");
     }
 
     #[test]

@@ -128,6 +128,152 @@ pub fn build(
     dijkstra(blocks, blocks.block(goal), words, Heap { w: heap, len: 0 });
     true
 }
+/// Rebuild the route to `goal` after the pruning marks or the map changed inside `area` only:
+/// `words` hold the links of the route [`build`] (or `repair`) made before, restored with
+/// [`unstash`]. The links of the blocks within one cell of `area` (`None`: no cell changed) are
+/// recomputed from the map, the rest are kept, and the distances and next blocks are computed
+/// again (Dijkstra over the blocks: a few thousand words, where the links read every block's
+/// border cells). The result is [`build`]'s on the map and marks as they are now, bit for bit
+/// (a property test compares them). Returns false (and no route) if a buffer is too short.
+pub fn repair(
+    moves: &Moves<'_>,
+    blocks: Blocks,
+    goal: Point,
+    dead: &[u32],
+    words: &mut [u32],
+    heap: &mut [u32],
+    area: Option<(Point, Point)>,
+) -> bool {
+    let n = blocks.count();
+    if n > usize::from(u16::MAX) {
+        return false;
+    }
+    let (Some(words), Some(heap)) = (words.get_mut(..n), heap.get_mut(..n)) else {
+        return false;
+    };
+    let grid = *moves.grid();
+    let (w, h) = (grid.width(), grid.height());
+    if let (Some((lo, hi)), true) = (area, w > 0 && h > 0) {
+        // A block's links read its border cells and the cells one move beyond them.
+        let s = blocks.shift();
+        let (x0, y0) = (lo.x.saturating_sub(1) >> s, lo.y.saturating_sub(1) >> s);
+        let x1 = hi.x.saturating_add(1).min(w.wrapping_sub(1)) >> s;
+        let y1 = hi.y.saturating_add(1).min(h.wrapping_sub(1)) >> s;
+        for by in y0..=y1 {
+            for bx in x0..=x1 {
+                let b = usize::from(by)
+                    .wrapping_mul(blocks.across())
+                    .wrapping_add(usize::from(bx));
+                let l = block_links(moves, blocks, dead, bx, by);
+                if let Some(wd) = words.get_mut(b) {
+                    *wd = u32::from(l);
+                }
+            }
+        }
+    }
+    for w in words.iter_mut() {
+        *w = (*w & 0xFF) | (NONE << 8) | (UNREACHED << DIST_SHIFT);
+    }
+    dijkstra(blocks, blocks.block(goal), words, Heap { w: heap, len: 0 });
+    true
+}
+
+/// `f32` slots [`stash`] needs for the links of `blocks`: two blocks a slot.
+pub fn stash_len(blocks: Blocks) -> usize {
+    blocks.count().div_ceil(2)
+}
+
+/// Keep the links of the route in `words` in `out` (at least [`stash_len`] slots of a buffer
+/// that is free until the next run: the smoothing's unused pheromone increments), two blocks'
+/// link bytes a slot as an integer below `2^16`, exact in an `f32`. Returns false if `out` is
+/// too short.
+pub fn stash(blocks: Blocks, words: &[u32], out: &mut [f32]) -> bool {
+    let n = blocks.count();
+    let (Some(words), Some(out)) = (words.get(..n), out.get_mut(..stash_len(blocks))) else {
+        return false;
+    };
+    for (slot, pair) in out.iter_mut().zip(words.chunks(2)) {
+        let lo = pair.first().map_or(0, |w| w & 0xFF);
+        let hi = pair.get(1).map_or(0, |w| w & 0xFF);
+        // Below 2^16: exact in an f32.
+        *slot = (lo | hi << 8) as f32;
+    }
+    true
+}
+
+/// Put the links [`stash`] kept back into the low bytes of `words` (the rest of each word is
+/// cleared). Returns false if a buffer is too short.
+pub fn unstash(blocks: Blocks, kept: &[f32], words: &mut [u32]) -> bool {
+    let n = blocks.count();
+    let (Some(words), Some(kept)) = (words.get_mut(..n), kept.get(..stash_len(blocks))) else {
+        return false;
+    };
+    for (pair, slot) in words.chunks_mut(2).zip(kept) {
+        // An integer below 2^16 (see `stash`): the cast is exact.
+        let v = *slot as u32;
+        for (w, byte) in pair.iter_mut().zip([v & 0xFF, (v >> 8) & 0xFF]) {
+            *w = byte;
+        }
+    }
+    true
+}
+
+/// The links of block `(bx, by)`: [`links`] for one block.
+fn block_links(moves: &Moves<'_>, blocks: Blocks, dead: &[u32], bx: u16, by: u16) -> u8 {
+    let grid = *moves.grid();
+    let (w, h) = (grid.width(), grid.height());
+    let s = blocks.shift();
+    let last = (1u16 << s).wrapping_sub(1);
+    let offsets = grid.offsets();
+    let (x0, y0) = (u32::from(bx) << s, u32::from(by) << s);
+    let x1 = (x0.wrapping_add(u32::from(last))).min(u32::from(w).wrapping_sub(1));
+    let y1 = (y0.wrapping_add(u32::from(last))).min(u32::from(h).wrapping_sub(1));
+    let mut out = 0u8;
+    for y in y0..=y1 {
+        let y = y as u16; // <= h - 1
+        let border_row = y & last == 0 || y & last == last;
+        let mut x = x0;
+        while x <= x1 {
+            let xs = x as u16; // <= w - 1
+            let p = Point::new(xs, y);
+            let ci = grid.index(p);
+            if !crate::bitmap::get(dead, ci) {
+                let mut leaving = 0u8;
+                if xs & last == 0 {
+                    leaving |= 0x38;
+                }
+                if xs & last == last {
+                    leaving |= 0x83;
+                }
+                if y & last == 0 {
+                    leaving |= 0xE0;
+                }
+                if y & last == last {
+                    leaving |= 0x0E;
+                }
+                let mut m = moves.at(ci, p) & leaving;
+                while m != 0 {
+                    let d = m.trailing_zeros() as usize & 7;
+                    m &= m.wrapping_sub(1);
+                    let ni = ci.wrapping_add_signed(offsets.get(d).copied().unwrap_or(0));
+                    if crate::bitmap::get(dead, ni) {
+                        continue;
+                    }
+                    let q = crate::grid::neighbour(p, d as Dir);
+                    out |= 1 << block_dir(p, q, s);
+                }
+            }
+            // Inside a block's rows only its first and last columns can leave it.
+            x = if border_row || x == x1 {
+                x.wrapping_add(1)
+            } else {
+                x1
+            };
+        }
+    }
+    out
+}
+
 /// Bits 0-7 of each block's word: the neighbour blocks one allowed move away.
 fn links(moves: &Moves<'_>, blocks: Blocks, dead: &[u32], words: &mut [u32]) {
     words.fill(0);
@@ -428,5 +574,101 @@ mod tests {
             &mut words,
             &mut short
         ));
+    }
+
+    #[test]
+    fn repair_equals_build_on_random_maps_with_random_changes() {
+        let mut x = 0x1234_5679u32;
+        let mut rnd = move || {
+            x ^= x << 13;
+            x ^= x >> 17;
+            x ^= x << 5;
+            x
+        };
+        let mut shifts = [0u32; 4];
+        for round in 0..300 {
+            let (w, h) = (20 + rnd() % 200, 20 + rnd() % 150);
+            let cells = (w * h) as usize;
+            let density = [5u32, 20, 35][round % 3];
+            let mut b = vec![0u8; cells.div_ceil(8)];
+            let mut dead = vec![0u32; crate::bitmap::words(cells)];
+            for i in 0..cells {
+                if rnd() % 100 < density {
+                    b[i / 8] |= 1 << (i % 8);
+                } else if rnd() % 100 < 15 {
+                    crate::bitmap::set(&mut dead, i);
+                }
+            }
+            let blocks = blocks(w as u16, h as u16);
+            shifts[usize::from(blocks.shift()).min(3)] += 1;
+            let goal = Point::new((rnd() % w) as u16, (rnd() % h) as u16);
+            let g0 = Grid::new(w as u16, h as u16, &b).unwrap();
+            let mut words = vec![0u32; GUIDE_BLOCKS];
+            let mut heap = vec![0u32; GUIDE_BLOCKS];
+            assert!(build(
+                &Moves::new(g0, &[]),
+                blocks,
+                goal,
+                &dead,
+                &mut words,
+                &mut heap
+            ));
+            let mut kept = vec![0f32; stash_len(blocks)];
+            assert!(stash(blocks, &words, &mut kept));
+            // Scribble over the words, as the local search does with its scratch.
+            words.fill(0xDEAD_BEEF);
+            // Change the map and the marks inside a random rectangle (or nowhere).
+            let area = (round % 7 != 0).then(|| {
+                let (cw, ch) = (1 + rnd() % 9, 1 + rnd() % 9);
+                let (x0, y0) = (rnd() % w, rnd() % h);
+                let (x1, y1) = ((x0 + cw - 1).min(w - 1), (y0 + ch - 1).min(h - 1));
+                for y in y0..=y1 {
+                    for x in x0..=x1 {
+                        let i = (y * w + x) as usize;
+                        match rnd() % 4 {
+                            0 => b[i / 8] |= 1 << (i % 8),
+                            1 => b[i / 8] &= !(1 << (i % 8)),
+                            2 => crate::bitmap::set(&mut dead, i),
+                            _ => crate::bitmap::unset(&mut dead, i),
+                        }
+                    }
+                }
+                (
+                    Point::new(x0 as u16, y0 as u16),
+                    Point::new(x1 as u16, y1 as u16),
+                )
+            });
+            let g1 = Grid::new(w as u16, h as u16, &b).unwrap();
+            assert!(unstash(blocks, &kept, &mut words));
+            let m1 = Moves::new(g1, &[]);
+            assert!(repair(
+                &m1, blocks, goal, &dead, &mut words, &mut heap, area
+            ));
+            let mut fresh = vec![0u32; GUIDE_BLOCKS];
+            assert!(build(&m1, blocks, goal, &dead, &mut fresh, &mut heap));
+            let n = blocks.count();
+            assert_eq!(words[..n], fresh[..n], "round {round}: {w} x {h}, {area:?}");
+        }
+        assert!(
+            shifts[0] > 20 && shifts[1] > 20 && shifts[2] > 10,
+            "{shifts:?}"
+        );
+    }
+
+    #[test]
+    fn stash_keeps_the_links_only() {
+        let blocks = blocks(256, 256);
+        let words: Vec<u32> = (0..GUIDE_BLOCKS as u32)
+            .map(|i| i.wrapping_mul(2654435761))
+            .collect();
+        let mut kept = vec![0f32; stash_len(blocks)];
+        assert_eq!(kept.len(), 2048);
+        assert!(stash(blocks, &words, &mut kept));
+        assert!(!stash(blocks, &words, &mut kept[..2047]));
+        let mut back = vec![u32::MAX; GUIDE_BLOCKS];
+        assert!(unstash(blocks, &kept, &mut back));
+        for (a, b) in words.iter().zip(&back) {
+            assert_eq!(a & 0xFF, *b);
+        }
     }
 }

@@ -201,6 +201,9 @@ impl Planner for HostPlanner {
         }
         .map_err(|e| e.to_string())?;
         while run.step() {}
+        // As the firmware does: record what the run leaves for the next warm start.
+        while run.polish_step() {}
+        run.keep(&mut self.memory);
         let plan = run.finish().map_err(|e| e.to_string())?;
         Ok(Planned {
             raw: plan.raw().collect(),

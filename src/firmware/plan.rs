@@ -121,6 +121,10 @@ async fn plan(
             return Err(cancelled());
         }
     }
+    // What the run leaves in the storage for the next warm start to repair rather than rebuild
+    // (its pruning marks and route links), recorded only now that it is complete.
+    run.keep(&mut memory);
+    state::set_colony(memory);
     let plan = run.finish()?;
     let t_end = Instant::now();
     // The path is in `storage`: the map is free for writers while it is sent.

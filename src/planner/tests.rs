@@ -575,3 +575,82 @@ fn a_workspace_too_small_for_the_scratch_skips_the_local_search() {
     assert_eq!(a.directions(), &off.0[..]);
     assert_eq!(a.waypoints(), &off.1[..]);
 }
+
+/// A warm replan that repairs the last run's pruning marks and coarse route locally
+/// ([`Run::keep`]) plans exactly what one that rebuilds them does: same path, waypoints,
+/// iterations, ant moves and pruned cells, over a drive of three plans with a wall appearing
+/// and then opening again.
+#[test]
+fn warm_starts_that_repair_the_marks_and_the_route_plan_what_rebuilding_ones_do() {
+    let p = Params::default();
+    let mut repaired_routes = 0;
+    for seed in 1..=6u64 {
+        let (mut b, w, h) = large_map(seed);
+        let goal = Point::new(63, 47);
+        let mut st_keep = Box::new(SLarge::new());
+        let mut st_plain = Box::new(SLarge::new());
+        let (mut mem_keep, mut mem_plain) = (Memory::new(), Memory::new());
+        let mut start = Point::new(0, 0);
+        for leg in 0..3 {
+            let g = Grid::new(w, h, &b).unwrap();
+            let mut outcomes = Vec::new();
+            for (keep, st, memory) in [
+                (true, &mut st_keep, &mut mem_keep),
+                (false, &mut st_plain, &mut mem_plain),
+            ] {
+                let run = if leg == 0 {
+                    Run::cold(&g, start, goal, &p, st.workspace(), memory)
+                } else {
+                    Run::warm(&g, start, goal, &p, st.workspace(), memory)
+                };
+                let Ok(mut run) = run else { return };
+                while run.step() {}
+                while run.polish_step() {}
+                let pruned = run.pruned();
+                if keep {
+                    run.keep(memory);
+                    let kept = memory.kept().expect("the run kept its marks");
+                    assert!(kept.route, "seed {seed}: the route's links were stashed");
+                    repaired_routes += usize::from(leg > 0);
+                }
+                let Ok(plan) = run.finish() else {
+                    outcomes.push(None);
+                    continue;
+                };
+                assert_raw_valid(&g, &plan, start, goal);
+                outcomes.push(Some((
+                    plan.raw().collect::<Vec<_>>(),
+                    plan.waypoints().to_vec(),
+                    plan.iterations,
+                    plan.moves,
+                    pruned,
+                )));
+            }
+            assert_eq!(outcomes[0], outcomes[1], "seed {seed}, leg {leg}");
+            let Some(Some(o)) = outcomes.pop() else {
+                return;
+            };
+            let raw = o.0;
+            // Drive a third of the way, then a wall of 5 cells across the path 4 cells ahead
+            // (leg 0), or the wall opens again (leg 1).
+            start = raw[raw.len() / 3];
+            let at = raw[(raw.len() / 3 + 4).min(raw.len() - 2)];
+            let (x0, y0) = (at.x.saturating_sub(2), at.y);
+            for x in x0..(x0 + 5).min(w) {
+                let c = Point::new(x, y0);
+                if c == start || c == goal {
+                    continue;
+                }
+                let i = usize::from(y0) * usize::from(w) + usize::from(x);
+                if leg == 0 {
+                    b[i / 8] |= 1 << (i % 8);
+                } else {
+                    b[i / 8] &= !(1 << (i % 8));
+                }
+                mem_keep.changed(Area::cell(c));
+                mem_plain.changed(Area::cell(c));
+            }
+        }
+    }
+    assert!(repaired_routes >= 6, "{repaired_routes}");
+}

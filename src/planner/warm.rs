@@ -10,7 +10,7 @@
 //! | pheromone, away from the changes | kept, clamped into the current `[tau_min, tau_max]` |
 //! | pheromone within [`REPAIR_RADIUS`] cells of a change | set back to `tau0`, as in a cold start |
 //! | pheromone on edges into new obstacles | kept: ants are never offered a blocked move, so it is inert |
-//! | pruned cells, the coarse route | rebuilt from scratch: they depend on the start, which moved |
+//! | pruned cells, the coarse route | repaired around the changes and the two starts when the last run kept them ([`super::Run::keep`]): [`crate::prune::repair`], [`crate::route::repair`], bit for bit what a rebuild gives; else rebuilt |
 //! | reachability | not checked up front with backtracking ants: the first ant proves a cut-off goal |
 //! | the early stop | after [`Params::warm_patience`] stale iterations instead of [`Params::patience`] |
 //!
@@ -77,6 +77,11 @@ impl Area {
         }
     }
 
+    /// The corners, as `(min, max)`.
+    pub fn corners(self) -> (Point, Point) {
+        (self.min, self.max)
+    }
+
     /// True if `p` lies inside.
     pub fn contains(&self, p: Point) -> bool {
         (self.min.x..=self.max.x).contains(&p.x) && (self.min.y..=self.max.y).contains(&p.y)
@@ -113,6 +118,22 @@ pub struct Memory {
     owner: Option<(u16, u16, Point)>,
     /// Bounding box of every cell changed since that run started.
     changes: Option<Area>,
+    /// What else that run left in the workspace for a warm start to repair instead of rebuild
+    /// ([`super::Run::keep`]).
+    kept: Option<Kept>,
+}
+
+/// What a run left in the workspace besides its pheromone ([`super::Run::keep`]): its pruning
+/// marks, and maybe its coarse route's links.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub(super) struct Kept {
+    /// The start the marks were pruned for ([`crate::prune::prune`], with the goal of the
+    /// memory's owner, on the map as it was before [`Memory::changes`]).
+    pub(super) start: Point,
+    /// True if the route's links are stashed in the pheromone increments
+    /// ([`crate::route::stash`], their last [`crate::route::stash_len`] slots).
+    pub(super) route: bool,
 }
 
 impl Memory {
@@ -121,6 +142,7 @@ impl Memory {
         Memory {
             owner: None,
             changes: None,
+            kept: None,
         }
     }
 
@@ -142,6 +164,17 @@ impl Memory {
     pub fn planned(&mut self, width: u16, height: u16, goal: Point) {
         self.owner = Some((width, height, goal));
         self.changes = None;
+        self.kept = None;
+    }
+
+    /// What the last run left besides its pheromone, if it said so ([`super::Run::keep`]).
+    pub(super) fn kept(&self) -> Option<Kept> {
+        self.kept
+    }
+
+    /// The run that last called [`Memory::planned`] left `kept` in the workspace.
+    pub(super) fn keep(&mut self, kept: Kept) {
+        self.kept = Some(kept);
     }
 
     /// True if a run on a `width x height` map to `goal` can start warm.

@@ -29,7 +29,7 @@ use crate::smoothing::SmoothingKind;
 
 use super::params::{Algorithm, Params};
 use super::plan::{CurvePoint, Plan};
-use super::warm::{self, Area, Memory};
+use super::warm::{self, Area, Kept, Memory};
 use super::workspace::Workspace;
 use colony::Best;
 use polish::{Polish, REFINE_WORDS, SMALL_REFINE_LINKS};
@@ -53,6 +53,17 @@ pub struct Run<'g, 'a> {
     pruned: u32,
     routed: bool,
     warm: bool,
+    /// A warm start's changes since the last run, and what that run kept (see [`Run::keep`]).
+    reuse: Option<(Option<Area>, Kept)>,
+    /// The coarse route's links of the last run are back in `guide` ([`route::unstash`]).
+    relinked: bool,
+    /// The cells whose pruning mark or map cell may differ from the last run's, after a local
+    /// repair of the marks (the coarse route repairs its links there).
+    touched: Option<Area>,
+    /// This run's pruning marks are in `dead` (the setup pruned them).
+    marks: bool,
+    /// This run's coarse route's links are stashed in `delta` ([`route::stash`]).
+    stashed: bool,
     setup: Setup,
     refines: bool,
     polish: Polish,
@@ -99,6 +110,22 @@ impl<'g, 'a> Run<'g, 'a> {
         Self::prepare(grid, start, goal, params, ws, None)
     }
 
+    /// Record in `memory` what this run leaves in the workspace for the next [`Run::warm`] to
+    /// repair locally instead of rebuilding: its pruning marks (once the setup made them) and
+    /// its coarse route's links (once [`Run::polish_step`] started: they are stashed then, before
+    /// the local search takes the route's words as scratch). Call it with the `memory` this run
+    /// was started with ([`Run::warm`], [`Run::cold`]), after the run (before [`Run::finish`]),
+    /// and before another run uses the workspace; the firmware calls it once the run's polish is
+    /// done. Without the call the next warm start rebuilds both, with the same result.
+    pub fn keep(&self, memory: &mut Memory) {
+        if self.marks && memory.is_warm_for(self.grid.width(), self.grid.height(), self.goal) {
+            memory.keep(Kept {
+                start: self.start,
+                route: self.stashed,
+            });
+        }
+    }
+
     /// [`Run::new`], keeping the colony of the previous run to the same goal when `memory` says
     /// the workspace holds it (same map size and goal): its pheromone is kept, reset to `tau0` near
     /// the cells changed since ([`crate::planner::REPAIR_RADIUS`]), and the run stops after
@@ -142,20 +169,21 @@ impl<'g, 'a> Run<'g, 'a> {
         warm: bool,
     ) -> Result<Self, Error> {
         let warm = (warm && memory.is_warm_for(grid.width(), grid.height(), goal))
-            .then(|| memory.changes());
+            .then(|| (memory.changes(), memory.kept()));
         let run = Self::prepare(grid, start, goal, params, ws, warm)?;
         memory.planned(grid.width(), grid.height(), goal);
         Ok(run)
     }
 
-    /// [`Run::new`] (`warm` = `None`) and [`Run::warm`] (`Some(changes since)`).
+    /// [`Run::new`] (`warm` = `None`) and [`Run::warm`] (`Some((changes since, what the last
+    /// run kept))`).
     fn prepare(
         grid: &'g Grid<'g>,
         start: Point,
         goal: Point,
         params: &Params,
         ws: Workspace<'a>,
-        warm: Option<Option<Area>>,
+        warm: Option<(Option<Area>, Option<Kept>)>,
     ) -> Result<Self, Error> {
         params.validate()?;
         let cells = grid.cells();
@@ -173,7 +201,7 @@ impl<'g, 'a> Run<'g, 'a> {
         let guide_blocks = route::blocks(grid.width(), grid.height());
         match warm {
             None => ws.tau.fill([params.tau0; 4]),
-            Some(changes) => {
+            Some((changes, _)) => {
                 let mut tau = Table::new(blocks, ws.tau);
                 let _reset = warm::repair(
                     &mut tau,
@@ -185,6 +213,23 @@ impl<'g, 'a> Run<'g, 'a> {
                 crate::fmt::debug!("plan: warm start, {} pheromone entries reset", _reset);
             }
         }
+        // The last run's pruning marks are reused (repaired locally) when it kept them and this
+        // run prunes too; its route's links too when it stashed them in `delta` (restored here,
+        // before `delta` is cleared).
+        let reuse = match warm {
+            Some((changes, Some(kept))) if params.prune => Some((changes, kept)),
+            _ => None,
+        };
+        let relinked = reuse.is_some_and(|(_, k)| k.route) && {
+            let kept = ws.delta.as_flattened();
+            let n = route::stash_len(guide_blocks);
+            kept.len() >= n
+                && route::unstash(
+                    guide_blocks,
+                    kept.get(kept.len().wrapping_sub(n)..).unwrap_or_default(),
+                    ws.guide,
+                )
+        };
         ws.delta.fill([0.0; 4]);
         let heuristic = Heuristic::new(goal, params.attraction(), params.beta);
         // The local search: OHACA on every map, when the workspace can lend its scratch (every
@@ -220,6 +265,11 @@ impl<'g, 'a> Run<'g, 'a> {
             pruned: 0,
             routed: false,
             warm: warm.is_some(),
+            reuse,
+            relinked,
+            touched: None,
+            marks: false,
+            stashed: false,
             setup: Setup::Reach,
             refines,
             polish: Polish::Start,

@@ -4,8 +4,8 @@
 
 use crate::grid::{direction, is_diagonal};
 use crate::refine::{self, Budget, Refiner, Scratch};
-use crate::route::GUIDE_BLOCKS;
-use crate::smoothing::{Smoother, SmoothingKind};
+use crate::route::{self, GUIDE_BLOCKS};
+use crate::smoothing::{Smoother, SmoothingKind, LOOKBACK};
 
 use crate::planner::params::Algorithm;
 #[cfg(doc)]
@@ -83,6 +83,19 @@ impl Run<'_, '_> {
                 let tour = ws.best.get(..best.steps).unwrap_or_default();
                 for (slot, p) in ws.points.iter_mut().zip(RawPath::new(self.start, tour)) {
                     *slot = p;
+                }
+                // Stash the coarse route's links for the next warm start ([`Run::keep`])
+                // before the local search takes the route's words as scratch: in the last
+                // slots of the pheromone increments, which the smoothing leaves alone (it uses
+                // a ring of at most `LOOKBACK + 1` from the front).
+                if self.routed {
+                    let n = route::stash_len(self.guide_blocks);
+                    let room = dist.len().saturating_sub(LOOKBACK.wrapping_add(1));
+                    self.stashed = n <= room && {
+                        let at = dist.len().wrapping_sub(n);
+                        let out = dist.get_mut(at..).unwrap_or_default();
+                        route::stash(self.guide_blocks, ws.guide, out)
+                    };
                 }
                 let refiner = self
                     .refines

@@ -4,10 +4,10 @@
 
 use crate::ant::DeadEnd;
 use crate::grid::{Moves, Reach};
-use crate::prune::prune;
+use crate::prune::{self, prune};
 use crate::route;
 
-use super::{Run, Setup};
+use super::{Area, Run, Setup};
 
 impl Run<'_, '_> {
     /// Do the next piece of the setup, if any is left: the flood fill (a goal found unreachable
@@ -40,7 +40,29 @@ impl Run<'_, '_> {
             Setup::Prune => {
                 self.pruned = if p.prune {
                     let moves = Moves::new(*grid, ws.moves);
-                    prune(&moves, self.start, self.goal, ws.dead, ws.links)
+                    self.marks = true;
+                    match self.reuse {
+                        // A warm start on the last run's marks: repair them around the changes
+                        // and the two starts (the same marks as pruning again, `prune::repair`).
+                        Some((changes, kept)) => {
+                            let r = prune::repair(
+                                &moves,
+                                (kept.start, self.start, self.goal),
+                                changes.map(Area::corners),
+                                ws.dead,
+                                ws.links,
+                            );
+                            let touched = r.touched.map(|(min, max)| Area { min, max });
+                            self.touched = match (touched, changes) {
+                                (Some(a), Some(b)) => Some(a.union(b)),
+                                (a, b) => a.or(b),
+                            };
+                            // Relinking the whole map is building the route.
+                            self.relinked &= !r.rebuilt;
+                            r.pruned
+                        }
+                        None => prune(&moves, self.start, self.goal, ws.dead, ws.links),
+                    }
                 } else {
                     crate::bitmap::clear(ws.dead, grid.cells());
                     0
@@ -52,14 +74,27 @@ impl Run<'_, '_> {
                 // has no attraction).
                 self.routed = self.blocks.shift() > 0 && p.algorithm.attracts() && {
                     let moves = Moves::new(*grid, ws.moves);
-                    route::build(
-                        &moves,
-                        self.guide_blocks,
-                        self.goal,
-                        ws.dead,
-                        ws.guide,
-                        ws.links,
-                    )
+                    if self.relinked && self.marks {
+                        // The last run's links, repaired where the map or the marks changed.
+                        route::repair(
+                            &moves,
+                            self.guide_blocks,
+                            self.goal,
+                            ws.dead,
+                            ws.guide,
+                            ws.links,
+                            self.touched.map(Area::corners),
+                        )
+                    } else {
+                        route::build(
+                            &moves,
+                            self.guide_blocks,
+                            self.goal,
+                            ws.dead,
+                            ws.guide,
+                            ws.links,
+                        )
+                    }
                 };
                 crate::fmt::debug!("plan: {} cells pruned", self.pruned);
                 self.setup = Setup::Done;
