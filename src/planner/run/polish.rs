@@ -89,6 +89,7 @@ impl Run<'_, '_> {
                 // slots of the pheromone increments, which the smoothing leaves alone (it uses
                 // a ring of at most `LOOKBACK + 1` from the front).
                 if self.routed {
+                    let dist = ws.delta.as_flattened_mut();
                     let n = route::stash_len(self.guide_blocks);
                     let room = dist.len().saturating_sub(LOOKBACK.wrapping_add(1));
                     self.stashed = n <= room && {
