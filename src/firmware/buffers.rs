@@ -17,8 +17,8 @@
 //! | SRAM4 (64 KiB) | `.sram4` (NOLOAD) | `links` (2 x 8,192) | 65,536 |
 //! | DTCM (128 KiB) | `.bss` | 4 tours (8,192 each), `points` (8,192), `guide`, `curve`, `moves` | 32,768 + 32,768 + 16,384 + 2,048 + 1,024 |
 //!
-//! Every region but the DTCM is then full to the byte; the DTCM keeps about 44 KiB for the rest
-//! of the firmware's statics and the stack. An ant path step costs 16 bytes (a byte in each of
+//! Every region but the DTCM is then full to the byte; the DTCM keeps 45 KiB for the rest of the
+//! firmware's statics (about 6 KiB) and the stack (3.4 KiB measured: BENCHMARKS.md, section 5b). An ant path step costs 16 bytes (a byte in each of
 //! the four tours, a 4-byte path cell, two 4-byte links): 8,192 steps take 128 KiB, which is
 //! what the regions have left beside the 768 KiB of per-cell bits (16,384 steps would need
 //! 256 KiB).
@@ -174,14 +174,14 @@ mod layout {
 
     /// What stays in the DTCM's `.bss` (zeroed by the startup code): the tours, the path cells,
     /// the coarse route, the curve and the move table.
-    struct Small {
+    struct Dtcm {
         tours: [[Dir; STEPS]; 4],
         points: [Point; STEPS],
         guide: [u32; GUIDE_BLOCKS],
         curve: [CurvePoint; CURVE],
         moves: [u8; MOVES],
     }
-    static SMALL: ConstStaticCell<Small> = ConstStaticCell::new(Small {
+    static DTCM: ConstStaticCell<Dtcm> = ConstStaticCell::new(Dtcm {
         tours: [[0; STEPS]; 4],
         points: [Point::new(0, 0); STEPS],
         guide: [0; GUIDE_BLOCKS],
@@ -200,7 +200,7 @@ mod layout {
     pub const BYTES: usize = 2 * size_of::<[u32; WORDS]>()
         + 2 * size_of::<[[f32; 4]; BLOCKS]>()
         + size_of::<[u32; LINKS]>()
-        + size_of::<Small>();
+        + size_of::<Dtcm>();
 
     /// The planner's buffers, each a `'static` slice of its own static.
     pub struct PlanStorage {
@@ -253,19 +253,19 @@ mod layout {
                 LINKS_BUF.fill(0),
             )
         };
-        let small = SMALL.take();
-        let [t0, t1, t2, t3] = &mut small.tours;
+        let dtcm = DTCM.take();
+        let [t0, t1, t2, t3] = &mut dtcm.tours;
         let storage = STORAGE.take().insert(PlanStorage {
             tau,
             delta,
             tabu,
             dead,
-            moves: &mut small.moves,
+            moves: &mut dtcm.moves,
             tours: [t0, t1, t2, t3],
-            points: &mut small.points,
+            points: &mut dtcm.points,
             links,
-            curve: &mut small.curve,
-            guide: &mut small.guide,
+            curve: &mut dtcm.curve,
+            guide: &mut dtcm.guide,
         });
         let mut buf = defmt::unwrap!(
             crate::firmware::state::MAP.try_lock().ok(),
