@@ -8,10 +8,12 @@ source scripts/setup.sh
 
 # The core (planner + protocol): unit tests and doc examples, on the host.
 cargo test -p ohaca --target host-tuple
-# The QEMU firmware the end-to-end tests boot.
+# The QEMU firmware the end-to-end tests boot, and the STM32H743's QEMU capacity twin (the
+# H743's capacity and RAM regions on the same QEMU board) that host/tests/qemu_twin.rs boots.
 cargo build --release
-# Host tool (incl. QEMU end-to-end tests), references, properties, shared maps. Release: the
-# shared-map checks plan thousands of times.
+cargo build --release --features twin-h743 --target-dir target/twin-h743
+# Host tool (incl. QEMU end-to-end tests, the twin's on 1024 x 1024 and 2048 x 1024 maps),
+# references, properties, shared maps. Release: the shared-map checks plan thousands of times.
 cargo test --release -p ohaca-host -p ohaca-host-tests --target host-tuple
 # The firmware's boot log against tests/golden/boot.txt, and the protocol selftest over QEMU.
 scripts/golden-boot.sh --no-build

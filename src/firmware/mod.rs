@@ -16,6 +16,7 @@
 //! Everything board-specific (UART, time driver, log sink, exit) is behind [`board::Board`].
 
 mod board;
+mod buffers;
 mod plan;
 mod rx;
 mod stack;
@@ -24,14 +25,9 @@ mod tx;
 
 use embassy_executor::Spawner;
 use embassy_sync::mutex::Mutex;
-use static_cell::{ConstStaticCell, StaticCell};
+use static_cell::StaticCell;
 
 use board::Board;
-use state::PlanStorage;
-
-/// The planner's workspace: maps of up to [`state::PLAN_CELLS`] cells (zero-initialised, so it
-/// lives in `.bss`).
-static STORAGE: ConstStaticCell<PlanStorage> = ConstStaticCell::new(PlanStorage::new());
 
 /// The UART's transmitting half, shared by the transmitter and the planner.
 static TX: StaticCell<state::TxPort> = StaticCell::new();
@@ -53,14 +49,16 @@ pub fn run(spawner: Spawner) {
         state::MAP_BYTES,
         state::MAX_SIDE,
         state::PLAN_STEPS,
-        PlanStorage::BYTES
+        buffers::BYTES
     );
     defmt::info!(
         "stack: {} bytes (RAM above the statics), {} used at boot",
         stack::size(),
         boot_stack
     );
-    let storage = STORAGE.take();
+    // The map and the planner's buffers: after the board's init (the STM32H743's enables the
+    // RAM regions they live in), before any task runs.
+    let storage = buffers::take();
     let port = TX.init(Mutex::new(tx));
     spawner.spawn(defmt::unwrap!(tx::tx_task(port)));
     spawner.spawn(defmt::unwrap!(plan::planner_task(storage, port)));

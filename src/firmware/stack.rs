@@ -5,8 +5,10 @@
 //! `main` runs. The region is `_stack_end` (the end of static RAM: `.data`, `.bss`, `.uninit`)
 //! to `_stack_start` (the top of RAM, the initial stack pointer). The stack grows down from the
 //! top, and interrupt handlers run on it too, so the lowest word that no longer holds the paint
-//! is the deepest the stack has ever reached. Both boards have the same layout (QEMU's
-//! `memory.x` copies the STM32F411's 128 KiB of RAM), so the numbers carry over.
+//! is the deepest the stack has ever reached. The QEMU board has the STM32F411's layout (its
+//! `memory.x` copies the 128 KiB of RAM), and its `twin-h743` build the STM32H743's (the stack at
+//! the top of the 128 KiB DTCM, the large buffers in the other regions), so the numbers carry
+//! over to the chips.
 
 use core::ptr::{addr_of, read_volatile};
 

@@ -21,11 +21,14 @@ use ohaca::planner::{Area, Memory, Params};
 use ohaca::protocol::{MapLimits, Reply, StatsReply};
 
 use super::board::{self, Board};
+use super::buffers::{MapBuf, MAP_INIT};
 use super::stack;
 
-/// Most cells of a map the device holds and plans on, whatever its shape (the same on every
-/// board, so what QEMU proves holds on the chip): 65,536 cells, 8 KiB at one bit a cell.
-pub const MAX_CELLS: usize = 65_536;
+/// Most cells of a map the device holds and plans on, whatever its shape: the board's
+/// [`board::CAPACITY`] (65,536 cells, 8 KiB at one bit a cell, on the STM32F411 and the default
+/// QEMU board, so what QEMU proves holds on the chip; 2,097,152 cells on the STM32H743 and its
+/// QEMU twin).
+pub const MAX_CELLS: usize = board::CAPACITY.cells;
 /// Longest side of a map the device takes (a 4096 x 16 corridor has as many cells as 256 x 256).
 pub const MAX_SIDE: u16 = 4096;
 /// Bytes of the map buffer.
@@ -33,15 +36,14 @@ pub const MAP_BYTES: usize = MAX_CELLS.div_ceil(8);
 /// Most cells of a map the planner plans on: every map the device holds, at full resolution.
 pub const PLAN_CELLS: usize = MAX_CELLS;
 /// Longest ant path the planner keeps, in steps (an ant whose path grows longer is dropped, and a
-/// plan no ant finishes that way is `Error PathTooLong`). A straight path across a 256 x 256 map
-/// has at most 255 steps, but a maze's or a long corridor's (4096 x 16) can be far longer: the
-/// longest scenario of `maps/large/maze-128-128-2` has 1,379 steps (BENCHMARKS.md, section 4).
-pub const PLAN_STEPS: usize = 1023;
-/// The planner's storage: two bits a map cell (tabu list, pruned cells), the pheromone budget,
-/// the coarse route, four ant paths of [`PLAN_STEPS`] steps, links, and the move table for maps of
-/// up to 1024 cells (`ohaca::planner::workspace` lists what each holds).
-pub type PlanStorage =
-    ohaca::planner::Storage<{ ohaca::bitmap::words(PLAN_CELLS) }, { PLAN_STEPS + 1 }, 4096, 1024>;
+/// plan no ant finishes that way is `Error PathTooLong`): the board's [`board::CAPACITY`]. A
+/// straight path across a 256 x 256 map has at most 255 steps, but a maze's or a long corridor's
+/// (4096 x 16) can be far longer: the longest scenario of `maps/large/maze-128-128-2` has 1,379
+/// steps (BENCHMARKS.md, section 4).
+pub const PLAN_STEPS: usize = board::CAPACITY.steps;
+/// The planner's storage (`super::buffers`): one `ohaca::planner::Storage` static on the small
+/// boards, buffers spread over the RAM regions on the STM32H743 and its twin.
+pub use super::buffers::PlanStorage;
 /// The map limits, for [`ohaca::protocol::Upload`].
 pub const LIMITS: MapLimits = MapLimits {
     max_cells: MAX_CELLS as u32,
@@ -76,8 +78,10 @@ pub struct Out(pub u32, pub Reply<'static>);
 /// frame, so frames never interleave.
 pub type TxPort = Mutex<Raw, board::Tx>;
 
-/// The map buffer, packed as `ohaca::grid` stores a map; [`MAP_SIZE`] says what it holds.
-pub static MAP: Mutex<Raw, [u8; MAP_BYTES]> = Mutex::new([0; MAP_BYTES]);
+/// The map buffer, packed as `ohaca::grid` stores a map; [`MAP_SIZE`] says what it holds. On the
+/// small boards the [`MAP_BYTES`] bytes themselves; on the STM32H743 and its twin a static of
+/// the AXI SRAM that `super::buffers::take` lends to this lock at boot (`super::buffers`).
+pub static MAP: Mutex<Raw, MapBuf> = Mutex::new(MAP_INIT);
 /// Width and height of the complete map in [`MAP`]; `None`: no map (none yet, an upload in
 /// progress, or a failed one).
 static MAP_SIZE: BlockingMutex<Raw, Cell<Option<(u16, u16)>>> = BlockingMutex::new(Cell::new(None));

@@ -71,29 +71,50 @@ macro_rules! need_qemu {
 /// The firmware ELF, built once per test run.
 pub fn firmware() -> &'static Path {
     static ELF: OnceLock<PathBuf> = OnceLock::new();
+    ELF.get_or_init(|| build_firmware("OHACA_FIRMWARE", &[], None))
+}
+
+/// The STM32H743's QEMU capacity twin (`--features twin-h743`, in `target/twin-h743`), built
+/// once per test run; `OHACA_TWIN_FIRMWARE=path/to/elf` uses another ELF and skips the build.
+pub fn twin_firmware() -> &'static Path {
+    static ELF: OnceLock<PathBuf> = OnceLock::new();
     ELF.get_or_init(|| {
-        if let Some(p) = std::env::var_os("OHACA_FIRMWARE") {
-            return PathBuf::from(p);
-        }
-        let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
-        let out = Command::new(cargo)
-            .args(["build", "--release", "-q"])
-            .current_dir(root())
-            .stdout(Stdio::inherit())
-            .output()
-            .expect("run cargo build --release for the firmware");
-        assert!(
-            out.status.success(),
-            "cargo build --release (the firmware) failed:\n{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        let target = std::env::var_os("CARGO_TARGET_DIR")
-            .map(PathBuf::from)
-            .unwrap_or_else(|| root().join("target"));
-        let elf = target.join("thumbv7em-none-eabihf/release/ohaca");
-        assert!(elf.is_file(), "no firmware at {}", elf.display());
-        elf
+        build_firmware(
+            "OHACA_TWIN_FIRMWARE",
+            &["--features", "twin-h743"],
+            Some(root().join("target/twin-h743")),
+        )
     })
+}
+
+/// `cargo build --release -q` plus `args` in the workspace root, into `target_dir` (default: the
+/// workspace's target directory); the ELF, or the path in `$var` if set (then nothing is built).
+fn build_firmware(var: &str, args: &[&str], target_dir: Option<PathBuf>) -> PathBuf {
+    if let Some(p) = std::env::var_os(var) {
+        return PathBuf::from(p);
+    }
+    let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
+    let mut c = Command::new(cargo);
+    c.args(["build", "--release", "-q"]).args(args);
+    if let Some(dir) = &target_dir {
+        c.arg("--target-dir").arg(dir);
+    }
+    let out = c
+        .current_dir(root())
+        .stdout(Stdio::inherit())
+        .output()
+        .expect("run cargo build --release for the firmware");
+    assert!(
+        out.status.success(),
+        "cargo build --release {args:?} (the firmware) failed:\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let target = target_dir
+        .or_else(|| std::env::var_os("CARGO_TARGET_DIR").map(PathBuf::from))
+        .unwrap_or_else(|| root().join("target"));
+    let elf = target.join("thumbv7em-none-eabihf/release/ohaca");
+    assert!(elf.is_file(), "no firmware at {}", elf.display());
+    elf
 }
 
 /// A running QEMU with the firmware; killed on drop.
@@ -121,12 +142,16 @@ fn defmt_log() -> Stdio {
 }
 
 fn qemu_command(serial: &str) -> Command {
+    qemu_command_for(serial, firmware())
+}
+
+fn qemu_command_for(serial: &str, elf: &Path) -> Command {
     let mut c = Command::new("qemu-system-arm");
     c.args(["-M", "mps2-an386", "-display", "none", "-monitor", "none"])
         .args(["-semihosting-config", "enable=on,target=native"])
         .args(["-serial", serial])
         .arg("-kernel")
-        .arg(firmware())
+        .arg(elf)
         .stdin(Stdio::null());
     c
 }
@@ -141,11 +166,17 @@ impl Qemu {
     /// time, a new one accepted after it disconnects); returns once the port accepts
     /// connections.
     pub fn tcp() -> Qemu {
+        Qemu::tcp_with(firmware())
+    }
+
+    /// [`Qemu::tcp`] with another firmware ELF (e.g. [`twin_firmware`]).
+    pub fn tcp_with(elf: &Path) -> Qemu {
         for _ in 0..5 {
             let port = free_port();
-            let child = qemu_command(&format!(
-                "tcp:127.0.0.1:{port},server=on,wait=off,nodelay=on"
-            ))
+            let child = qemu_command_for(
+                &format!("tcp:127.0.0.1:{port},server=on,wait=off,nodelay=on"),
+                elf,
+            )
             .stdout(defmt_log())
             .stderr(Stdio::piped())
             .spawn()
@@ -332,11 +363,35 @@ pub fn core_plan(
     goal: Point,
     params: &Params,
 ) -> Result<CorePath, ErrorReply> {
+    // The device's capacities: ant paths of up to 1023 steps (`firmware::state::PLAN_STEPS`).
+    core_plan_with(map, start, goal, params, 1023, true)
+}
+
+/// [`core_plan`] for a device that keeps ant paths of up to `steps` steps (Hello's
+/// `capacity.max_steps`), with the device's workspace shape: links for `steps`, the move table
+/// only on maps of up to 1024 cells, as the firmware has it (`firmware::buffers`).
+pub fn core_plan_steps(
+    map: &Map,
+    start: Point,
+    goal: Point,
+    params: &Params,
+    steps: usize,
+) -> Result<CorePath, ErrorReply> {
+    core_plan_with(map, start, goal, params, steps, map.cells() <= 1024)
+}
+
+fn core_plan_with(
+    map: &Map,
+    start: Point,
+    goal: Point,
+    params: &Params,
+    steps: usize,
+    moves: bool,
+) -> Result<CorePath, ErrorReply> {
     let grid = map.grid().map_err(ErrorReply::from)?;
     params.validate().map_err(ErrorReply::from)?;
-    // The device's capacities: ant paths of up to 1023 steps (`firmware::state::PLAN_STEPS`).
     let mut storage =
-        HeapStorage::with_steps(map.cells(), 1023, true, usize::from(params.iterations))
+        HeapStorage::with_steps(map.cells(), steps, moves, usize::from(params.iterations))
             .expect("host storage");
     let plan = ohaca::plan(&grid, start, goal, params, storage.workspace())?;
     Ok(CorePath {

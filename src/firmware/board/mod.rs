@@ -7,20 +7,75 @@
 //! | [`qemu`] (default) | `board-qemu` | CMSDK APB UART0, RX interrupt + ring | SysTick, 1 tick = 1 µs | semihosting | semihosting exit |
 //! | [`stm32f411`] | `board-stm32f411` | USART1 `BufferedUart` (PA9 TX, PA10 RX) | embassy-stm32 (TIM) | RTT | system reset |
 
-#[cfg(all(feature = "board-qemu", feature = "board-stm32f411"))]
-compile_error!("choose one board: `board-qemu` (default) or `--no-default-features --features board-stm32f411`");
-#[cfg(not(any(feature = "board-qemu", feature = "board-stm32f411")))]
-compile_error!("no board selected: enable `board-qemu` or `board-stm32f411`");
+//! | [`stm32h743`] | `board-stm32h743` | USART3 `BufferedUart` (PD8 TX, PD9 RX: the ST-LINK's virtual COM port) | embassy-stm32 (TIM) | RTT | system reset |
+//!
+//! Each board module also says how much its firmware holds: its [`Capacity`] (`CAPACITY`),
+//! [`SMALL`] on the STM32F411 and the default QEMU board, [`LARGE`] on the STM32H743 and on its
+//! QEMU capacity twin (`board-qemu` + `twin-h743`), whose RAM regions have the H743's sizes.
+//! Where the buffers go in RAM: `super::buffers`.
+
+#[cfg(any(
+    all(feature = "board-qemu", feature = "board-stm32f411"),
+    all(feature = "board-qemu", feature = "board-stm32h743"),
+    all(feature = "board-stm32f411", feature = "board-stm32h743"),
+))]
+compile_error!("choose one board: `board-qemu` (default), or `--no-default-features --features board-stm32f411` or `board-stm32h743`");
+#[cfg(not(any(
+    feature = "board-qemu",
+    feature = "board-stm32f411",
+    feature = "board-stm32h743"
+)))]
+compile_error!("no board selected: enable `board-qemu`, `board-stm32f411` or `board-stm32h743`");
 
 #[cfg(feature = "board-qemu")]
 pub mod qemu;
 #[cfg(feature = "board-qemu")]
-pub use qemu::Qemu as Active;
+pub use qemu::{Qemu as Active, CAPACITY};
 
 #[cfg(all(feature = "board-stm32f411", not(feature = "board-qemu")))]
 pub mod stm32f411;
 #[cfg(all(feature = "board-stm32f411", not(feature = "board-qemu")))]
-pub use stm32f411::Stm32f411 as Active;
+pub use stm32f411::{Stm32f411 as Active, CAPACITY};
+
+#[cfg(all(
+    feature = "board-stm32h743",
+    not(any(feature = "board-qemu", feature = "board-stm32f411"))
+))]
+pub mod stm32h743;
+#[cfg(all(
+    feature = "board-stm32h743",
+    not(any(feature = "board-qemu", feature = "board-stm32f411"))
+))]
+pub use stm32h743::{Stm32h743 as Active, CAPACITY};
+
+/// How much a board's firmware holds: maps of up to `cells` cells (any shape, one bit a cell in
+/// the map buffer) planned at full resolution, and ant paths of up to `steps` steps (a longer
+/// one is `Error PathTooLong`). Hello reports both.
+#[derive(Clone, Copy)]
+pub struct Capacity {
+    /// Most cells of a map.
+    pub cells: usize,
+    /// Longest ant path, in steps.
+    pub steps: usize,
+}
+
+/// The STM32F411's capacity (128 KiB of RAM), and the default QEMU board's, which copies it so
+/// that what QEMU proves holds on the chip: 65,536 cells (8 KiB of map), paths of 1,023 steps.
+#[cfg(not(any(feature = "twin-h743", feature = "board-stm32h743")))]
+pub const SMALL: Capacity = Capacity {
+    cells: 65_536,
+    steps: 1023,
+};
+
+/// The STM32H743's capacity, and its QEMU twin's: 2,097,152 cells (2048 x 1024, or Nav2's
+/// 1006 x 1674 warehouse at 3 cm; a 256 KiB map), paths of 8,191 steps. The map and the planner's
+/// two per-cell bit sets take 768 KiB of the chip's 992 KiB of RAM; what is left holds ant paths
+/// of 8,191 steps at 16 bytes a step (`super::buffers` has the arithmetic).
+#[cfg(any(feature = "twin-h743", feature = "board-stm32h743"))]
+pub const LARGE: Capacity = Capacity {
+    cells: 2_097_152,
+    steps: 8191,
+};
 
 /// What a board provides.
 pub trait Board {

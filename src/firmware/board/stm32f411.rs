@@ -9,7 +9,10 @@ use embassy_stm32::usart::{BufferedUart, BufferedUartRx, BufferedUartTx, Config}
 use embassy_stm32::{bind_interrupts, peripherals, rcc, usart};
 use static_cell::ConstStaticCell;
 
-use super::Board;
+use super::{Board, Capacity};
+
+/// Maps of up to 65,536 cells, paths of up to 1,023 steps.
+pub const CAPACITY: Capacity = super::SMALL;
 
 bind_interrupts!(struct Irqs {
     USART1 => usart::BufferedInterruptHandler<peripherals::USART1>;

@@ -8,7 +8,16 @@ mod uart;
 
 use defmt_semihosting as _;
 
-use super::Board;
+use super::{Board, Capacity};
+
+/// The STM32F411's capacity (the default), or with feature `twin-h743` the STM32H743's: the twin
+/// also has the H743's RAM regions (`twin-h743-memory.x`) and buffer placement.
+#[cfg(not(feature = "twin-h743"))]
+pub const CAPACITY: Capacity = super::SMALL;
+/// The STM32H743's capacity: this is its QEMU twin (`twin-h743-memory.x` has the H743's RAM
+/// regions, `crate::firmware::buffers` places the buffers as on the chip).
+#[cfg(feature = "twin-h743")]
+pub const CAPACITY: Capacity = super::LARGE;
 
 /// System clock of the MPS2 FPGA images, also the SysTick and UART clock.
 pub const SYSCLK_HZ: u32 = 25_000_000;
@@ -16,7 +25,10 @@ pub const SYSCLK_HZ: u32 = 25_000_000;
 pub struct Qemu;
 
 impl Board for Qemu {
+    #[cfg(not(feature = "twin-h743"))]
     const NAME: &'static str = "qemu-mps2-an386";
+    #[cfg(feature = "twin-h743")]
+    const NAME: &'static str = "qemu-mps2-an386-twin-h743";
     type Rx = uart::Rx;
     type Tx = uart::Tx;
 

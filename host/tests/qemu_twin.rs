@@ -1,0 +1,231 @@
+//! End-to-end tests of the STM32H743's QEMU capacity twin: the mps2-an386 firmware built with
+//! `--features twin-h743` (the H743's capacity, 2,097,152 cells and paths of 8,191 steps, and its
+//! RAM regions at their sizes: `src/firmware/board/qemu/twin-h743-memory.x`), so what it plans
+//! here fits the chip. Maps of 1024 x 1024 and 2048 x 1024 cells go up over QEMU's UART and are
+//! planned at full resolution, bit for bit as the host core plans them with the device's
+//! workspace shape (`core_plan_steps` with Hello's `max_steps`).
+//!
+//! The twin is built once per run into `target/twin-h743` (`OHACA_TWIN_FIRMWARE=path/to/elf`
+//! uses another ELF). Without `qemu-system-arm` the tests fail unless `OHACA_SKIP_QEMU=1`.
+//! Upload and plan times are printed (`-- --nocapture`), not asserted: the whole file takes
+//! about 20 s on a 2-core machine (BENCHMARKS.md, section 5).
+
+#[macro_use]
+#[path = "common/qemu.rs"]
+mod qemu;
+
+use std::time::Instant;
+
+use ohaca::protocol::{ErrorCode, ErrorReply};
+use ohaca::{Params, Point};
+use ohaca_host::link::{LinkError, PlanJob};
+use ohaca_host::Map;
+use qemu::{assert_core_path, core_plan_steps, have_qemu, maps, twin_firmware, Qemu};
+
+/// The H743's capacity (`src/firmware/board/mod.rs`, `LARGE`).
+const CELLS: u32 = 2_097_152;
+const STEPS: u32 = 8191;
+
+fn error_code<T: std::fmt::Debug>(r: Result<T, LinkError>) -> ErrorReply {
+    match r {
+        Err(LinkError::Device { error, .. }) => error,
+        other => panic!("expected a device error, got {other:?}"),
+    }
+}
+
+/// The longest scenario of a Moving AI scenario file (start, goal).
+fn longest_scenario(scen: &str) -> (Point, Point) {
+    let text = std::fs::read_to_string(maps().join(scen)).expect("scenario file");
+    let mut best: Option<(f64, Point, Point)> = None;
+    for l in text.lines().skip(1) {
+        let f: Vec<&str> = l.split('\t').collect();
+        let n = |i: usize| f.get(i).and_then(|v| v.trim().parse::<u16>().ok());
+        let (Some(sx), Some(sy), Some(gx), Some(gy)) = (n(4), n(5), n(6), n(7)) else {
+            continue;
+        };
+        let Some(len) = f.get(8).and_then(|v| v.trim().parse::<f64>().ok()) else {
+            continue;
+        };
+        if best.is_none_or(|(b, _, _)| len > b) {
+            best = Some((len, Point::new(sx, sy), Point::new(gx, gy)));
+        }
+    }
+    let (_, s, g) = best.expect("scenarios");
+    (s, g)
+}
+
+/// A 2048 x 1024 map (exactly the twin's 2,097,152 cells), blocked but for four corridors four
+/// cells high, 2,032 cells long, at rows 100, 400, 700 and 1000, joined at alternate ends by
+/// shafts four cells wide: one way through, 9,000 steps from the first corridor's left end to
+/// the last one's.
+fn corridors() -> Map {
+    const ROWS: [u16; 4] = [100, 400, 700, 1000];
+    Map::from_fn(2048, 1024, |x, y| {
+        let along = (8..2040).contains(&x) && ROWS.iter().any(|&r| (r..r + 4).contains(&y));
+        let shaft = ROWS.windows(2).enumerate().any(|(i, w)| {
+            let x0 = if i % 2 == 0 { 2028 } else { 8 };
+            (x0..x0 + 4).contains(&x) && (w[0]..w[1] + 4).contains(&y)
+        });
+        !(along || shaft)
+    })
+}
+
+#[test]
+fn the_twin_reports_the_h743_capacity_and_refuses_more() {
+    need_qemu!();
+    let q = Qemu::tcp_with(twin_firmware());
+    let mut link = q.link();
+    let info = link.hello().expect("hello");
+    assert_eq!(info.board, "qemu-mps2-an386-twin-h743");
+    assert_eq!(info.capacity.cells, CELLS, "{info:?}");
+    assert_eq!(info.capacity.max_steps, STEPS, "{info:?}");
+    // One row more than 2048 x 1024: refused by cells, and nothing is left.
+    let e = error_code(link.set_map(&Map::from_fn(2048, 1025, |_, _| false)));
+    assert_eq!(
+        e,
+        ErrorReply::with(ErrorCode::MapTooLarge, 2048 * 1025, CELLS)
+    );
+    let st = link.stats().expect("stats");
+    assert_eq!((st.map_width, st.map_height), (0, 0), "{st:?}");
+    assert_eq!(link.stray_count(), 0, "{:?}", link.take_strays());
+}
+
+/// Sydney_0_1024 (1024 x 1024 cells, a city of the Moving AI benchmarks): its longest scenario,
+/// with two seeds, bit for bit as the host core plans it with the device's capacity.
+#[test]
+fn a_1024x1024_city_plans_bit_identical_to_the_host() {
+    need_qemu!();
+    let q = Qemu::tcp_with(twin_firmware());
+    let mut link = q.link();
+    let info = link.hello().expect("hello");
+    let steps = info.capacity.max_steps as usize;
+    let defaults = Params::default();
+    assert_eq!(
+        info.defaults, defaults,
+        "firmware and test built from other sources?"
+    );
+    let map = Map::load(maps().join("large/Sydney_0_1024.map")).expect("Sydney_0_1024");
+    assert_eq!((map.width, map.height), (1024, 1024));
+    let t0 = Instant::now();
+    link.set_map(&map).expect("upload");
+    println!(
+        "Sydney_0_1024: upload {:.1} s over QEMU's UART",
+        t0.elapsed().as_secs_f64()
+    );
+    let (start, goal) = longest_scenario("large/Sydney_0_1024.map.scen");
+    let jobs: Vec<PlanJob> = [1, 2]
+        .map(|seed| PlanJob {
+            start,
+            goal,
+            seed: Some(seed),
+        })
+        .to_vec();
+    let t0 = Instant::now();
+    let outcomes = link.plan_many(&jobs).expect("plans");
+    println!(
+        "Sydney_0_1024 {start:?} -> {goal:?}: 2 plans in {:.1} s",
+        t0.elapsed().as_secs_f64()
+    );
+    for (job, o) in jobs.iter().zip(&outcomes) {
+        let seed = job.seed.unwrap_or(0);
+        let params = Params { seed, ..defaults };
+        let host = core_plan_steps(&map, start, goal, &params, steps).expect("host plan");
+        let dev = o.result.as_ref().expect("device path");
+        assert_core_path(&format!("Sydney_0_1024 seed {seed}"), &host, dev);
+        println!(
+            "  seed {seed}: {} cells, length {}, {} iterations, {} ticks",
+            dev.raw_cells, dev.length, dev.iterations, dev.ticks
+        );
+    }
+    let st = link.stats().expect("stats");
+    println!("stack peak {} bytes", st.stack_peak);
+    assert_eq!(link.stray_count(), 0, "{:?}", link.take_strays());
+}
+
+/// A 2048 x 1024 map, all the cells the twin holds: a path of 4,632 steps (four times what the
+/// STM32F411 keeps) is the host core's, bit for bit; a path of about 9,000 steps is
+/// `PathTooLong` with the twin's limit, as the host core says; a path of about 6,700 steps fits
+/// the planner but its reply does not fit the protocol's largest frame (`MAX_REPLY`, 5,248
+/// bytes): until the protocol carries longer paths it is refused with `Internal` (waypoints,
+/// directions), and the device goes on. (If a path is sent, it must be the host core's.)
+#[test]
+fn a_2048x1024_map_and_paths_of_thousands_of_steps() {
+    need_qemu!();
+    let q = Qemu::tcp_with(twin_firmware());
+    let mut link = q.link();
+    let info = link.hello().expect("hello");
+    let steps = info.capacity.max_steps as usize;
+    let map = corridors();
+    assert_eq!(map.cells(), CELLS as usize);
+    let t0 = Instant::now();
+    link.set_map(&map).expect("upload");
+    println!(
+        "2048x1024: upload {:.1} s over QEMU's UART",
+        t0.elapsed().as_secs_f64()
+    );
+    let st = link.stats().expect("stats");
+    assert_eq!((st.map_width, st.map_height), (2048, 1024), "{st:?}");
+
+    let defaults = Params::default();
+    let start = Point::new(9, 101);
+    // Along two corridors and down two shafts: 4,632 steps.
+    let goal = Point::new(9, 702);
+    let t0 = Instant::now();
+    let dev = link.plan(start, goal, None).expect("device plan");
+    println!(
+        "2048x1024 {start:?} -> {goal:?}: {} cells in {:.1} s",
+        dev.raw_cells,
+        t0.elapsed().as_secs_f64()
+    );
+    let host = core_plan_steps(&map, start, goal, &defaults, steps).expect("host plan");
+    assert_core_path("2048x1024, 4,632 steps", &host, &dev);
+    assert!(dev.raw_cells > 4096, "{}", dev.raw_cells);
+
+    // Beyond the twin's 8,191 steps: few ants, few iterations, so it is quick.
+    let few = Params {
+        ants: 4,
+        iterations: 2,
+        ..defaults
+    };
+    link.set_params(&few).expect("set params");
+    let far = Point::new(9, 1001);
+    let e = error_code(link.plan(start, far, None));
+    assert_eq!(e, ErrorReply::with(ErrorCode::PathTooLong, 8, STEPS));
+    let host = core_plan_steps(&map, start, far, &few, steps);
+    assert_eq!(host.err(), Some(e), "the host core's answer");
+
+    // About 6,700 steps: kept by the planner; its reply is over the protocol's largest frame.
+    link.set_params(&defaults).expect("set params");
+    let right = Point::new(2039, 702);
+    let t0 = Instant::now();
+    let r = link.plan(start, right, None);
+    println!(
+        "2048x1024 {start:?} -> {right:?}: {:.1} s",
+        t0.elapsed().as_secs_f64()
+    );
+    let host = core_plan_steps(&map, start, right, &defaults, steps).expect("host plan");
+    match r {
+        Ok(dev) => assert_core_path("2048x1024, 6,700 steps", &host, &dev),
+        Err(e) => {
+            let e = error_code::<()>(Err(e));
+            let (wps, dirs) = (host.waypoints.len(), host.directions.len());
+            assert_eq!(
+                e,
+                ErrorReply::with(ErrorCode::Internal, wps as u32, dirs as u32),
+                "{e}"
+            );
+        }
+    }
+    // The device goes on: the short plan again.
+    let again = link.plan(start, goal, None).expect("device plan");
+    assert_eq!(again.raw_cells, host_cells(&map, start, goal, steps));
+    let st = link.stats().expect("stats");
+    println!("stack peak {} bytes", st.stack_peak);
+    assert_eq!(link.stray_count(), 0, "{:?}", link.take_strays());
+}
+
+fn host_cells(map: &Map, start: Point, goal: Point, steps: usize) -> u32 {
+    core_plan_steps(map, start, goal, &Params::default(), steps)
+        .expect("host plan")
+        .raw_cells
+}

@@ -1,0 +1,277 @@
+//! Where the map buffer and the planner's buffers live in RAM, per board, and the one function
+//! that hands them out at boot: [`take`].
+//!
+//! - **STM32F411 and the default QEMU board** (maps of up to 65,536 cells): the map (8 KiB) and
+//!   one `ohaca::planner::Storage` static, both zero-initialised in `.bss`.
+//! - **STM32H743 and its QEMU twin** (`twin-h743`; maps of up to 2,097,152 cells, paths of up
+//!   to 8,191 steps): the map (256 KiB) and the planner's two per-cell bit sets (256 KiB each)
+//!   do not fit one RAM region (the largest, the AXI SRAM, has 512 KiB), so every buffer is a
+//!   static of its own, placed with `#[link_section]` into the board's regions
+//!   (`board/stm32h743-memory.x`, `board/qemu/twin-h743-memory.x`), and the planner's workspace
+//!   is built from them with `Workspace::new(Buffers { .. })`:
+//!
+//! | region (size) | section | buffers | bytes |
+//! | --- | --- | --- | ---: |
+//! | AXI SRAM (512 KiB) | `.axisram` (NOLOAD) | map, `tabu` | 262,144 + 262,144 |
+//! | SRAM1-3 (288 KiB) | `.sram123` (NOLOAD) | `dead`, `tau`, `delta` | 262,144 + 16,384 + 16,384 |
+//! | SRAM4 (64 KiB) | `.sram4` (NOLOAD) | `links` (2 x 8,192) | 65,536 |
+//! | DTCM (128 KiB) | `.bss` | 4 tours (8,192 each), `points` (8,192), `guide`, `curve`, `moves` | 32,768 + 32,768 + 16,384 + 2,048 + 1,024 |
+//!
+//! Every region but the DTCM is then full to the byte; the DTCM keeps 45 KiB for the rest of the
+//! firmware's statics (about 6 KiB) and the stack (3.4 KiB measured: BENCHMARKS.md, section 5b). An ant path step costs 16 bytes (a byte in each of
+//! the four tours, a 4-byte path cell, two 4-byte links): 8,192 steps take 128 KiB, which is
+//! what the regions have left beside the 768 KiB of per-cell bits (16,384 steps would need
+//! 256 KiB).
+//!
+//! The NOLOAD sections are not touched by the startup code (cortex-m-rt zeroes `.bss` only), so
+//! their statics are `Region`s, `MaybeUninit` memory that [`take`] fills with zeros element by
+//! element before it lends it out, once. Nothing reads them before.
+
+pub use layout::{take, MapBuf, PlanStorage, BYTES, MAP_INIT};
+
+/// The planner's storage as one `Storage` static (STM32F411 and the default QEMU board).
+#[cfg(not(feature = "twin-h743"))]
+#[cfg(not(feature = "board-stm32h743"))]
+mod layout {
+    use static_cell::ConstStaticCell;
+
+    use crate::firmware::state::{MAP_BYTES, PLAN_CELLS, PLAN_STEPS};
+
+    /// Two bits a map cell (tabu list, pruned cells), the pheromone budget, the coarse route,
+    /// four ant paths of [`PLAN_STEPS`] steps, links, and the move table for maps of up to 1024
+    /// cells (`ohaca::planner::workspace` lists what each holds).
+    pub type PlanStorage = ohaca::planner::Storage<
+        { ohaca::bitmap::words(PLAN_CELLS) },
+        { PLAN_STEPS + 1 },
+        4096,
+        1024,
+    >;
+
+    /// Bytes of the planner's storage.
+    pub const BYTES: usize = PlanStorage::BYTES;
+
+    /// The map buffer: the array itself, inside `state::MAP`'s lock (in `.bss`).
+    pub type MapBuf = [u8; MAP_BYTES];
+    /// Its value at boot.
+    pub const MAP_INIT: MapBuf = [0; MAP_BYTES];
+
+    /// Zero-initialised, so it lives in `.bss`.
+    static STORAGE: ConstStaticCell<PlanStorage> = ConstStaticCell::new(PlanStorage::new());
+
+    /// Hand out the planner's storage (the map is already in `state::MAP`). Call once, at boot,
+    /// before any task runs; a second call panics.
+    pub fn take() -> &'static mut PlanStorage {
+        STORAGE.take()
+    }
+}
+
+/// The planner's storage as separate statics over the STM32H743's RAM regions (the H743 and
+/// its QEMU twin; the module docs have the table).
+#[cfg(any(feature = "twin-h743", feature = "board-stm32h743"))]
+mod layout {
+    use core::cell::UnsafeCell;
+    use core::mem::{size_of, MaybeUninit};
+    use core::sync::atomic::{AtomicBool, Ordering};
+
+    use static_cell::ConstStaticCell;
+
+    use ohaca::bitmap::words;
+    use ohaca::grid::{Dir, Point};
+    use ohaca::pheromone::BLOCKS;
+    use ohaca::planner::{Buffers, CurvePoint, Workspace};
+    use ohaca::route::GUIDE_BLOCKS;
+
+    use crate::firmware::state::{MAP_BYTES, PLAN_CELLS, PLAN_STEPS};
+
+    /// The map buffer behind `state::MAP`'s lock: the [`MAP`] static, lent to it once by
+    /// [`take`]; empty before (nothing can read unset memory through it).
+    pub struct MapBuf(Option<&'static mut [u8]>);
+
+    /// Its value at boot: no buffer yet.
+    pub const MAP_INIT: MapBuf = MapBuf(None);
+
+    impl core::ops::Deref for MapBuf {
+        type Target = [u8];
+        fn deref(&self) -> &[u8] {
+            self.0.as_deref().unwrap_or(&[])
+        }
+    }
+
+    impl core::ops::DerefMut for MapBuf {
+        fn deref_mut(&mut self) -> &mut [u8] {
+            match &mut self.0 {
+                Some(b) => b,
+                None => &mut [],
+            }
+        }
+    }
+
+    /// Words of each per-cell bit set.
+    const WORDS: usize = words(PLAN_CELLS);
+    /// Entries of each tour and of the path cells: paths of up to [`PLAN_STEPS`] steps.
+    const STEPS: usize = PLAN_STEPS + 1;
+    /// Links: two per path cell (tightening's positions and its hash table), and at least the
+    /// coarse route's blocks.
+    const LINKS: usize = if 2 * STEPS > GUIDE_BLOCKS {
+        2 * STEPS
+    } else {
+        GUIDE_BLOCKS
+    };
+    /// The move table for maps of up to this many cells (larger maps compute moves on the fly).
+    const MOVES: usize = 1024;
+    /// Iterations of the convergence curve kept.
+    const CURVE: usize = 128;
+
+    /// Memory the startup code does not initialise (a NOLOAD section): [`Region::fill`] writes
+    /// every element before the memory is lent out, once.
+    #[repr(transparent)]
+    struct Region<T, const N: usize>(UnsafeCell<MaybeUninit<[T; N]>>);
+
+    // SAFETY: the memory is only reached through `fill`, which `take` calls once per region
+    // (guarded by `TAKEN`), before any task runs; afterwards the one `&'static mut` it returned
+    // is the only way to it.
+    unsafe impl<T, const N: usize> Sync for Region<T, N> {}
+
+    impl<T: Copy, const N: usize> Region<T, N> {
+        const fn new() -> Self {
+            Region(UnsafeCell::new(MaybeUninit::uninit()))
+        }
+
+        /// Write `value` into every element and lend the whole array.
+        ///
+        /// # Safety
+        /// At most once per region (the returned reference is exclusive for `'static`).
+        #[allow(clippy::mut_from_ref)] // the memory is an UnsafeCell's, lent once (# Safety)
+        unsafe fn fill(&'static self, value: T) -> &'static mut [T] {
+            let first = self.0.get().cast::<T>();
+            for i in 0..N {
+                // SAFETY: `i < N`: inside the array; nothing else refers to it (the caller's
+                // promise), and writing does not read the uninitialised value.
+                unsafe { first.add(i).write(value) };
+            }
+            // SAFETY: all `N` elements were just initialised; the caller lends them once.
+            unsafe { core::slice::from_raw_parts_mut(first, N) }
+        }
+    }
+
+    /// The map: AXI SRAM.
+    #[link_section = ".axisram.map"]
+    static MAP: Region<u8, MAP_BYTES> = Region::new();
+    /// The tabu bit set: AXI SRAM, beside the map.
+    #[link_section = ".axisram.tabu"]
+    static TABU: Region<u32, WORDS> = Region::new();
+    /// The pruned-cell bit set: SRAM1-3.
+    #[link_section = ".sram123.dead"]
+    static DEAD: Region<u32, WORDS> = Region::new();
+    /// Pheromone and its increments: SRAM1-3, after `dead`.
+    #[link_section = ".sram123.tau"]
+    static TAU: Region<[f32; 4], BLOCKS> = Region::new();
+    #[link_section = ".sram123.delta"]
+    static DELTA: Region<[f32; 4], BLOCKS> = Region::new();
+    /// Links: SRAM4.
+    #[link_section = ".sram4.links"]
+    static LINKS_BUF: Region<u32, LINKS> = Region::new();
+
+    /// What stays in the DTCM's `.bss` (zeroed by the startup code): the tours, the path cells,
+    /// the coarse route, the curve and the move table.
+    struct Dtcm {
+        tours: [[Dir; STEPS]; 4],
+        points: [Point; STEPS],
+        guide: [u32; GUIDE_BLOCKS],
+        curve: [CurvePoint; CURVE],
+        moves: [u8; MOVES],
+    }
+    static DTCM: ConstStaticCell<Dtcm> = ConstStaticCell::new(Dtcm {
+        tours: [[0; STEPS]; 4],
+        points: [Point::new(0, 0); STEPS],
+        guide: [0; GUIDE_BLOCKS],
+        curve: [CurvePoint {
+            best: 0.0,
+            mean: 0.0,
+            best_so_far: 0.0,
+            arrived: 0,
+        }; CURVE],
+        moves: [0; MOVES],
+    });
+
+    static TAKEN: AtomicBool = AtomicBool::new(false);
+
+    /// Bytes of the planner's buffers (without the map).
+    pub const BYTES: usize = 2 * size_of::<[u32; WORDS]>()
+        + 2 * size_of::<[[f32; 4]; BLOCKS]>()
+        + size_of::<[u32; LINKS]>()
+        + size_of::<Dtcm>();
+
+    /// The planner's buffers, each a `'static` slice of its own static.
+    pub struct PlanStorage {
+        tau: &'static mut [[f32; 4]],
+        delta: &'static mut [[f32; 4]],
+        tabu: &'static mut [u32],
+        dead: &'static mut [u32],
+        moves: &'static mut [u8],
+        tours: [&'static mut [Dir]; 4],
+        points: &'static mut [Point],
+        links: &'static mut [u32],
+        curve: &'static mut [CurvePoint],
+        guide: &'static mut [u32],
+    }
+
+    impl PlanStorage {
+        /// Lend the buffers as a workspace for one run.
+        pub fn workspace(&mut self) -> Workspace<'_> {
+            let [t0, t1, t2, t3] = &mut self.tours;
+            Workspace::new(Buffers {
+                tau: self.tau,
+                delta: self.delta,
+                tabu: self.tabu,
+                dead: self.dead,
+                moves: self.moves,
+                tours: [t0, t1, t2, t3],
+                points: self.points,
+                links: self.links,
+                curve: self.curve,
+                guide: self.guide,
+            })
+        }
+    }
+
+    /// Build the planner's storage from the statics and lend the map static to `state::MAP`:
+    /// the one place that does. Call once, at boot, after the board's `init` (on the STM32H743 it
+    /// enables the SRAM1-3 clocks) and before any task runs; a second call panics.
+    pub fn take() -> &'static mut PlanStorage {
+        static STORAGE: ConstStaticCell<Option<PlanStorage>> = ConstStaticCell::new(None);
+        let taken = TAKEN.swap(true, Ordering::AcqRel);
+        defmt::assert!(!taken, "the planner's buffers are taken once");
+        // SAFETY: once (`TAKEN`), so each region is filled and lent once.
+        let (map, tabu, dead, tau, delta, links) = unsafe {
+            (
+                MAP.fill(0),
+                TABU.fill(0),
+                DEAD.fill(0),
+                TAU.fill([0.0; 4]),
+                DELTA.fill([0.0; 4]),
+                LINKS_BUF.fill(0),
+            )
+        };
+        let dtcm = DTCM.take();
+        let [t0, t1, t2, t3] = &mut dtcm.tours;
+        let storage = STORAGE.take().insert(PlanStorage {
+            tau,
+            delta,
+            tabu,
+            dead,
+            moves: &mut dtcm.moves,
+            tours: [t0, t1, t2, t3],
+            points: &mut dtcm.points,
+            links,
+            curve: &mut dtcm.curve,
+            guide: &mut dtcm.guide,
+        });
+        let mut buf = defmt::unwrap!(
+            crate::firmware::state::MAP.try_lock().ok(),
+            "the map buffer is locked at boot"
+        );
+        buf.0 = Some(map);
+        storage
+    }
+}
