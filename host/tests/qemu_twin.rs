@@ -142,6 +142,38 @@ fn a_1024x1024_city_plans_bit_identical_to_the_host() {
     assert_eq!(link.stray_count(), 0, "{:?}", link.take_strays());
 }
 
+/// `maze-128-128-2`'s longest scenario (a 1-wide maze; the optimum has 1,379 steps, more than the
+/// STM32F411 build's 1,023, which answers `PathTooLong`): the twin plans it, bit for bit as the
+/// host core with the twin's capacity, and its raw path is the optimum.
+#[test]
+fn the_longest_maze_128_128_2_scenario_plans_on_the_twin() {
+    need_qemu!();
+    let q = Qemu::tcp_with(twin_firmware());
+    let mut link = q.link();
+    let info = link.hello().expect("hello");
+    let steps = info.capacity.max_steps as usize;
+    let map = Map::load(maps().join("large/maze-128-128-2.map")).expect("maze-128-128-2");
+    link.set_map(&map).expect("upload");
+    let (start, goal) = longest_scenario("large/maze-128-128-2-random-1.scen");
+    let params = Params {
+        seed: 1,
+        ..Params::default()
+    };
+    let dev = link.plan(start, goal, Some(1)).expect("device path");
+    let host = core_plan_steps(&map, start, goal, &params, steps).expect("host plan");
+    assert_core_path("maze-128-128-2", &host, &dev);
+    assert!(dev.raw_cells > 1024, "{} cells", dev.raw_cells);
+    assert!(
+        (f64::from(dev.raw_length) - 1458.11).abs() < 0.01,
+        "raw {}",
+        dev.raw_length
+    );
+    println!(
+        "maze-128-128-2 {start:?} -> {goal:?}: {} cells, raw {}, {} iterations, {} ticks",
+        dev.raw_cells, dev.raw_length, dev.iterations, dev.ticks
+    );
+}
+
 /// A 2048 x 1024 map, all the cells the twin holds: a path of 4,632 steps (four times what the
 /// STM32F411 keeps) is the host core's, bit for bit; a path of about 9,000 steps is
 /// `PathTooLong` with the twin's limit, as the host core says; a path of about 6,700 steps fits
