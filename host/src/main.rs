@@ -42,6 +42,9 @@ enum Command {
     Send(cmd::send::Args),
     /// Drive a robot through map changes and replan warm or cold (host core or a device)
     Replan(cmd::replan::Args),
+    /// Run as a ROS 2 node: /map, /goal_pose, /initialpose in, /plan and Nav2's
+    /// compute_path_to_pose out (host core or a device)
+    Ros(Box<cmd::ros::Args>),
 }
 
 fn main() -> ExitCode {
@@ -55,6 +58,7 @@ fn main() -> ExitCode {
         Command::Experiment(args) => cmd::experiment::run(&args),
         Command::Send(args) => cmd::send::run(&args),
         Command::Replan(args) => cmd::replan::run(&args),
+        Command::Ros(args) => cmd::ros::run(&args),
     };
     ExitCode::from(code)
 }

@@ -4,6 +4,7 @@ pub mod experiment;
 pub mod plan;
 pub mod render;
 pub mod replan;
+pub mod ros;
 pub mod send;
 
 use std::io::Write;
