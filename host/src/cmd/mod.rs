@@ -1,5 +1,6 @@
 //! The subcommands, one module each, plus the output helpers they share.
 
+pub mod check;
 pub mod experiment;
 pub mod plan;
 pub mod render;

@@ -82,7 +82,9 @@ pub fn grid_map(g: &OccupancyGrid, rule: &Occupancy01) -> Result<(Map, MapFrame)
             g.data.len()
         ));
     }
-    let res = f64::from(g.info.resolution);
+    // The decimal the publisher meant: map_server's 0.05 arrives as the float32 nearest to it,
+    // 0.0500000007 in f64, and an inflation of 0.1 m must stay 2 cells, not 1.99999997.
+    let res = decimal_f64(g.info.resolution);
     if !(res.is_finite() && res > 0.0) {
         return Err(format!(
             "map resolution {} is not a positive number",
@@ -107,6 +109,11 @@ pub fn grid_map(g: &OccupancyGrid, rule: &Occupancy01) -> Result<(Map, MapFrame)
         height: h16,
     };
     Ok((map, frame))
+}
+
+/// The shortest decimal that reads back as `v` (Rust prints `f32`s that way), as an `f64`.
+pub fn decimal_f64(v: f32) -> f64 {
+    v.to_string().parse().unwrap_or(f64::NAN)
 }
 
 /// Apply an `OccupancyGridUpdate` to `map` (the grid before inflation): the window's cells take
@@ -247,6 +254,14 @@ mod tests {
         let mut bad = grid(1, 1, vec![0]);
         bad.info.resolution = f32::NAN;
         assert!(grid_map(&bad, &Occupancy01::default()).is_err());
+    }
+
+    #[test]
+    fn a_float32_resolution_is_the_decimal_it_stands_for() {
+        assert_eq!(decimal_f64(0.05), 0.05);
+        assert_eq!(decimal_f64(0.1), 0.1);
+        let (_, frame) = grid_map(&grid(1, 1, vec![0]), &Occupancy01::default()).unwrap();
+        assert_eq!(frame.resolution, 0.5);
     }
 
     #[test]

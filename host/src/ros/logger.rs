@@ -1,6 +1,7 @@
 //! The log of `ohaca ros`: one line per event on stderr, `HH:MM:SS.mmm LEVEL message` (UTC),
 //! through the `log` facade that ros2-client and RustDDS also use. Our own lines from `level`
-//! up; the DDS libraries' only from warnings up (`--log-level debug` shows theirs too).
+//! up; the DDS libraries' only errors (RustDDS warns about every locator it skips; `--log-level
+//! debug` shows theirs too).
 
 use std::io::Write;
 
@@ -16,7 +17,7 @@ impl Log for Stderr {
         m.level() <= if ours || self.level >= Level::Debug {
             self.level
         } else {
-            Level::Warn
+            Level::Error
         }
     }
 
