@@ -303,6 +303,8 @@ class Test:
         cmd += ["--tcp", self.a.tcp] if self.a.tcp else ["--host"]
         if self.a.gif:
             cmd += ["--gif", self.a.gif]
+        if self.a.png:
+            cmd += ["--png", self.a.png]
         self.say("node: " + " ".join(cmd))
         self.log = open(self.log_path, "w")
         self.node = subprocess.Popen(cmd, stdin=subprocess.DEVNULL, stdout=self.log, stderr=self.log)
@@ -453,12 +455,12 @@ class Test:
         self.say(f"plan 2 valid on the updated map (plan 1 is not): {c2}")
         # 3. the action, with rmw_cyclonedds's service mapping.
         t = time.monotonic()
-        res = self.action_call(10, GOAL, START)
+        res = self.action_call(10, GOAL, here)
         if res.status != 4 or res.result.error_code != 0:
             raise Fail(f"the action should succeed: status {res.status}, error {res.result.error_code} "
                        f"{res.result.error_msg!r}")
         pt = res.result.planning_time
-        c3 = self.check(res.result.path, self.upd_yaml, START, GOAL, name="action")
+        c3 = self.check(res.result.path, self.upd_yaml, here, GOAL, name="action")
         self.say(f"action: SUCCEEDED in {time.monotonic() - t:.2f} s (planning_time "
                  f"{pt.sec + pt.nanosec / 1e9:.3f} s), path valid: {c3}")
         off = (ORIGIN[0] - 1.0, 0.0)
@@ -478,6 +480,7 @@ def main():
     ap.add_argument("--domain", type=int, help="DDS domain (default: random in 100..200)")
     ap.add_argument("--timeout", type=float, default=30.0, help="seconds per wait")
     ap.add_argument("--gif", help="ask the node to draw the replanning drive into this GIF")
+    ap.add_argument("--png", help="the same drive as a strip of PNG panels")
     ap.add_argument("--log", action="store_true", help="print the node's log even on success")
     args = ap.parse_args()
     t = Test(args)

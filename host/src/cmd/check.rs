@@ -14,9 +14,9 @@
 use std::path::PathBuf;
 
 use ohaca::geometry::segment_clear;
+use ohaca_host::exit;
 use ohaca_host::input::{parse_length, parse_metres};
 use ohaca_host::map::{prepare, Unknown};
-use ohaca_host::exit;
 
 use super::{bad_input, print};
 

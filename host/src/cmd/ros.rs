@@ -134,6 +134,9 @@ pub struct Args {
     /// Draw the plans to the current goal (and the updates between them) as an animated GIF
     #[arg(long, value_name = "FILE")]
     pub gif: Option<PathBuf>,
+    /// Draw the same as a strip of PNG panels, one per plan
+    #[arg(long, value_name = "FILE")]
+    pub png: Option<PathBuf>,
     /// Stop after this many seconds (default: run until killed)
     #[arg(long, value_name = "SECONDS")]
     pub run_for: Option<f64>,
@@ -146,7 +149,9 @@ pub struct Args {
 
 fn seconds(v: f64, what: &str) -> Result<Duration, String> {
     if !(v > 0.0 && v <= 86_400.0 * 365.0) {
-        return Err(format!("{what} must be a positive number of seconds, not {v}"));
+        return Err(format!(
+            "{what} must be a positive number of seconds, not {v}"
+        ));
     }
     Duration::try_from_secs_f64(v).map_err(|e| format!("{what}: {e}"))
 }
@@ -221,17 +226,17 @@ fn config(args: &Args) -> Result<NodeConfig, String> {
             MappingArg::Basic => ServiceMapping::Basic,
         },
         gif: args.gif.clone(),
-        run_for: args
-            .run_for
-            .map(|v| seconds(v, "--run-for"))
-            .transpose()?,
+        png: args.png.clone(),
+        run_for: args.run_for.map(|v| seconds(v, "--run-for")).transpose()?,
     })
 }
 
 /// Run `ohaca ros`; returns the exit code.
 pub fn run(args: &Args) -> u8 {
     let ok = |p: f64| (0.0..=1.0).contains(&p);
-    if !(ok(args.occupied_thresh) && ok(args.free_thresh) && args.free_thresh <= args.occupied_thresh)
+    if !(ok(args.occupied_thresh)
+        && ok(args.free_thresh)
+        && args.free_thresh <= args.occupied_thresh)
     {
         return bad_input(format!(
             "thresholds must be in [0, 1] with --free-thresh ({}) <= --occupied-thresh ({})",

@@ -283,9 +283,8 @@ mod tests {
 
     #[test]
     fn an_unreachable_device_is_an_error_not_a_panic() {
-        let connect: Connect<std::net::TcpStream> = Box::new(|| {
-            Link::tcp("127.0.0.1:1", std::time::Duration::from_millis(200))
-        });
+        let connect: Connect<std::net::TcpStream> =
+            Box::new(|| Link::tcp("127.0.0.1:1", std::time::Duration::from_millis(200)));
         let mut b = DeviceBackend::new("127.0.0.1:1", connect, Params::default());
         let map = Map::from_fn(4, 4, |_, _| false);
         assert!(matches!(b.upload(&map), Err(BackendError::Unreachable(_))));

@@ -157,12 +157,7 @@ pub fn apply_update(
     }
     let cell = |v: i64| u16::try_from(v).unwrap_or(0);
     // ROS rows cy0..cy1 are planner rows mh - cy1 ..= mh - 1 - cy0.
-    Ok((
-        cell(cx0),
-        cell(mh - cy1),
-        cell(cx1 - cx0),
-        cell(cy1 - cy0),
-    ))
+    Ok((cell(cx0), cell(mh - cy1), cell(cx1 - cx0), cell(cy1 - cy0)))
 }
 
 /// The position of a pose, in metres (x, y), if finite.
@@ -293,21 +288,20 @@ mod tests {
             ..u.clone()
         };
         assert_eq!(apply_update(&mut map, &edge, &rule), Ok((3, 0, 1, 1)));
-        let off = OccupancyGridUpdate {
-            x: 9,
-            ..u.clone()
-        };
+        let off = OccupancyGridUpdate { x: 9, ..u.clone() };
         assert!(apply_update(&mut map, &off, &rule).is_err());
-        let short = OccupancyGridUpdate {
-            data: vec![0],
-            ..u
-        };
+        let short = OccupancyGridUpdate { data: vec![0], ..u };
         assert!(apply_update(&mut map, &short, &rule).is_err());
     }
 
     #[test]
     fn poses_face_the_next_point() {
-        let p = ros_path(&[[0.0, 0.0], [1.0, 1.0], [1.0, 2.0]], 0.3, "map", Time::default());
+        let p = ros_path(
+            &[[0.0, 0.0], [1.0, 1.0], [1.0, 2.0]],
+            0.3,
+            "map",
+            Time::default(),
+        );
         assert_eq!(p.poses.len(), 3);
         let yaw = |i: usize| p.poses[i].pose.orientation.yaw();
         assert!((yaw(0) - std::f64::consts::FRAC_PI_4).abs() < 1e-9);

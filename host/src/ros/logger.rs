@@ -14,11 +14,12 @@ struct Stderr {
 impl Log for Stderr {
     fn enabled(&self, m: &Metadata<'_>) -> bool {
         let ours = m.target().starts_with("ohaca");
-        m.level() <= if ours || self.level >= Level::Debug {
-            self.level
-        } else {
-            Level::Error
-        }
+        m.level()
+            <= if ours || self.level >= Level::Debug {
+                self.level
+            } else {
+                Level::Error
+            }
     }
 
     fn log(&self, r: &Record<'_>) {

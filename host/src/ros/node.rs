@@ -10,7 +10,7 @@
 //! | `/goal_pose` (sub) | `geometry_msgs/PoseStamped` | reliable, volatile, depth 10 | plan from the last start to it |
 //! | `/initialpose` (sub; `--start-topic`) | `geometry_msgs/PoseWithCovarianceStamped` | reliable, volatile, depth 10 | the start of later plans |
 //! | `/plan` (pub) | `nav_msgs/Path` | reliable, transient local, depth 1 | every plan, in the map's frame |
-//! | `/plan_info` (pub) | `std_msgs/String` | reliable, transient local, depth 1 | one JSON object per plan: `seq`, `trigger`, `warm`, times, lengths, backend |
+//! | `/plan_info` (pub) | `std_msgs/String` | reliable, transient local, depth 1 | one JSON object per plan: `seq`, `trigger`, `warm`, times, lengths, backend, the last map upload |
 //! | `compute_path_to_pose` (action) | `nav2_msgs/action/ComputePathToPose` | ROS 2 action defaults | [`super::action`] |
 //!
 //! A message in another frame than the map's is refused (there is no TF here): the map frame
@@ -35,6 +35,9 @@ use super::msg::{
 };
 use super::planning::{PlanError, PlanOut, Planning};
 use super::record::Recorder;
+use crate::map::Map;
+use crate::replan::Planned;
+use ohaca::Point;
 
 /// Topic and action names (ROS names: `/map`, `map`, `/robot1/map`, ...).
 #[derive(Clone, Debug)]
@@ -101,6 +104,8 @@ pub struct NodeConfig {
     pub service_mapping: ServiceMapping,
     /// `--gif`: draw the plans to the current goal.
     pub gif: Option<PathBuf>,
+    /// `--png`: the same as a strip of panels.
+    pub png: Option<PathBuf>,
     /// Stop after this long (tests, benchmarks); run until killed otherwise.
     pub run_for: Option<Duration>,
 }
@@ -135,7 +140,12 @@ fn endpoints(node: &mut Node, cfg: &NodeConfig) -> Result<(Endpoints, PathAction
     let map_t = topic(&t.map, "nav_msgs", "OccupancyGrid", &q.map)?;
     let upd_t = topic(&t.map_updates, "map_msgs", "OccupancyGridUpdate", &q.input)?;
     let goal_t = topic(&t.goal, "geometry_msgs", "PoseStamped", &q.input)?;
-    let start_t = topic(&t.start, "geometry_msgs", "PoseWithCovarianceStamped", &q.input)?;
+    let start_t = topic(
+        &t.start,
+        "geometry_msgs",
+        "PoseWithCovarianceStamped",
+        &q.input,
+    )?;
     let plan_t = topic(&t.plan, "nav_msgs", "Path", &q.output)?;
     let info_t = topic(&t.plan_info, "std_msgs", "String", &q.output)?;
     let service = QosProfile::publisher_default()
@@ -203,6 +213,8 @@ struct State {
     goal: Option<([f64; 2], f64)>,
     seq: u64,
     recorder: Option<Recorder>,
+    /// Plans still to draw (`--gif`).
+    to_draw: Vec<(Map, (Point, Point), Planned)>,
 }
 
 impl State {
@@ -254,6 +266,8 @@ impl State {
             "backend": self.planning.describe(),
             "factor": out.factor,
             "cells": [out.sent_size.0, out.sent_size.1],
+            "upload_s": self.planning.last_upload().map(|u| u.0),
+            "upload_bytes": self.planning.last_upload().map(|u| u.1),
         });
         log::info!(
             "plan {} ({trigger}): {} poses, {:.2} m, {} iterations, {}, in {:.3} s on {}",
@@ -273,12 +287,24 @@ impl State {
         }) {
             log::warn!("cannot publish the plan info: {e:?}");
         }
-        if let (Some(rec), Some(map)) = (self.recorder.as_mut(), self.planning.sent_map()) {
-            if let Err(e) = rec.plan(map, out.ends, &out.planned) {
+        if let (true, Some(map)) = (self.recorder.is_some(), self.planning.sent_map()) {
+            self.to_draw
+                .push((map.clone(), out.ends, out.planned.clone()));
+        }
+        Ok((path, out))
+    }
+
+    /// `--gif`: draw the plans made since the last call (after the answers went out: drawing
+    /// takes a while).
+    fn draw(&mut self) {
+        let Some(rec) = self.recorder.as_mut() else {
+            return;
+        };
+        for (map, ends, planned) in self.to_draw.drain(..) {
+            if let Err(e) = rec.plan(&map, ends, &planned) {
                 log::warn!("--gif: {e}");
             }
         }
-        Ok((path, out))
     }
 
     /// The action's goal: plan and answer.
@@ -306,8 +332,12 @@ impl State {
         if let Some(msg) = frames.into_iter().flatten().next() {
             return Err(fail(error_code::TF_ERROR, msg));
         }
-        let goal = position(&g.goal.pose)
-            .ok_or_else(|| fail(error_code::GOAL_OUTSIDE_MAP, "the goal is not finite".into()))?;
+        let goal = position(&g.goal.pose).ok_or_else(|| {
+            fail(
+                error_code::GOAL_OUTSIDE_MAP,
+                "the goal is not finite".into(),
+            )
+        })?;
         let start = if g.use_start {
             position(&g.start.pose).ok_or_else(|| {
                 fail(
@@ -432,8 +462,8 @@ pub fn run(cfg: NodeConfig, planning: Planning) -> Result<(), String> {
         .map_err(|e| format!("cannot start DDS (domain {}): {e:?}", cfg.domain))?;
     let context = Context::from_domain_participant(participant)
         .map_err(|e| format!("cannot start ROS 2: {e:?}"))?;
-    let node_name =
-        NodeName::new("/", &cfg.name).map_err(|e| format!("bad node name `{}`: {e:?}", cfg.name))?;
+    let node_name = NodeName::new("/", &cfg.name)
+        .map_err(|e| format!("bad node name `{}`: {e:?}", cfg.name))?;
     let mut node = context
         .new_node(node_name, NodeOptions::new().enable_rosout(false))
         .map_err(|e| format!("cannot create the node: {e:?}"))?;
@@ -459,12 +489,15 @@ pub fn run(cfg: NodeConfig, planning: Planning) -> Result<(), String> {
         start: None,
         goal: None,
         seq: 0,
-        recorder: cfg.gif.clone().map(Recorder::new),
+        recorder: (cfg.gif.is_some() || cfg.png.is_some())
+            .then(|| Recorder::new(cfg.gif.clone(), cfg.png.clone())),
+        to_draw: Vec::new(),
     };
     let began = Instant::now();
     loop {
         let mut busy = state.topics(&ep);
         busy |= action.poll(&mut |g| state.action(&ep, g));
+        state.draw();
         if cfg.run_for.is_some_and(|d| began.elapsed() >= d) {
             log::info!("stopping after {:.1} s", began.elapsed().as_secs_f64());
             return Ok(());

@@ -23,6 +23,7 @@ use ohaca::Point;
 use super::backend::{Backend, BackendError};
 use super::convert::{apply_update, grid_map, Occupancy01};
 use super::msg::{error_code, OccupancyGrid, OccupancyGridUpdate};
+use crate::link::MapCode;
 use crate::map::{fit, fits, inflate, Fitted, Map, MapFrame};
 use crate::replan::Planned;
 
@@ -111,6 +112,8 @@ pub struct Planning {
     /// `--inflate`, metres.
     inflate_m: Option<f64>,
     loaded: Option<Loaded>,
+    /// The last whole-map upload: seconds, and the map's bytes as coded for the wire.
+    last_upload: Option<(f64, usize)>,
 }
 
 /// Cells of `a` and `b` (same sides) that differ, split into blocked in `b` and cleared in `b`.
@@ -147,6 +150,7 @@ impl Planning {
             rule,
             inflate_m,
             loaded: None,
+            last_upload: None,
         }
     }
 
@@ -209,11 +213,17 @@ impl Planning {
         // Forget the old map first: if this one cannot be sent, there is none.
         self.loaded = None;
         let fitted = self.fitted(&map, &frame, &[])?;
-        let sent = fitted.as_ref().map_or_else(|| map.clone(), |f| f.map.clone());
+        let sent = fitted
+            .as_ref()
+            .map_or_else(|| map.clone(), |f| f.map.clone());
         let t0 = Instant::now();
         self.backend.upload(&sent)?;
+        let secs = t0.elapsed().as_secs_f64();
+        let bytes = MapCode::of(&sent).bytes().len();
+        self.last_upload = Some((secs, bytes));
         let text = format!(
-            "map {}x{} cells of {} m in frame `{}` sent to {} as {}x{} in {:.3} s",
+            "map {}x{} cells of {} m in frame `{}` sent to {} as {}x{} ({bytes} bytes coded) in \
+             {secs:.3} s",
             map.width,
             map.height,
             frame.cell_size_m(),
@@ -221,7 +231,6 @@ impl Planning {
             self.backend.describe(),
             sent.width,
             sent.height,
-            t0.elapsed().as_secs_f64()
         );
         self.loaded = Some(Loaded {
             grid,
@@ -414,6 +423,12 @@ impl Planning {
         })
     }
 
+    /// The last whole-map upload: seconds, and the map's bytes as coded for the wire
+    /// ([`MapCode`]; frames add a few per chunk).
+    pub fn last_upload(&self) -> Option<(f64, usize)> {
+        self.last_upload
+    }
+
     /// The map as the backend holds it (for pictures of the drive).
     pub fn sent_map(&self) -> Option<&Map> {
         self.loaded.as_ref().map(|l| &l.sent)
@@ -480,7 +495,12 @@ mod tests {
         assert!(again.warm, "the replan keeps the colony");
         assert!(again.cells.iter().all(|c| c.x != 10 || c.y == 0));
         for (what, s, g, code) in [
-            ("off", [-1.0, 0.5], [1.95, 0.5], error_code::START_OUTSIDE_MAP),
+            (
+                "off",
+                [-1.0, 0.5],
+                [1.95, 0.5],
+                error_code::START_OUTSIDE_MAP,
+            ),
             ("off", [0.05, 0.5], [5.0, 0.5], error_code::GOAL_OUTSIDE_MAP),
             ("on", [1.05, 0.5], [1.95, 0.5], error_code::START_OCCUPIED),
             ("on", [0.05, 0.5], [1.05, 0.3], error_code::GOAL_OCCUPIED),

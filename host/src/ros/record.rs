@@ -1,5 +1,6 @@
-//! `ohaca ros --gif FILE`: the plans to one goal as a replanning drive ([`Drive`]), drawn as an
-//! animated GIF ([`crate::strip::save_gif`]) after every plan, in the backend's cells: the map
+//! `ohaca ros --gif FILE` / `--png FILE`: the plans to one goal as a replanning drive
+//! ([`Drive`]), drawn as an animated GIF ([`crate::strip::save_gif`]) or a strip of panels
+//! ([`crate::strip::save_strip`]) after every plan, in the backend's cells: the map
 //! each plan saw, the cells the updates before it changed, the plan, and the robot's trail from
 //! one plan's start to the next along the plan it followed. A new goal (or map) starts a new
 //! drive.
@@ -10,11 +11,12 @@ use ohaca::Point;
 
 use crate::map::Map;
 use crate::replan::{Drive, Planned, Step};
-use crate::strip::save_gif;
+use crate::strip::{save_gif, save_strip};
 
 /// See the module docs.
 pub struct Recorder {
-    path: PathBuf,
+    gif: Option<PathBuf>,
+    png: Option<PathBuf>,
     goal: Option<Point>,
     steps: Vec<Step>,
     /// Cells blocked by updates since the last plan.
@@ -24,10 +26,11 @@ pub struct Recorder {
 }
 
 impl Recorder {
-    /// Record into `path`.
-    pub fn new(path: PathBuf) -> Self {
+    /// Record into a GIF, a PNG strip or both.
+    pub fn new(gif: Option<PathBuf>, png: Option<PathBuf>) -> Self {
         Recorder {
-            path,
+            gif,
+            png,
             goal: None,
             steps: Vec::new(),
             blocked: Vec::new(),
@@ -81,7 +84,13 @@ impl Recorder {
             optimum: None,
         });
         let drive = self.drive();
-        save_gif(&drive, goal, &self.path)
+        if let Some(p) = &self.gif {
+            save_gif(&drive, goal, p)?;
+        }
+        if let Some(p) = &self.png {
+            save_strip(&drive, goal, p)?;
+        }
+        Ok(())
     }
 
     /// The drive so far: each plan followed up to the next plan's start.
