@@ -192,9 +192,9 @@ fn endpoints(node: &mut Node, cfg: &NodeConfig) -> Result<(Endpoints, PathAction
 }
 
 /// Every message waiting on `sub`, oldest first (unreadable ones logged and skipped).
-fn take_all<M: 'static>(sub: &Subscription<M>, what: &str) -> Vec<M>
+fn take_all<M>(sub: &Subscription<M>, what: &str) -> Vec<M>
 where
-    M: serde::de::DeserializeOwned,
+    M: serde::de::DeserializeOwned + 'static,
 {
     let mut out = Vec::new();
     loop {
