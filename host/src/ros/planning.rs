@@ -511,6 +511,81 @@ mod tests {
         }
     }
 
+    /// The host core posing as a device that holds `cap`.
+    struct Small(HostBackend, ohaca::protocol::Capacity);
+
+    impl Backend for Small {
+        fn describe(&self) -> String {
+            "a small device".into()
+        }
+        fn capacity(&mut self) -> Result<Option<ohaca::protocol::Capacity>, BackendError> {
+            Ok(Some(self.1))
+        }
+        fn upload(&mut self, map: &Map) -> Result<(), BackendError> {
+            assert!(fits(map, &self.1), "{}x{}", map.width, map.height);
+            self.0.upload(map)
+        }
+        fn set_rect(&mut self, r: (u16, u16, u16, u16), b: bool) -> Result<(), BackendError> {
+            self.0.set_rect(r, b)
+        }
+        fn set_cells(&mut self, c: &[Point], b: bool) -> Result<(), BackendError> {
+            self.0.set_cells(c, b)
+        }
+        fn plan(&mut self, s: Point, g: Point, w: bool) -> Result<Planned, BackendError> {
+            self.0.plan(s, g, w)
+        }
+    }
+
+    #[test]
+    fn a_map_larger_than_the_device_is_resampled_and_answered_in_its_own_frame() {
+        // 100 x 100 cells of 0.1 m with a wall; the device holds 1,024 cells: 4 x 4 per cell.
+        let mut g = grid();
+        g.info.width = 100;
+        g.info.height = 100;
+        g.data = (0..100 * 100)
+            .map(|i| if i % 100 == 50 && i / 100 < 80 { 100 } else { 0 })
+            .collect();
+        let cap = ohaca::protocol::Capacity {
+            cells: 1024,
+            max_side: 4096,
+            max_steps: 1023,
+            max_chunk: 128,
+            max_request: 256,
+            plan_queue: 4,
+            tick_hz: 1_000_000,
+        };
+        let mut p = Planning::new(
+            Box::new(Small(HostBackend::new(Params::default()), cap)),
+            Occupancy01::default(),
+            None,
+        );
+        let note = p.set_grid(&g).unwrap();
+        assert!(note.text.contains("as 25x25"), "{}", note.text);
+        let (s, goal) = ([0.25, 0.25], [9.75, 0.25]);
+        let out = p.plan(s, goal).unwrap();
+        assert_eq!(out.factor, 4);
+        assert_eq!(out.points_m.first(), Some(&s));
+        assert_eq!(out.points_m.last(), Some(&goal));
+        // Every waypoint is a free cell of the original map, and the path goes over the wall.
+        let (map, frame) = grid_map(&g, &Occupancy01::default()).unwrap();
+        for m in &out.points_m {
+            let c = frame.cell(*m).unwrap();
+            assert!(!map.is_blocked(c), "{m:?}");
+        }
+        assert!(out.points_m.iter().any(|m| m[1] > 8.0), "{:?}", out.points_m);
+        // An update reaches the device through the same window.
+        let u = OccupancyGridUpdate {
+            header: Header::default(),
+            x: 0,
+            y: 90,
+            width: 40,
+            height: 1,
+            data: vec![100; 40],
+        };
+        let note = p.update(&u).unwrap();
+        assert_eq!(note.blocked.len(), 10, "{}", note.text);
+    }
+
     #[test]
     fn rectangles_and_scattered_cells() {
         let c = |x, y| Point::new(x, y);
