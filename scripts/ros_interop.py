@@ -448,6 +448,7 @@ class Test:
         path2, info2 = self.next_plan(2, "the replan after the map update")
         self.say(f"plan 2: {len(path2.poses)} poses in {time.monotonic() - t:.2f} s "
                  f"(node: {info2['planning_time_s']:.3f} s, warm {info2['warm']}, trigger {info2['trigger']})")
+        self.say(f"plan 2 info: {json.dumps(info2)}")
         if not info2["warm"] or info2["trigger"] != "map_update":
             raise Fail(f"plan 2 should be a warm replan after the update: {info2}")
         self.check(path1, self.upd_yaml, START, GOAL, expect_valid=False, name="plan1-on-updated-map")
