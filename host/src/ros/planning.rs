@@ -543,7 +543,13 @@ mod tests {
         g.info.width = 100;
         g.info.height = 100;
         g.data = (0..100 * 100)
-            .map(|i| if i % 100 == 50 && i / 100 < 80 { 100 } else { 0 })
+            .map(|i| {
+                if i % 100 == 50 && i / 100 < 80 {
+                    100
+                } else {
+                    0
+                }
+            })
             .collect();
         let cap = ohaca::protocol::Capacity {
             cells: 1024,
@@ -572,7 +578,11 @@ mod tests {
             let c = frame.cell(*m).unwrap();
             assert!(!map.is_blocked(c), "{m:?}");
         }
-        assert!(out.points_m.iter().any(|m| m[1] > 8.0), "{:?}", out.points_m);
+        assert!(
+            out.points_m.iter().any(|m| m[1] > 8.0),
+            "{:?}",
+            out.points_m
+        );
         // An update reaches the device through the same window.
         let u = OccupancyGridUpdate {
             header: Header::default(),
