@@ -385,7 +385,7 @@ impl State {
                     }
                     replan = Some("map");
                 }
-                Err(e) => log::error!("map refused: {e}"),
+                Err(e) => log::error!("map: {e}"),
             }
         }
         for u in take_all(&ep.updates, "map update") {

@@ -5,7 +5,9 @@
 //! - **Map**: an `OccupancyGrid` is classified ([`grid_map`]), inflated by `--inflate` metres on
 //!   its own cells ([`inflate`]), and, on a device, fitted to what it holds ([`fit`]: cropped to
 //!   the free area, then resampled only if needed, keeping start and goal free; the same as
-//!   `ohaca send`). It goes to the backend at once.
+//!   `ohaca send`). It goes to the backend at once; a map the backend cannot take then (a device
+//!   unreachable) is kept and sent at the next plan, and so is the map after an update the
+//!   backend failed to take.
 //! - **Updates**: an `OccupancyGridUpdate` changes the grid; inflation is recomputed, the fitted
 //!   map refreshed through the same window ([`Fitted::refresh`]), and only the cells that differ
 //!   from what the backend holds are sent: one `SetRect` when they fill a rectangle with one
@@ -39,6 +41,8 @@ struct Loaded {
     fitted: Option<Fitted>,
     /// What the backend holds (the fitted map, or `map`).
     sent: Map,
+    /// Not on the backend (the upload failed, or an update did): sent whole at the next plan.
+    pending: bool,
 }
 
 /// A plan, in the map's frame.
@@ -205,14 +209,41 @@ impl Planning {
         Ok(f)
     }
 
-    /// A new map (`/map`): classified, inflated, fitted and sent.
+    /// A new map (`/map`): classified, inflated, fitted and sent. A map the backend could not
+    /// take is kept (the error says so) and sent at the next plan.
     pub fn set_grid(&mut self, g: &OccupancyGrid) -> Result<MapNote, PlanError> {
         let (grid, frame) =
             grid_map(g, &self.rule).map_err(|e| PlanError::new(error_code::UNKNOWN, e))?;
         let map = self.inflated(&grid, &frame);
-        // Forget the old map first: if this one cannot be sent, there is none.
-        self.loaded = None;
-        let fitted = self.fitted(&map, &frame, &[])?;
+        self.loaded = Some(Loaded {
+            grid,
+            sent: map.clone(),
+            map,
+            frame,
+            frame_id: g.header.frame_id.clone(),
+            fitted: None,
+            pending: true,
+        });
+        let text = self.send(&[]).map_err(|e| {
+            PlanError::new(
+                e.code,
+                format!("{e}; the map is kept and sent again at the next request"),
+            )
+        })?;
+        Ok(MapNote {
+            text,
+            blocked: Vec::new(),
+            cleared: Vec::new(),
+        })
+    }
+
+    /// Fit the map to the backend (keeping `ends` free) and upload it.
+    fn send(&mut self, ends: &[Point]) -> Result<String, PlanError> {
+        let Some(l) = self.loaded.as_ref() else {
+            return Err(PlanError::new(error_code::UNKNOWN, "no map"));
+        };
+        let (map, frame) = (l.map.clone(), l.frame);
+        let fitted = self.fitted(&map, &frame, ends)?;
         let sent = fitted
             .as_ref()
             .map_or_else(|| map.clone(), |f| f.map.clone());
@@ -227,24 +258,17 @@ impl Planning {
             map.width,
             map.height,
             frame.cell_size_m(),
-            g.header.frame_id,
+            self.frame_id().unwrap_or(""),
             self.backend.describe(),
             sent.width,
             sent.height,
         );
-        self.loaded = Some(Loaded {
-            grid,
-            map,
-            frame,
-            frame_id: g.header.frame_id.clone(),
-            fitted,
-            sent,
-        });
-        Ok(MapNote {
-            text,
-            blocked: Vec::new(),
-            cleared: Vec::new(),
-        })
+        if let Some(l) = self.loaded.as_mut() {
+            l.fitted = fitted;
+            l.sent = sent;
+            l.pending = false;
+        }
+        Ok(text)
     }
 
     /// A map update (`/map_updates`): see the module docs.
@@ -269,21 +293,32 @@ impl Planning {
         let (blocked, cleared) = diff(&l.sent, &next);
         l.map = map;
         l.sent = next;
+        let pending = l.pending;
         let mut sent = Vec::new();
         for (cells, b) in [(&blocked, true), (&cleared, false)] {
-            if cells.is_empty() {
+            if cells.is_empty() || pending {
                 continue;
             }
-            match as_rect(cells) {
+            let r = match as_rect(cells) {
                 Some(r) => {
-                    self.backend.set_rect(r, b)?;
                     sent.push(format!("SetRect {}x{} at ({}, {})", r.2, r.3, r.0, r.1));
+                    self.backend.set_rect(r, b)
                 }
                 None => {
-                    self.backend.set_cells(cells, b)?;
                     sent.push(format!("SetCells {}", cells.len()));
+                    self.backend.set_cells(cells, b)
                 }
+            };
+            if let Err(e) = r {
+                // What the device holds is unknown now: the whole map goes at the next plan.
+                if let Some(l) = self.loaded.as_mut() {
+                    l.pending = true;
+                }
+                return Err(PlanError::from(e));
             }
+        }
+        if pending {
+            sent.push("kept for the next upload".into());
         }
         Ok(MapNote {
             text: format!(
@@ -367,15 +402,9 @@ impl Planning {
                 .iter()
                 .any(|&p| f.cell_inside(p).is_none_or(|c| f.map.is_blocked(c))),
         };
-        if lost(l) {
-            let (map, frame) = (l.map.clone(), l.frame);
-            let f = self.fitted(&map, &frame, &[s, g])?;
-            let sent = f.as_ref().map_or_else(|| map.clone(), |f| f.map.clone());
-            self.backend.upload(&sent)?;
-            if let Some(l) = self.loaded.as_mut() {
-                l.fitted = f;
-                l.sent = sent;
-            }
+        if l.pending || lost(l) {
+            let note = self.send(&[s, g])?;
+            log::info!("{note}");
         }
         let Some(l) = self.loaded.as_ref() else {
             return Err(PlanError::new(error_code::UNKNOWN, "no map"));
@@ -594,6 +623,67 @@ mod tests {
         };
         let note = p.update(&u).unwrap();
         assert_eq!(note.blocked.len(), 10, "{}", note.text);
+    }
+
+    /// The host core behind a link that fails its first `fail` uploads.
+    struct Flaky(HostBackend, usize);
+
+    impl Backend for Flaky {
+        fn describe(&self) -> String {
+            "a flaky device".into()
+        }
+        fn capacity(&mut self) -> Result<Option<ohaca::protocol::Capacity>, BackendError> {
+            Ok(None)
+        }
+        fn upload(&mut self, map: &Map) -> Result<(), BackendError> {
+            if self.1 > 0 {
+                self.1 -= 1;
+                return Err(BackendError::Unreachable("cable out".into()));
+            }
+            self.0.upload(map)
+        }
+        fn set_rect(&mut self, r: (u16, u16, u16, u16), b: bool) -> Result<(), BackendError> {
+            self.0.set_rect(r, b)
+        }
+        fn set_cells(&mut self, c: &[Point], b: bool) -> Result<(), BackendError> {
+            self.0.set_cells(c, b)
+        }
+        fn plan(&mut self, s: Point, g: Point, w: bool) -> Result<Planned, BackendError> {
+            self.0.plan(s, g, w)
+        }
+    }
+
+    #[test]
+    fn a_map_the_device_missed_is_sent_at_the_next_request() {
+        let mut p = Planning::new(
+            Box::new(Flaky(HostBackend::new(Params::default()), 2)),
+            Occupancy01::default(),
+            None,
+        );
+        let e = p.set_grid(&grid()).unwrap_err();
+        assert!(e.message.contains("unreachable: cable out"), "{e}");
+        assert!(e.message.contains("kept"), "{e}");
+        // An update while it is not there changes the kept map only.
+        let u = OccupancyGridUpdate {
+            header: Header::default(),
+            x: 10,
+            y: 0,
+            width: 1,
+            height: 9,
+            data: vec![100; 9],
+        };
+        assert!(p
+            .update(&u)
+            .unwrap()
+            .text
+            .contains("kept for the next upload"));
+        let e = p.plan([0.05, 0.55], [1.95, 0.55]).unwrap_err();
+        assert!(e.message.contains("device unreachable"), "{e}");
+        let out = p.plan([0.05, 0.55], [1.95, 0.55]).unwrap();
+        assert!(
+            out.cells.iter().all(|c| c.x != 10 || c.y == 0),
+            "the update is in"
+        );
     }
 
     #[test]
