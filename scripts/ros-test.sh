@@ -27,18 +27,25 @@ fi
 ohaca="target/$host_target/release/ohaca"
 [ -x "$ohaca" ] || { echo "FAIL: no $ohaca (build it, or drop --no-build)" >&2; exit 1; }
 
-if [ "${OHACA_SKIP_QEMU:-}" = 1 ] && ! command -v qemu-system-arm >/dev/null; then
+if ! command -v qemu-system-arm >/dev/null; then
+  if [ "${OHACA_SKIP_QEMU:-}" != 1 ]; then
+    echo "FAIL: qemu-system-arm is missing (source scripts/setup.sh), or set OHACA_SKIP_QEMU=1" >&2
+    exit 1
+  fi
   echo "SKIPPED: ohaca ros on the QEMU firmware (qemu-system-arm missing, OHACA_SKIP_QEMU=1)"
 else
   port=$(python3 -c 'import socket; s = socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
   scripts/qemu-serve.sh --no-build --port "$port" --defmt /dev/null 2>/dev/null &
   qemu=$!
   trap 'kill $qemu 2>/dev/null || true; wait $qemu 2>/dev/null || true' EXIT
+  up=0
   for _ in $(seq 100); do
-    python3 -c "import socket; socket.create_connection(('127.0.0.1', $port), 0.2).close()" \
-      2>/dev/null && break
+    if python3 -c "import socket; socket.create_connection(('127.0.0.1', $port), 0.2).close()" \
+      2>/dev/null; then up=1; break; fi
+    kill -0 $qemu 2>/dev/null || break
     sleep 0.1
   done
+  [ "$up" = 1 ] || { echo "FAIL: QEMU did not open its UART on 127.0.0.1:$port" >&2; exit 1; }
   python3 scripts/ros_interop.py --ohaca "$ohaca" --tcp "127.0.0.1:$port" "${gif[@]}"
   kill $qemu 2>/dev/null || true
   wait $qemu 2>/dev/null || true
