@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Run every test of ohaca: the core's unit tests and doc examples, the protocol's byte-exact
 # document test, the host tool's tests, the exact references and property tests, the shared-map
-# checks, and the firmware under QEMU (end-to-end over its emulated UART, and its golden boot log).
+# checks, the firmware under QEMU (end-to-end over its emulated UART, and its golden boot log), and
+# `ohaca ros` against Cyclone DDS (on the QEMU firmware and on the host core).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 source scripts/setup.sh
@@ -18,3 +19,6 @@ cargo test --release -p ohaca-host -p ohaca-host-tests --target host-tuple
 # The firmware's boot log against tests/golden/boot.txt, and the protocol selftest over QEMU.
 scripts/golden-boot.sh --no-build
 scripts/qemu-selftest.sh --no-build
+# `ohaca ros` as a ROS 2 node against Eclipse Cyclone DDS, loopback only: on the QEMU firmware,
+# then on the host core (map, poses, plan, a map update's warm replan, the Nav2 action).
+scripts/ros-test.sh

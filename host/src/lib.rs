@@ -22,6 +22,7 @@
 //! | [`link`] | the firmware link: a blocking protocol client over TCP or a serial port |
 //! | [`strip`] | pictures of a replanning drive: a PNG strip, an animated GIF |
 //! | [`replan`] | replanning scenarios: a robot driving while cells change, warm or cold replans on the core or a device |
+//! | [`ros`] | `ohaca ros`: a ROS 2 node (map, goal and pose topics, `/plan`, Nav2's `compute_path_to_pose`) |
 //!
 //! ## Panic freedom
 //! Like the core, nothing reachable from a file, a command line or a parameter set panics:
@@ -57,6 +58,7 @@ pub mod map;
 pub mod output;
 pub mod plan_map;
 pub mod replan;
+pub mod ros;
 pub mod strip;
 pub mod trace;
 

@@ -42,6 +42,11 @@ enum Command {
     Send(cmd::send::Args),
     /// Drive a robot through map changes and replan warm or cold (host core or a device)
     Replan(cmd::replan::Args),
+    /// Run as a ROS 2 node: /map, /goal_pose, /initialpose in, /plan and Nav2's
+    /// compute_path_to_pose out (host core or a device)
+    Ros(Box<cmd::ros::Args>),
+    /// Check a path in metres (JSON [[x, y], ...]) against a map: start, goal, free segments
+    Check(cmd::check::Args),
 }
 
 fn main() -> ExitCode {
@@ -55,6 +60,8 @@ fn main() -> ExitCode {
         Command::Experiment(args) => cmd::experiment::run(&args),
         Command::Send(args) => cmd::send::run(&args),
         Command::Replan(args) => cmd::replan::run(&args),
+        Command::Ros(args) => cmd::ros::run(&args),
+        Command::Check(args) => cmd::check::run(&args),
     };
     ExitCode::from(code)
 }

@@ -1,9 +1,11 @@
 //! The subcommands, one module each, plus the output helpers they share.
 
+pub mod check;
 pub mod experiment;
 pub mod plan;
 pub mod render;
 pub mod replan;
+pub mod ros;
 pub mod send;
 
 use std::io::Write;

@@ -278,6 +278,33 @@ fn window_frame(f: &MapFrame, origin: (i32, i32), k: u16, w: u16, h: u16) -> Map
 }
 
 impl Fitted {
+    /// The fitted map of `map` (the original map, changed since: `ohaca ros`'s map updates)
+    /// through the same window: same corner, factor and sides, so cells keep their places and
+    /// only the blocks whose cells changed differ.
+    pub fn refresh(&self, map: &Map) -> Map {
+        coarse(
+            map,
+            self.origin,
+            self.factor,
+            self.map.width,
+            self.map.height,
+        )
+    }
+
+    /// The fitted cell that holds original cell `p`, if the window covers it.
+    pub fn cell_inside(&self, p: Point) -> Option<Point> {
+        let k = i32::from(self.factor);
+        let (dx, dy) = (
+            i32::from(p.x) - self.origin.0,
+            i32::from(p.y) - self.origin.1,
+        );
+        if dx < 0 || dy < 0 {
+            return None;
+        }
+        let c = Point::new(u16::try_from(dx / k).ok()?, u16::try_from(dy / k).ok()?);
+        (c.x < self.map.width && c.y < self.map.height).then_some(c)
+    }
+
     /// The fitted cell that holds original cell `p`.
     pub fn cell(&self, p: Point) -> Point {
         to_coarse(self.origin, self.factor, p)

@@ -1,0 +1,509 @@
+//! The DDS side of `ohaca ros`: a ROS 2 node (ros2-client over RustDDS) that subscribes to the
+//! map, its updates, the goal and the robot's pose, publishes the plan and what it was
+//! (`/plan_info`), and serves `compute_path_to_pose`; one loop polls everything and plans in
+//! [`Planning`].
+//!
+//! | topic (default) | type | QoS | what |
+//! | --- | --- | --- | --- |
+//! | `/map` (sub) | `nav_msgs/OccupancyGrid` | reliable, transient local, depth 1 (as `map_server`) | a new map: sent to the backend |
+//! | `/map_updates` (sub) | `map_msgs/OccupancyGridUpdate` | reliable, volatile, depth 10 | cells changed: `SetRect`/`SetCells`, then a warm replan to the current goal |
+//! | `/goal_pose` (sub) | `geometry_msgs/PoseStamped` | reliable, volatile, depth 10 | plan from the last start to it |
+//! | `/initialpose` (sub; `--start-topic`) | `geometry_msgs/PoseWithCovarianceStamped` | reliable, volatile, depth 10 | the start of later plans |
+//! | `/plan` (pub) | `nav_msgs/Path` | reliable, transient local, depth 1 | every plan, in the map's frame |
+//! | `/plan_info` (pub) | `std_msgs/String` | reliable, transient local, depth 1 | one JSON object per plan: `seq`, `trigger`, `warm`, times, lengths, backend, the last map upload |
+//! | `compute_path_to_pose` (action) | `nav2_msgs/action/ComputePathToPose` | ROS 2 action defaults | [`super::action`] |
+//!
+//! A message in another frame than the map's is refused (there is no TF here): the map frame
+//! is the only one.
+
+use std::net::IpAddr;
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
+
+use ros2_client::dds::rustdds::DomainParticipantBuilder;
+use ros2_client::qos::{Durability, History};
+use ros2_client::{
+    action::ActionServerQosPolicies, ActionTypeName, Context, MessageTypeName, Name, Node,
+    NodeName, NodeOptions, Publisher, QosProfile, ServiceMapping, Subscription,
+};
+
+use super::action::PathAction;
+use super::convert::{position, ros_path};
+use super::msg::{
+    error_code, ComputePathGoal, ComputePathResult, OccupancyGrid, OccupancyGridUpdate,
+    PoseStamped, PoseWithCovarianceStamped, RosDuration, RosPath, StringMsg, Time,
+};
+use super::planning::{PlanError, PlanOut, Planning};
+use super::record::Recorder;
+use crate::map::Map;
+use crate::replan::Planned;
+use ohaca::Point;
+
+/// Topic and action names (ROS names: `/map`, `map`, `/robot1/map`, ...).
+#[derive(Clone, Debug)]
+pub struct Topics {
+    /// `nav_msgs/OccupancyGrid`.
+    pub map: String,
+    /// `map_msgs/OccupancyGridUpdate`.
+    pub map_updates: String,
+    /// `geometry_msgs/PoseStamped`.
+    pub goal: String,
+    /// `geometry_msgs/PoseWithCovarianceStamped`.
+    pub start: String,
+    /// `nav_msgs/Path`.
+    pub plan: String,
+    /// `std_msgs/String`.
+    pub plan_info: String,
+    /// `nav2_msgs/action/ComputePathToPose`.
+    pub action: String,
+}
+
+/// QoS of the node's endpoints.
+#[derive(Clone, Debug)]
+pub struct Qos {
+    /// The map subscription.
+    pub map: QosProfile,
+    /// Updates, goal and start subscriptions.
+    pub input: QosProfile,
+    /// `/plan` and `/plan_info`.
+    pub output: QosProfile,
+}
+
+impl Default for Qos {
+    fn default() -> Self {
+        let reliable = QosProfile::publisher_default();
+        Qos {
+            map: reliable
+                .clone()
+                .durability(Durability::TransientLocal)
+                .history(History::KeepLast { depth: 1 }),
+            input: reliable
+                .clone()
+                .durability(Durability::Volatile)
+                .history(History::KeepLast { depth: 10 }),
+            output: reliable
+                .durability(Durability::TransientLocal)
+                .history(History::KeepLast { depth: 1 }),
+        }
+    }
+}
+
+/// Everything the node needs besides the planner.
+pub struct NodeConfig {
+    /// The node's name.
+    pub name: String,
+    /// DDS domain (`ROS_DOMAIN_ID`).
+    pub domain: u16,
+    /// Use only these local addresses for DDS (e.g. `127.0.0.1`); all when empty.
+    pub only_networks: Vec<IpAddr>,
+    /// Names.
+    pub topics: Topics,
+    /// QoS.
+    pub qos: Qos,
+    /// How the action's services map onto DDS (`Enhanced`: Fast DDS, Connext; `Cyclone`).
+    pub service_mapping: ServiceMapping,
+    /// `--gif`: draw the plans to the current goal.
+    pub gif: Option<PathBuf>,
+    /// `--png`: the same as a strip of panels.
+    pub png: Option<PathBuf>,
+    /// Stop after this long (tests, benchmarks); run until killed otherwise.
+    pub run_for: Option<Duration>,
+}
+
+fn name(s: &str) -> Result<Name, String> {
+    let full = if s.starts_with('/') {
+        s.to_string()
+    } else {
+        format!("/{s}")
+    };
+    Name::parse(&full).map_err(|e| format!("bad ROS name `{s}`: {e:?}"))
+}
+
+/// The node's endpoints.
+struct Endpoints {
+    map: Subscription<OccupancyGrid>,
+    updates: Subscription<OccupancyGridUpdate>,
+    goal: Subscription<PoseStamped>,
+    start: Subscription<PoseWithCovarianceStamped>,
+    plan: Publisher<RosPath>,
+    info: Publisher<StringMsg>,
+}
+
+fn endpoints(node: &mut Node, cfg: &NodeConfig) -> Result<(Endpoints, PathAction), String> {
+    let t = &cfg.topics;
+    let q = &cfg.qos;
+    let e = |what: &str, e: ros2_client::CreateError| format!("cannot create {what}: {e:?}");
+    let topic = |n: &str, pkg: &str, ty: &str, qos: &QosProfile| {
+        node.create_topic(&name(n)?, MessageTypeName::new(pkg, ty), qos)
+            .map_err(|x| e(n, x))
+    };
+    let map_t = topic(&t.map, "nav_msgs", "OccupancyGrid", &q.map)?;
+    let upd_t = topic(&t.map_updates, "map_msgs", "OccupancyGridUpdate", &q.input)?;
+    let goal_t = topic(&t.goal, "geometry_msgs", "PoseStamped", &q.input)?;
+    let start_t = topic(
+        &t.start,
+        "geometry_msgs",
+        "PoseWithCovarianceStamped",
+        &q.input,
+    )?;
+    let plan_t = topic(&t.plan, "nav_msgs", "Path", &q.output)?;
+    let info_t = topic(&t.plan_info, "std_msgs", "String", &q.output)?;
+    let service = QosProfile::publisher_default()
+        .durability(Durability::Volatile)
+        .history(History::KeepLast { depth: 10 });
+    let action_qos = ActionServerQosPolicies {
+        goal_service: service.clone(),
+        result_service: service.clone(),
+        cancel_service: service.clone(),
+        feedback_publisher: service,
+        status_publisher: QosProfile::publisher_default()
+            .durability(Durability::TransientLocal)
+            .history(History::KeepLast { depth: 1 }),
+    };
+    let server = node
+        .create_action_server(
+            cfg.service_mapping,
+            &name(&t.action)?,
+            &ActionTypeName::new("nav2_msgs", "ComputePathToPose"),
+            action_qos,
+        )
+        .map_err(|x| e(&t.action, x))?;
+    let ep = Endpoints {
+        map: node
+            .create_subscription(&map_t, Some(q.map.clone()))
+            .map_err(|x| e(&t.map, x))?,
+        updates: node
+            .create_subscription(&upd_t, Some(q.input.clone()))
+            .map_err(|x| e(&t.map_updates, x))?,
+        goal: node
+            .create_subscription(&goal_t, Some(q.input.clone()))
+            .map_err(|x| e(&t.goal, x))?,
+        start: node
+            .create_subscription(&start_t, Some(q.input.clone()))
+            .map_err(|x| e(&t.start, x))?,
+        plan: node
+            .create_publisher(&plan_t, Some(q.output.clone()))
+            .map_err(|x| e(&t.plan, x))?,
+        info: node
+            .create_publisher(&info_t, Some(q.output.clone()))
+            .map_err(|x| e(&t.plan_info, x))?,
+    };
+    Ok((ep, PathAction::new(server)))
+}
+
+/// Every message waiting on `sub`, oldest first (unreadable ones logged and skipped).
+fn take_all<M>(sub: &Subscription<M>, what: &str) -> Vec<M>
+where
+    M: serde::de::DeserializeOwned + 'static,
+{
+    let mut out = Vec::new();
+    loop {
+        match sub.take() {
+            Ok(Some((m, _))) => out.push(m),
+            Ok(None) => return out,
+            Err(e) => log::warn!("{what}: unreadable message skipped: {e:?}"),
+        }
+    }
+}
+
+/// The node's state between messages.
+struct State {
+    planning: Planning,
+    start: Option<[f64; 2]>,
+    goal: Option<([f64; 2], f64)>,
+    seq: u64,
+    recorder: Option<Recorder>,
+    /// Plans still to draw (`--gif`).
+    to_draw: Vec<(Map, (Point, Point), Planned)>,
+}
+
+impl State {
+    /// A frame other than the map's, in words.
+    fn wrong_frame(&self, frame: &str, what: &str) -> Option<String> {
+        let map = self.planning.frame_id()?;
+        (!frame.is_empty() && frame != map)
+            .then(|| format!("{what} is in frame `{frame}`, not the map's `{map}` (no TF here)"))
+    }
+
+    /// Plan from `start` to `goal` and publish it (`/plan`, `/plan_info`).
+    fn plan(
+        &mut self,
+        ep: &Endpoints,
+        start: [f64; 2],
+        (goal, yaw): ([f64; 2], f64),
+        trigger: &str,
+    ) -> Result<(RosPath, PlanOut), PlanError> {
+        let out = self.planning.plan(start, goal).inspect_err(|e| {
+            log::warn!(
+                "{trigger}: no plan from ({:.3}, {:.3}) to ({:.3}, {:.3}): {e}",
+                start[0],
+                start[1],
+                goal[0],
+                goal[1]
+            );
+        })?;
+        self.seq += 1;
+        let path = ros_path(&out.points_m, yaw, &out.frame_id, Time::now());
+        let length_m: f64 = out
+            .points_m
+            .windows(2)
+            .map(|w| match w {
+                [a, b] => (b[0] - a[0]).hypot(b[1] - a[1]),
+                _ => 0.0,
+            })
+            .sum();
+        let info = serde_json::json!({
+            "seq": self.seq,
+            "trigger": trigger,
+            "warm": out.warm,
+            "planning_time_s": out.elapsed.as_secs_f64(),
+            "device_ticks": out.planned.ticks,
+            "iterations": out.planned.iterations,
+            "poses": path.poses.len(),
+            "length_m": length_m,
+            "start": start,
+            "goal": goal,
+            "backend": self.planning.describe(),
+            "factor": out.factor,
+            "cells": [out.sent_size.0, out.sent_size.1],
+            "upload_s": self.planning.last_upload().map(|u| u.0),
+            "upload_bytes": self.planning.last_upload().map(|u| u.1),
+        });
+        log::info!(
+            "plan {} ({trigger}): {} poses, {:.2} m, {} iterations, {}, in {:.3} s on {}",
+            self.seq,
+            path.poses.len(),
+            length_m,
+            out.planned.iterations,
+            if out.warm { "warm" } else { "cold" },
+            out.elapsed.as_secs_f64(),
+            self.planning.describe()
+        );
+        if let Err(e) = ep.plan.publish(path.clone()) {
+            log::warn!("cannot publish the plan: {e:?}");
+        }
+        if let Err(e) = ep.info.publish(StringMsg {
+            data: info.to_string(),
+        }) {
+            log::warn!("cannot publish the plan info: {e:?}");
+        }
+        if let (true, Some(map)) = (self.recorder.is_some(), self.planning.sent_map()) {
+            self.to_draw
+                .push((map.clone(), out.ends, out.planned.clone()));
+        }
+        Ok((path, out))
+    }
+
+    /// `--gif`: draw the plans made since the last call (after the answers went out: drawing
+    /// takes a while).
+    fn draw(&mut self) {
+        let Some(rec) = self.recorder.as_mut() else {
+            return;
+        };
+        for (map, ends, planned) in self.to_draw.drain(..) {
+            if let Err(e) = rec.plan(&map, ends, &planned) {
+                log::warn!("--gif: {e}");
+            }
+        }
+    }
+
+    /// The action's goal: plan and answer.
+    fn action(
+        &mut self,
+        ep: &Endpoints,
+        g: &ComputePathGoal,
+    ) -> Result<ComputePathResult, ComputePathResult> {
+        let t0 = Instant::now();
+        let fail = |code: u16, msg: String| {
+            log::warn!("compute_path_to_pose: {msg}");
+            ComputePathResult {
+                planning_time: RosDuration::from(t0.elapsed()),
+                error_code: code,
+                error_msg: msg,
+                ..ComputePathResult::default()
+            }
+        };
+        let frames = [
+            self.wrong_frame(&g.goal.header.frame_id, "the goal"),
+            g.use_start
+                .then(|| self.wrong_frame(&g.start.header.frame_id, "the start"))
+                .flatten(),
+        ];
+        if let Some(msg) = frames.into_iter().flatten().next() {
+            return Err(fail(error_code::TF_ERROR, msg));
+        }
+        let goal = position(&g.goal.pose).ok_or_else(|| {
+            fail(
+                error_code::GOAL_OUTSIDE_MAP,
+                "the goal is not finite".into(),
+            )
+        })?;
+        let start = if g.use_start {
+            position(&g.start.pose).ok_or_else(|| {
+                fail(
+                    error_code::START_OUTSIDE_MAP,
+                    "the start is not finite".into(),
+                )
+            })?
+        } else {
+            self.start.ok_or_else(|| {
+                fail(
+                    error_code::UNKNOWN,
+                    "use_start is false and no robot pose arrived yet on the start topic".into(),
+                )
+            })?
+        };
+        log::info!(
+            "compute_path_to_pose: ({:.3}, {:.3}) -> ({:.3}, {:.3})",
+            start[0],
+            start[1],
+            goal[0],
+            goal[1]
+        );
+        match self.plan(ep, start, (goal, g.goal.pose.orientation.yaw()), "action") {
+            Ok((path, _)) => Ok(ComputePathResult {
+                path,
+                planning_time: RosDuration::from(t0.elapsed()),
+                error_code: error_code::NONE,
+                error_msg: String::new(),
+            }),
+            Err(e) => Err(fail(e.code, e.message)),
+        }
+    }
+
+    /// One pass over the topics; true if anything arrived.
+    fn topics(&mut self, ep: &Endpoints) -> bool {
+        let mut busy = false;
+        let mut replan = None;
+        if let Some(g) = take_all(&ep.map, "map").pop() {
+            busy = true;
+            match self.planning.set_grid(&g) {
+                Ok(note) => {
+                    log::info!("{}", note.text);
+                    if let Some(r) = self.recorder.as_mut() {
+                        r.new_map();
+                    }
+                    replan = Some("map");
+                }
+                Err(e) => log::error!("map: {e}"),
+            }
+        }
+        for u in take_all(&ep.updates, "map update") {
+            busy = true;
+            if let Some(msg) = self.wrong_frame(&u.header.frame_id, "a map update") {
+                log::warn!("{msg}: ignored");
+                continue;
+            }
+            match self.planning.update(&u) {
+                Ok(note) => {
+                    log::info!("{}", note.text);
+                    if let Some(r) = self.recorder.as_mut() {
+                        r.changed(&note.blocked, &note.cleared);
+                    }
+                    if !(note.blocked.is_empty() && note.cleared.is_empty()) {
+                        replan = Some("map_update");
+                    }
+                }
+                Err(e) => log::error!("map update refused: {e}"),
+            }
+        }
+        if let Some(s) = take_all(&ep.start, "start").pop() {
+            busy = true;
+            match (
+                self.wrong_frame(&s.header.frame_id, "the start pose"),
+                position(&s.pose.pose),
+            ) {
+                (Some(msg), _) => log::warn!("{msg}: ignored"),
+                (None, None) => log::warn!("a start pose that is not finite: ignored"),
+                (None, Some(p)) => {
+                    log::info!("start ({:.3}, {:.3})", p[0], p[1]);
+                    self.start = Some(p);
+                }
+            }
+        }
+        if let Some(g) = take_all(&ep.goal, "goal").pop() {
+            busy = true;
+            match (
+                self.wrong_frame(&g.header.frame_id, "the goal"),
+                position(&g.pose),
+            ) {
+                (Some(msg), _) => log::warn!("{msg}: ignored"),
+                (None, None) => log::warn!("a goal that is not finite: ignored"),
+                (None, Some(p)) => {
+                    log::info!("goal ({:.3}, {:.3})", p[0], p[1]);
+                    self.goal = Some((p, g.pose.orientation.yaw()));
+                    replan = Some("goal");
+                }
+            }
+        }
+        if let Some(trigger) = replan {
+            match (self.start, self.goal) {
+                (Some(s), Some(g)) => {
+                    let _ = self.plan(ep, s, g, trigger);
+                }
+                (None, Some(_)) => {
+                    log::warn!("a goal but no start yet: waiting for the start topic")
+                }
+                _ => {}
+            }
+        }
+        busy
+    }
+}
+
+/// Run the node until killed (or for `cfg.run_for`).
+pub fn run(cfg: NodeConfig, planning: Planning) -> Result<(), String> {
+    let mut builder = DomainParticipantBuilder::new(cfg.domain);
+    if !cfg.only_networks.is_empty() {
+        builder = builder.with_only_networks(cfg.only_networks.iter().copied());
+    }
+    let participant = builder
+        .build()
+        .map_err(|e| format!("cannot start DDS (domain {}): {e:?}", cfg.domain))?;
+    let context = Context::from_domain_participant(participant)
+        .map_err(|e| format!("cannot start ROS 2: {e:?}"))?;
+    let node_name = NodeName::new("/", &cfg.name)
+        .map_err(|e| format!("bad node name `{}`: {e:?}", cfg.name))?;
+    let mut node = context
+        .new_node(node_name, NodeOptions::new().enable_rosout(false))
+        .map_err(|e| format!("cannot create the node: {e:?}"))?;
+    let (ep, mut action) = endpoints(&mut node, &cfg)?;
+    let t = &cfg.topics;
+    log::info!(
+        "node /{} on DDS domain {}: map `{}`, updates `{}`, goal `{}`, start `{}` -> plan `{}`, \
+         info `{}`, action `{}` ({:?} service mapping); planning on {}",
+        cfg.name,
+        cfg.domain,
+        t.map,
+        t.map_updates,
+        t.goal,
+        t.start,
+        t.plan,
+        t.plan_info,
+        t.action,
+        cfg.service_mapping,
+        planning.describe()
+    );
+    let mut state = State {
+        planning,
+        start: None,
+        goal: None,
+        seq: 0,
+        recorder: (cfg.gif.is_some() || cfg.png.is_some())
+            .then(|| Recorder::new(cfg.gif.clone(), cfg.png.clone())),
+        to_draw: Vec::new(),
+    };
+    let began = Instant::now();
+    loop {
+        let mut busy = state.topics(&ep);
+        busy |= action.poll(&mut |g| state.action(&ep, g));
+        state.draw();
+        if cfg.run_for.is_some_and(|d| began.elapsed() >= d) {
+            log::info!("stopping after {:.1} s", began.elapsed().as_secs_f64());
+            return Ok(());
+        }
+        if !busy {
+            std::thread::sleep(Duration::from_millis(5));
+        }
+    }
+}
