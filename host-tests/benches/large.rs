@@ -13,47 +13,13 @@
 use std::hint::black_box;
 use std::time::{Duration, Instant};
 
+#[path = "shared/astar.rs"]
+mod astar;
+use astar::astar_cost;
 use criterion::{criterion_group, criterion_main, Criterion};
-use ohaca::{plan, Params, Point};
+use ohaca::{plan, Params};
 use ohaca_host_tests::large::load_large;
-use ohaca_host_tests::maps::{maps_dir, Map};
-use ohaca_host_tests::reference::step_allowed;
-use pathfinding::prelude::astar;
-
-/// One exact A* with the `pathfinding` crate: the path's cost in thousandths.
-fn astar_cost(map: &Map, start: Point, goal: Point) -> Option<u32> {
-    const MOVES: [(i64, i64, u32); 8] = [
-        (1, 0, 1000),
-        (1, 1, 1414),
-        (0, 1, 1000),
-        (-1, 1, 1414),
-        (-1, 0, 1000),
-        (-1, -1, 1414),
-        (0, -1, 1000),
-        (1, -1, 1414),
-    ];
-    let r = astar(
-        &start,
-        |&p| {
-            MOVES
-                .iter()
-                .filter(move |&&(dx, dy, _)| step_allowed(map, p, dx, dy))
-                .map(move |&(dx, dy, c)| {
-                    (
-                        Point::new((i64::from(p.x) + dx) as u16, (i64::from(p.y) + dy) as u16),
-                        c,
-                    )
-                })
-        },
-        |&p| {
-            let dx = u32::from(p.x.abs_diff(goal.x));
-            let dy = u32::from(p.y.abs_diff(goal.y));
-            1000 * dx.max(dy) + 414 * dx.min(dy)
-        },
-        |&p| p == goal,
-    );
-    r.map(|(_, c)| c)
-}
+use ohaca_host_tests::maps::maps_dir;
 
 fn bench_large(c: &mut Criterion) {
     let dir = maps_dir().join("large");

@@ -12,42 +12,12 @@
 
 use std::time::Instant;
 
+#[path = "../benches/shared/astar.rs"]
+mod astar;
+use astar::astar_cost;
+
 use ohaca::{plan, Params, Point};
 use ohaca_host_tests::maps::Map;
-use ohaca_host_tests::reference::step_allowed;
-use pathfinding::prelude::astar;
-
-fn astar_cost(map: &Map, start: Point, goal: Point) -> Option<u32> {
-    const MOVES: [(i64, i64, u32); 8] = [
-        (1, 0, 1000),
-        (1, 1, 1414),
-        (0, 1, 1000),
-        (-1, 1, 1414),
-        (-1, 0, 1000),
-        (-1, -1, 1414),
-        (0, -1, 1000),
-        (1, -1, 1414),
-    ];
-    astar(
-        &start,
-        |&p| {
-            MOVES
-                .iter()
-                .filter(move |&&(dx, dy, _)| step_allowed(map, p, dx, dy))
-                .map(move |&(dx, dy, c)| {
-                    let q = Point::new((i64::from(p.x) + dx) as u16, (i64::from(p.y) + dy) as u16);
-                    (q, c)
-                })
-        },
-        |&p| {
-            let dx = u32::from(p.x.abs_diff(goal.x));
-            let dy = u32::from(p.y.abs_diff(goal.y));
-            1000 * dx.max(dy) + 414 * dx.min(dy)
-        },
-        |&p| p == goal,
-    )
-    .map(|(_, c)| c)
-}
 
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
