@@ -289,7 +289,33 @@ pub fn check_plan(
     } else {
         p.patience
     };
-    let early = patience > 0 && u32::from(its) == u32::from(best_it) + 1 + u32::from(patience);
+    // A refining run's stale streak ends only on a gain below `REFINE_GAIN` times the best at the
+    // last such gain (`ohaca::planner::REFINE_GAIN`): replayed here from the curve when it holds
+    // every iteration; a plan whose curve was cut short is held to the weaker bound.
+    let curve = plan.curve();
+    let streak_from = if refines && curve.len() == usize::from(its) {
+        let mut mark: Option<f32> = None;
+        let mut from = 0u16;
+        for (i, c) in curve.iter().enumerate() {
+            if c.best_so_far.is_finite()
+                && mark.is_none_or(|m| c.best_so_far < m * ohaca::planner::REFINE_GAIN)
+            {
+                mark = Some(c.best_so_far);
+                from = i as u16;
+            }
+        }
+        if from > best_it {
+            return Err(format!(
+                "a significant gain at {from} after the best at {best_it}"
+            ));
+        }
+        from
+    } else {
+        best_it
+    };
+    let early = patience > 0
+        && (u32::from(its) == u32::from(streak_from) + 1 + u32::from(patience)
+            || refines && curve.len() != usize::from(its) && its > best_it + patience);
     if its != p.iterations && !early {
         return Err(format!(
             "stopped after {its} of {} iterations (best at {best_it}, patience {patience})",
@@ -300,7 +326,6 @@ pub fn check_plan(
         return Err("early stop after the limit".into());
     }
     // The curve.
-    let curve = plan.curve();
     if curve.len() != usize::from(its).min(curve_capacity) {
         return Err(format!(
             "curve has {} points for {its} iterations",

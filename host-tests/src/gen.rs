@@ -9,6 +9,10 @@
 //! [`case`] picks one of them and a start and goal cell, which it clears (so the endpoints are
 //! valid; the error paths for bad endpoints are tested separately). Everything shrinks towards
 //! small, empty maps.
+//!
+//! [`maze`] and [`far_pair`] make fresh wide-corridor mazes (Moving AI's `maze-*-*-W` style, any
+//! corridor width) and a far start/goal pair in them, deterministically from a seed: the
+//! `mazes` example and `tests/mazes.rs` plan on them.
 
 use ohaca::Point;
 use proptest::collection::vec;
@@ -90,4 +94,126 @@ pub fn config(cases: u32) -> ProptestConfig {
         )),
         ..ProptestConfig::default()
     }
+}
+
+/// SplitMix64, the generator of [`maze`] (deterministic from its seed, independent of proptest).
+struct Mix(u64);
+
+impl Mix {
+    fn next(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+
+    fn below(&mut self, n: usize) -> usize {
+        (self.next() % n as u64) as usize
+    }
+}
+
+/// A perfect maze in the style of Moving AI's `maze-*-*-W` maps: corridors `width` cells wide
+/// between walls one cell thick, on a `side x side` map (rooms `(side - 1) / (width + 1)` a side;
+/// cells beyond the last room stay blocked). The passages are a randomised depth-first spanning
+/// tree of the rooms, so between any two cells there is exactly one corridor route, and the
+/// number of dead-end pockets is that of a classic "recursive backtracker" maze. Deterministic in
+/// `seed`.
+pub fn maze(side: u16, width: u16, seed: u64) -> Map {
+    let w = usize::from(width.max(1));
+    let s = usize::from(side);
+    let rooms = s.saturating_sub(1) / (w + 1);
+    let mut blocked = vec![true; s * s];
+    let mut open = |x0: usize, y0: usize, x1: usize, y1: usize| {
+        for y in y0..y1 {
+            for x in x0..x1 {
+                blocked[y * s + x] = false;
+            }
+        }
+    };
+    // Room (i, j) covers cells 1 + i (w + 1) .. + w in x, likewise in y.
+    let origin = |i: usize| 1 + i * (w + 1);
+    for j in 0..rooms {
+        for i in 0..rooms {
+            open(origin(i), origin(j), origin(i) + w, origin(j) + w);
+        }
+    }
+    let mut rng = Mix(seed ^ (u64::from(side) << 32) ^ u64::from(width));
+    let mut seen = vec![false; rooms * rooms];
+    let mut stack = Vec::new();
+    if rooms > 0 {
+        seen[0] = true;
+        stack.push(0usize);
+    }
+    while let Some(&r) = stack.last() {
+        let (i, j) = (r % rooms, r / rooms);
+        let mut next = [(0usize, 0usize); 4];
+        let mut n = 0;
+        for (di, dj) in [(1i64, 0i64), (-1, 0), (0, 1), (0, -1)] {
+            let (ni, nj) = (i as i64 + di, j as i64 + dj);
+            if ni >= 0 && nj >= 0 && (ni as usize) < rooms && (nj as usize) < rooms {
+                let k = nj as usize * rooms + ni as usize;
+                if !seen[k] {
+                    next[n] = (ni as usize, nj as usize);
+                    n += 1;
+                }
+            }
+        }
+        if n == 0 {
+            stack.pop();
+            continue;
+        }
+        let (ni, nj) = next[rng.below(n)];
+        // Knock down the one-cell wall between the two rooms, across the corridor's width.
+        if ni != i {
+            let x = origin(i.min(ni)) + w;
+            open(x, origin(j), x + 1, origin(j) + w);
+        } else {
+            let y = origin(j.min(nj)) + w;
+            open(origin(i), y, origin(i) + w, y + 1);
+        }
+        let k = nj * rooms + ni;
+        seen[k] = true;
+        stack.push(k);
+    }
+    Map::new(side, side, blocked)
+}
+
+/// Start and goal in the two rooms farthest apart along the maze's corridors that `maze` can
+/// make (a corner room and the room the depth-first tree puts farthest from it): picked by two
+/// breadth-first passes over the cells, so the pair is one of the longest the map has. `k`
+/// varies the choice: the `k`-th farthest cell from a corner, then its farthest cell.
+pub fn far_pair(map: &Map, k: usize) -> Option<(Point, Point)> {
+    let far = |from: Point| -> Vec<(usize, Point)> {
+        let (w, h) = (usize::from(map.width()), usize::from(map.height()));
+        let mut dist = vec![usize::MAX; w * h];
+        let mut queue = std::collections::VecDeque::new();
+        dist[map.index(from)] = 0;
+        queue.push_back(from);
+        let mut order = Vec::new();
+        while let Some(p) = queue.pop_front() {
+            let d = dist[map.index(p)];
+            order.push((d, p));
+            for (dx, dy) in [(1i64, 0i64), (-1, 0), (0, 1), (0, -1)] {
+                let (x, y) = (i64::from(p.x) + dx, i64::from(p.y) + dy);
+                if map.free(x, y) {
+                    let q = Point::new(x as u16, y as u16);
+                    if dist[map.index(q)] == usize::MAX {
+                        dist[map.index(q)] = d + 1;
+                        queue.push_back(q);
+                    }
+                }
+            }
+        }
+        order.sort_by(|a, b| b.0.cmp(&a.0));
+        order
+    };
+    let corner = (0..map.cells())
+        .map(|i| map.point(i))
+        .find(|&p| map.is_free(p))?;
+    let a = far(corner);
+    // Skip ahead by whole rooms' worth of cells so that different `k` give different starts.
+    let start = a.get((k * 97) % a.len().max(1))?.1;
+    let b = far(start);
+    Some((start, b.first()?.1))
 }

@@ -33,7 +33,7 @@ mod workspace;
 
 pub use params::{Algorithm, Params};
 pub use plan::{CurvePoint, Plan, RawPath};
-pub use run::Run;
+pub use run::{Run, REFINE_GAIN};
 pub use warm::{Area, Memory, REPAIR_RADIUS};
 #[cfg(any(feature = "alloc", test))]
 pub(crate) use workspace::OwnedBuffers;

@@ -33,6 +33,20 @@ use super::Run;
 /// figures.
 pub(super) const MOVE_BUDGET: u32 = 3;
 
+/// How much shorter a new best must be to end a stale streak in a run that refines its result
+/// ([`crate::Params::refine`]): below `REFINE_GAIN` times the best of the iteration that last
+/// ended one. A smaller gain still becomes the run's best (its path is kept), but counts as a
+/// stale iteration for `refine_patience`.
+///
+/// Why: the local search replaces every piece of the best path by the exact shortest path in a
+/// window around it, so the colony's slow gains (a corner cut, a wiggle straightened: 0.1-0.5 %
+/// an iteration in a wide corridor) are what the local search does anyway. What the colony alone
+/// finds is another way round an obstacle, which on the maps measured gains more. Measured on
+/// `maze-128-128-10` (the longest scenario): the best fell 468.1 -> 459.5 over 13 iterations,
+/// 0.1-0.7 % at a time, and the local search makes every one of those paths the same optimum
+/// (453.9); `BENCHMARKS.md` 1b has the quality of all large maps with this rule.
+pub const REFINE_GAIN: f32 = 0.99;
+
 /// The best path of an iteration or of the run, as step counts (exact length comparison).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(super) struct Best {
@@ -199,13 +213,20 @@ impl Run<'_, '_> {
             (Some((b, _)), Some(g)) if b.length() < g.length() => Some(b),
             _ => None,
         };
+        // In a run that refines, only a gain of more than `REFINE_GAIN` ends a stale streak.
+        let significant = |b: &Best, mark: f32| !self.refines || b.length() < mark * REFINE_GAIN;
         if let Some(b) = improved {
             if let Some(src) = self.ws.iter_best.get(..b.steps) {
                 copy_tour(self.ws.best, src);
             }
             self.best = Some(b);
             self.best_iteration = self.iteration;
-            self.stale = 0;
+            if self.mark.is_none_or(|m| significant(&b, m)) {
+                self.mark = Some(b.length());
+                self.stale = 0;
+            } else {
+                self.stale = self.stale.saturating_add(1);
+            }
         } else {
             self.stale = self.stale.saturating_add(1);
         }

@@ -18,6 +18,8 @@ mod colony;
 mod polish;
 mod setup;
 
+pub use colony::REFINE_GAIN;
+
 use crate::error::{Endpoint, Error};
 use crate::geometry::{polyline_length, turns};
 use crate::grid::{Dir, Grid, Moves, Point};
@@ -48,6 +50,8 @@ pub struct Run<'g, 'a> {
     iteration: u16,
     best: Option<Best>,
     best_iteration: u16,
+    /// The best's length when a stale streak last ended (see `colony::REFINE_GAIN`).
+    mark: Option<f32>,
     stale: u16,
     moves: u64,
     pruned: u32,
@@ -260,6 +264,7 @@ impl<'g, 'a> Run<'g, 'a> {
             iteration: 0,
             best: None,
             best_iteration: 0,
+            mark: None,
             stale: 0,
             moves: 0,
             pruned: 0,
