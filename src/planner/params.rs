@@ -88,7 +88,10 @@ pub struct Params {
     pub warm_patience: u16,
     /// [`Params::patience`] for a run that refines its result ([`Params::refine`]):
     /// the local search straightens the path, so the colony only has to find the corridor;
-    /// 0 = the same as `patience`. A warm start's `warm_patience` comes first.
+    /// 0 = the same as `patience`. A warm start's `warm_patience` comes first. In a run that
+    /// refines, a new best counts as a gain only if it is more than 1 % shorter than the best at
+    /// the last gain ([`crate::planner::REFINE_GAIN`]); a smaller one is kept but the iteration
+    /// counts as stale.
     pub refine_patience: u16,
     /// Seed of the random generator.
     pub seed: u64,
