@@ -4,6 +4,7 @@
 //! ```text
 //! cargo run --release -p ohaca-host-tests --target host-tuple --example large -- \
 //!     [--maps NAME,NAME,...] [--scen N] [--seeds N] [--ants M] [--iterations N] [--patience P]
+//!     [--refine-patience P]
 //! ```
 //!
 //! For each map: the `N` (default 20) scenarios of largest `optimal` of its scenario file, the exact
@@ -36,6 +37,9 @@ fn main() {
             "--ants" => params.ants = v.parse().expect("--ants M"),
             "--iterations" => params.iterations = v.parse().expect("--iterations N"),
             "--patience" => params.patience = v.parse().expect("--patience P"),
+            "--refine-patience" => {
+                params.refine_patience = v.parse().expect("--refine-patience P")
+            }
             _ => panic!("unknown option {flag}"),
         }
     }
