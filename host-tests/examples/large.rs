@@ -37,9 +37,7 @@ fn main() {
             "--ants" => params.ants = v.parse().expect("--ants M"),
             "--iterations" => params.iterations = v.parse().expect("--iterations N"),
             "--patience" => params.patience = v.parse().expect("--patience P"),
-            "--refine-patience" => {
-                params.refine_patience = v.parse().expect("--refine-patience P")
-            }
+            "--refine-patience" => params.refine_patience = v.parse().expect("--refine-patience P"),
             _ => panic!("unknown option {flag}"),
         }
     }
