@@ -16,9 +16,10 @@ use crate::planner::workspace::Workspace;
 
 use super::Run;
 
-/// An ant of a run with the local search may make at most this many moves (forward and back) per
-/// step of the shortest path found so far in the run; one that needs more is abandoned
-/// ([`Lost::Budget`]). Not in the paper, and off without the local search (the paper preset).
+/// From its second iteration on, an ant of a run with the local search may make at most this many
+/// times the moves (forward and back) of the cheapest walk that arrived so far in the run; one
+/// that needs more is abandoned ([`Lost::Budget`]). Not in the paper, and off without the local
+/// search (the paper preset).
 ///
 /// Why: a backtracking ant is a randomised depth-first search. In an open area (a 10-wide maze
 /// corridor, a room) the potential field can lead it to wall itself in with its own trail; it
@@ -26,10 +27,11 @@ use super::Run;
 /// on. Measured on `maze-128-128-10` (20 ants on `tau0`, the longest scenario): 15 of 20 ants make
 /// 1.0-1.01 moves a path step, 5 make 4-35 (one visited 12,740 of the maze's cells), and those 5
 /// are 90 % of all moves. Their paths are long detours (the iteration's worst, punished by the
-/// wolves rule); with the local search they add nothing the run needs. A budget of 3 moves a
-/// step of the shortest path so far leaves every ant that goes more or less straight (detours
-/// included) alone and stops the walled-in ones early. The first ant of a run has no budget, so
-/// a run always has its first path as before; `BENCHMARKS.md` and `docs/ALGORITHM.md` have the
+/// wolves rule); with the local search they add nothing the run needs. A budget of 3 times the
+/// cheapest arrived walk leaves every ant that goes more or less straight (detours included)
+/// alone and stops the walled-in ones early (a budget in path steps instead abandoned 49 of 50
+/// ants on `ht_chantry`, where every ant backtracks a lot). The first iteration has no budget, so
+/// a run always has its first paths as before; `BENCHMARKS.md` and `docs/ALGORITHM.md` have the
 /// figures.
 pub(super) const MOVE_BUDGET: u32 = 3;
 
