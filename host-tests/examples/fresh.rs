@@ -12,23 +12,9 @@
 
 use ohaca::{plan, Params, Point};
 use ohaca_host_tests::check::check_plan;
+use ohaca_host_tests::gen::Mix;
 use ohaca_host_tests::maps::Map;
 use ohaca_host_tests::reference::optima;
-
-/// SplitMix64: the generator of the maps (not the planner's).
-struct Mix(u64);
-impl Mix {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    fn below(&mut self, n: u64) -> u64 {
-        self.next() % n
-    }
-}
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();

@@ -96,11 +96,13 @@ pub fn config(cases: u32) -> ProptestConfig {
     }
 }
 
-/// SplitMix64, the generator of [`maze`] (deterministic from its seed, independent of proptest).
-struct Mix(u64);
+/// SplitMix64: the generator of [`maze`] and of the `fresh` example's maps (deterministic from its
+/// seed, independent of proptest and of the planner's own generator).
+pub struct Mix(pub u64);
 
 impl Mix {
-    fn next(&mut self) -> u64 {
+    /// The next 64 random bits.
+    pub fn next(&mut self) -> u64 {
         self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
         let mut z = self.0;
         z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
@@ -108,8 +110,9 @@ impl Mix {
         z ^ (z >> 31)
     }
 
-    fn below(&mut self, n: usize) -> usize {
-        (self.next() % n as u64) as usize
+    /// A number below `n` (`n > 0`).
+    pub fn below(&mut self, n: u64) -> u64 {
+        self.next() % n
     }
 }
 
@@ -163,7 +166,7 @@ pub fn maze(side: u16, width: u16, seed: u64) -> Map {
             stack.pop();
             continue;
         }
-        let (ni, nj) = next[rng.below(n)];
+        let (ni, nj) = next[rng.below(n as u64) as usize];
         // Knock down the one-cell wall between the two rooms, across the corridor's width.
         if ni != i {
             let x = origin(i.min(ni)) + w;
