@@ -102,7 +102,7 @@ pub struct Mix(pub u64);
 
 impl Mix {
     /// The next 64 random bits.
-    pub fn next(&mut self) -> u64 {
+    pub fn next_u64(&mut self) -> u64 {
         self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
         let mut z = self.0;
         z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
@@ -112,7 +112,7 @@ impl Mix {
 
     /// A number below `n` (`n > 0`).
     pub fn below(&mut self, n: u64) -> u64 {
-        self.next() % n
+        self.next_u64() % n
     }
 }
 
@@ -208,7 +208,7 @@ pub fn far_pair(map: &Map, k: usize) -> Option<(Point, Point)> {
                 }
             }
         }
-        order.sort_by(|a, b| b.0.cmp(&a.0));
+        order.sort_by_key(|e| std::cmp::Reverse(e.0));
         order
     };
     let corner = (0..map.cells())
