@@ -10,8 +10,8 @@
 
 use ohaca::protocol::{
     encode_reply, encode_request, Feed, PathReply, Reply, Request, RequestReader, Waypoints,
-    MAX_CHUNK, MAX_DIRECTIONS, MAX_REPLY, MAX_REPLY_WIRE, MAX_REQUEST, MAX_REQUEST_WIRE,
-    MAX_STEPS, MAX_UPDATE_CELLS, MAX_WAYPOINTS, VERSION,
+    MAX_CHUNK, MAX_DIRECTIONS, MAX_REPLY, MAX_REPLY_WIRE, MAX_REQUEST, MAX_REQUEST_WIRE, MAX_STEPS,
+    MAX_UPDATE_CELLS, MAX_WAYPOINTS, VERSION,
 };
 use ohaca::{DeadEnd, Params, Point, SmoothingKind};
 

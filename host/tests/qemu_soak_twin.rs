@@ -37,8 +37,8 @@ use std::time::{Duration, Instant};
 
 use ohaca::protocol::{
     decode_reply, decode_request, encode_request, Encoding, ErrorCode, ErrorReply, MapChunk,
-    MapLimits, ReplyReader, Request, RequestReader, RleEncoder, Upload, MAX_CHUNK,
-    MAX_REPLY_WIRE, MAX_REQUEST_WIRE,
+    MapLimits, ReplyReader, Request, RequestReader, RleEncoder, Upload, MAX_CHUNK, MAX_REPLY_WIRE,
+    MAX_REQUEST_WIRE,
 };
 use ohaca::{Params, Point};
 use ohaca_host::link::Response;
@@ -109,7 +109,10 @@ fn depot(seed: u64) -> Map {
         y += 9 + rng.below(4) as u16;
     }
     for _ in 0..60 {
-        let (px, py) = (rng.below(usize::from(w)) as u16, rng.below(usize::from(h)) as u16);
+        let (px, py) = (
+            rng.below(usize::from(w)) as u16,
+            rng.below(usize::from(h)) as u16,
+        );
         for d in 0..9 {
             set(px + d % 3, py + d / 3, &mut blocked);
         }
@@ -122,7 +125,9 @@ fn depot(seed: u64) -> Map {
     for (x, y) in [(1, h - 2), (w - 2, 1), (2, h - 2), (1, h - 3)] {
         blocked[usize::from(y) * usize::from(w) + usize::from(x)] = false;
     }
-    Map::from_fn(w, h, |x, y| blocked[usize::from(y) * usize::from(w) + usize::from(x)])
+    Map::from_fn(w, h, |x, y| {
+        blocked[usize::from(y) * usize::from(w) + usize::from(x)]
+    })
 }
 
 type Incoming = Result<(u32, Response), String>;
@@ -229,7 +234,6 @@ impl Model {
             Err(e) => Want::Exact(id, Response::Error(e)),
         }
     }
-
 }
 
 /// The device as the host models it, and the link to it.
@@ -415,9 +419,10 @@ impl Device {
             let want = self.write(&bytes);
             let got = self.expect(&want);
             // A run-length code that overran the map closed the upload: nothing to redo.
-            if got.iter().any(
-                |(_, r)| matches!(r, Response::Error(e) if e.code == ErrorCode::BadRle),
-            ) {
+            if got
+                .iter()
+                .any(|(_, r)| matches!(r, Response::Error(e) if e.code == ErrorCode::BadRle))
+            {
                 return written;
             }
             // The chunks acknowledged in order from `next`: the device holds every byte before

@@ -311,7 +311,10 @@ fn a_path_of_8191_steps_comes_back_in_one_reply() {
     let beyond = Point::new(7, 15);
     let e = error_code(link.plan(start, beyond, None));
     assert_eq!(e.code, ErrorCode::PathTooLong, "{e}");
-    assert_eq!(core_plan_steps(&map, start, beyond, &few, steps).err(), Some(e));
+    assert_eq!(
+        core_plan_steps(&map, start, beyond, &few, steps).err(),
+        Some(e)
+    );
     let st = link.stats().expect("stats");
     println!("stack peak {} bytes", st.stack_peak);
     assert_eq!(link.stray_count(), 0, "{:?}", link.take_strays());
