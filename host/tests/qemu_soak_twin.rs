@@ -4,15 +4,16 @@
 //!
 //! Each round uploads `NewYork_0_512` (512 x 512, a city) and a generated 604 x 307 depot (the
 //! shape of Nav2's sample depot: walls, racks, aisles, noise), each raw and run-length coded,
-//! three chunks in flight like `ohaca_host::link::Link`. About one chunk frame in six is damaged
-//! on its way: a byte dropped (one time in four the delimiter, so the frame runs into the next
-//! one), a bit flipped, a byte garbled, garbage inserted, or the frame cut short. The host
-//! reacts as a client written from docs/PROTOCOL.md would: after a lost or refused chunk it sends
-//! a lone `00` (to end a partial frame) and goes back to the first chunk not acknowledged
-//! (`BadChunk` says how far the device got). Before some uploads it also breaks one on purpose:
-//! abandoned half way (`Stats` says 0 x 0, a plan gets `NoMap`), a run-length code that overruns
-//! the map in a frame with a good CRC (`BadRle`, no map), or a restart with a wrong `total_len`
-//! (`BadMap`, and the open upload goes on untouched). Each is then redone.
+//! three chunks in flight like `ohaca_host::link::Link`. 15 % of the chunk frames are damaged on
+//! their way, one of six ways alike: a byte dropped, the delimiter dropped (so the frame runs
+//! into the next one), a bit flipped, a byte garbled, garbage inserted, or the frame cut short.
+//! The host reacts as a client written from docs/PROTOCOL.md would: after a lost or refused
+//! chunk it sends a lone `00` (to end a partial frame) and goes back to the first chunk not
+//! acknowledged (`BadChunk` says how far the device got). Before three uploads of every four
+//! (in turn) it also breaks one on purpose: abandoned half way (`Stats` says 0 x 0, a plan gets
+//! `NoMap`), a run-length code that overruns the map in a frame with a good CRC (`BadRle`, no
+//! map), or a restart with a wrong `total_len` (`BadMap`, and the open upload goes on
+//! untouched). Each is then redone.
 //!
 //! What the device must answer is computed by a model fed the exact bytes written: the protocol's
 //! own `RequestReader` and `decode_request`, and its `Upload` rules for the map (as
