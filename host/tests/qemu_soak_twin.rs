@@ -402,6 +402,7 @@ impl Device {
         let chunks: Vec<&[u8]> = code.chunks(MAX_CHUNK).collect();
         let mut next = 0; // the first chunk not known to be acknowledged
         let mut written = 0;
+        let mut stalled = 0;
         while next < chunks.len() {
             let end = (next + WINDOW).min(chunks.len());
             let mut bytes = Vec::new();
@@ -418,7 +419,20 @@ impl Device {
             }
             written += ids.len();
             let want = self.write(&bytes);
-            let got = self.expect(&want);
+            let mut got = self.expect(&want);
+            let all_acked = |got: &[(u32, Response)]| {
+                ids.iter().all(|(id, _)| {
+                    got.iter()
+                        .any(|(i, r)| i == id && matches!(r, Response::Ack))
+                })
+            };
+            if !all_acked(&got) {
+                // A lost or refused chunk: end a partial frame (whose reply then comes: a frame
+                // that lost only its delimiter is whole again), then go back.
+                self.resent += 1;
+                let want = self.write(&[0]);
+                got.extend(self.expect(&want));
+            }
             // A run-length code that overran the map closed the upload: nothing to redo.
             if got
                 .iter()
@@ -435,12 +449,12 @@ impl Device {
                         .any(|(i, r)| i == id && matches!(r, Response::Ack))
                 })
                 .count();
-            if acked < ids.len() {
-                self.resent += 1;
-                // A lost or refused chunk: end a partial frame, then go back.
-                let want = self.write(&[0]);
-                self.expect(&want);
-            }
+            stalled = if acked == 0 { stalled + 1 } else { 0 };
+            assert!(
+                stalled < 50,
+                "no progress at chunk {next} of {}: {got:?}",
+                chunks.len()
+            );
             next += acked;
             if stop_after.is_some_and(|n| next >= n) {
                 return written;
