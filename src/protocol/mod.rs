@@ -120,9 +120,10 @@ pub const fn path_payload(waypoints: usize, directions: usize) -> usize {
 /// piece by piece.
 pub const MAX_REPLY: usize = path_payload(MAX_WAYPOINTS, MAX_DIRECTIONS);
 
-// Every other reply is far smaller than a path (Hello, the largest, is under 100 bytes), and a
-// request never needs a reply's room.
-const _: () = assert!(MAX_REPLY == 41_019 && MAX_REPLY > MAX_REQUEST);
+// The figure docs/PROTOCOL.md gives (`host-tests/tests/documents.rs` reads it there and encodes
+// the widest path reply): a change to `MAX_STEPS` or to `PathReply` is a new protocol version.
+// Each board checks its `max_steps` against `MAX_STEPS` (`firmware::board`).
+const _: () = assert!(MAX_REPLY == 41_019);
 
 /// Largest request frame on the wire, delimiter included.
 pub const MAX_REQUEST_WIRE: usize = wire_len(MAX_REQUEST);
