@@ -41,12 +41,14 @@ def free_port():
 class Qemu:
     """scripts/qemu-serve.sh in the background, its defmt stream kept in a file."""
 
-    def __init__(self, icount):
+    def __init__(self, icount, elf=ELF):
         self.port = free_port()
+        self.elf = elf
         self.defmt = tempfile.NamedTemporaryFile(prefix="ohaca-bench-", suffix=".defmt",
                                                  delete=False).name
         cmd = [os.path.join(ROOT, "scripts/qemu-serve.sh"), "--no-build", "--port",
-               str(self.port), "--defmt", self.defmt] + (["--icount"] if icount else [])
+               str(self.port), "--defmt", self.defmt, "--elf", elf] + (["--icount"] if icount
+                                                                         else [])
         self.proc = subprocess.Popen(cmd, stderr=subprocess.DEVNULL)
 
     def stop(self):
@@ -54,7 +56,7 @@ class Qemu:
         self.proc.terminate()
         self.proc.wait()
         try:
-            out = subprocess.run(["defmt-print", "-e", ELF, "--log-format", "{s}"],
+            out = subprocess.run(["defmt-print", "-e", self.elf, "--log-format", "{s}"],
                                  stdin=open(self.defmt, "rb"), capture_output=True, text=True,
                                  check=False).stdout
         except FileNotFoundError:
@@ -107,6 +109,9 @@ def main():
     ap.add_argument("--goal", default=None, help="default: the map's far corner")
     ap.add_argument("--seeds", type=int, default=10)
     ap.add_argument("--hellos", type=int, default=100)
+    ap.add_argument("--elf", default=ELF,
+                    help="the firmware to boot, e.g. the H743 twin's "
+                         "target/twin-h743/thumbv7em-none-eabihf/release/ohaca")
     ap.add_argument("--default-only", action="store_true",
                     help="only the default plans: no full runs, no Hello round trips")
     args = ap.parse_args()
@@ -117,7 +122,8 @@ def main():
     seeds = list(range(1, args.seeds + 1))
 
     # Instruction counts, under -icount shift=0.
-    q = Qemu(icount=True)
+    elf = os.path.abspath(args.elf)
+    q = Qemu(icount=True, elf=elf)
     try:
         dev = Device("127.0.0.1", q.port)
         hello = expect(dev.call(req_hello()), "Hello")
@@ -146,7 +152,7 @@ def main():
         parts = []  # no defmt-print, or a log that does not match: leave the split out
 
     # Hello round trips, wall clock, without -icount.
-    q = Qemu(icount=False)
+    q = Qemu(icount=False, elf=elf)
     try:
         dev = Device("127.0.0.1", q.port)
         for _ in range(5):  # warm up

@@ -2,6 +2,9 @@
 """The firmware's default plan per map size: instructions under QEMU, map memory, upload.
 
     cargo build --release && python3 scripts/bench_sizes.py [--seeds 3]
+    cargo build --release --features twin-h743 --target-dir target/twin-h743
+    python3 scripts/bench_sizes.py --elf target/twin-h743/thumbv7em-none-eabihf/release/ohaca \
+        [--only NewYork,Sydney]                  # the STM32H743's capacity twin, up to 1024^2
 
 For each size (32^2 .. 512^2) one public Moving AI map of `maps/` and its longest scenario (the
 largest optimum in the map's `.scen`): boots the release firmware with `-icount shift=0` (1 tick
@@ -23,7 +26,7 @@ import statistics
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from bench_device import ROOT, Qemu, mi, split_log  # noqa: E402
+from bench_device import ELF, ROOT, Qemu, mi, split_log  # noqa: E402
 from ohaca_client import (Device, expect, frame, load_map, raw_cells,  # noqa: E402
                           req_hello, req_plan, req_set_map, varint)
 
@@ -35,6 +38,7 @@ MAPS = [
     ("128 x 128", "maps/large/maze-128-128-2.map", "maps/large/maze-128-128-2-random-1.scen"),
     ("256 x 256", "maps/large/Boston_0_256.map", "maps/large/Boston_0_256-random-1.scen"),
     ("512 x 512", "maps/large/NewYork_0_512.map", "maps/large/NewYork_0_512.map.scen"),
+    ("1024 x 1024", "maps/large/Sydney_0_1024.map", "maps/large/Sydney_0_1024.map.scen"),
 ]
 CHUNK = 128
 BAUD_BYTES = 115200 / 10  # 8N1: ten bits a byte
@@ -72,17 +76,23 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--seeds", type=int, default=3)
+    ap.add_argument("--elf", default=ELF,
+                    help="the firmware to boot (default: the QEMU board's release build)")
+    ap.add_argument("--only", default="",
+                    help="comma-separated substrings: only the maps whose file name has one")
     args = ap.parse_args()
     seeds = list(range(1, args.seeds + 1))
+    only = [o for o in args.only.split(",") if o]
+    maps = [m for m in MAPS if not only or any(o in os.path.basename(m[1]) for o in only)]
 
     rows = []
-    q = Qemu(icount=True)
+    q = Qemu(icount=True, elf=os.path.abspath(args.elf))
     plans_done = 0
     try:
         dev = Device("127.0.0.1", q.port)
         hello = expect(dev.call(req_hello()), "Hello")
         cap = hello["capacity"]
-        for size, path, scen in MAPS:
+        for size, path, scen in maps:
             w, h, bits, _ = load_map(os.path.join(ROOT, path))
             start, goal, opt = longest(scen)
             wire = wire_bytes(w, h, bits)

@@ -13,7 +13,7 @@ use image::{GrayImage, ImageFormat, Luma, Rgba, RgbaImage};
 use ohaca::protocol::{
     encode_reply, encode_request, Capacity, ErrorCode, ErrorReply, HelloReply, PathReply, Reply,
     Request, StatsReply, Waypoints, MAX_CHUNK, MAX_DIRECTIONS, MAX_REPLY_WIRE, MAX_REQUEST,
-    MAX_REQUEST_WIRE, MAX_WAYPOINTS, VERSION,
+    MAX_REQUEST_WIRE, MAX_STEPS, MAX_UPDATE_CELLS, MAX_WAYPOINTS, VERSION,
 };
 use ohaca::{Algorithm, DeadEnd, Params, Point, SmoothingKind};
 use ohaca_host::map::Map;
@@ -171,6 +171,66 @@ fn wire_frame_seeds(root: &Path) -> Result<Vec<(String, Vec<u8>)>> {
         },
     ));
     out.push(("session-rle-updates".into(), session));
+    // Protocol 6 and 7 singles: the largest request (SetCells with MAX_UPDATE_CELLS cells and the
+    // longest id), a rectangle, a warm plan, first chunks of maps sized by cells (604 x 307 fits
+    // 512 x 512's cells; 2048 x 1025 is over the twin's 2,097,152; 5000 x 10 over the side).
+    let many_cells: Vec<Point> = (0..MAX_UPDATE_CELLS as u16)
+        .map(|i| Point::new(u16::MAX - i, i * 7))
+        .collect();
+    out.push((
+        "req-set-cells-max".into(),
+        req(
+            u32::MAX,
+            &Request::SetCells {
+                blocked: true,
+                cells: Waypoints::Points(&many_cells),
+            },
+        ),
+    ));
+    out.push((
+        "req-set-rect".into(),
+        req(
+            80,
+            &Request::SetRect {
+                x: 600,
+                y: 300,
+                width: 4,
+                height: 7,
+                blocked: false,
+            },
+        ),
+    ));
+    out.push((
+        "req-plan-warm".into(),
+        req(
+            81,
+            &Request::PlanWarm {
+                start: Point::new(603, 306),
+                goal: Point::new(0, 0),
+                seed: None,
+            },
+        ),
+    ));
+    for (name, w, h) in [
+        ("req-set-map-604x307", 604u16, 307u16),
+        ("req-set-map-2048x1025", 2048, 1025),
+        ("req-set-map-5000x10", 5000, 10),
+    ] {
+        let total = (u32::from(w) * u32::from(h)).div_ceil(8);
+        out.push((
+            name.into(),
+            req(
+                82,
+                &Request::SetMap {
+                    width: w,
+                    height: h,
+                    offset: 0,
+                    total_len: total,
+                    chunk: &[0x0f; 64],
+                },
+            ),
+        ));
+    }
     out.push((
         "req-set-map-rle-bad".into(),
         req(
@@ -202,6 +262,17 @@ fn wire_frame_seeds(root: &Path) -> Result<Vec<(String, Vec<u8>)>> {
         defaults: Params::default(),
     };
     out.push(("rep-hello".into(), rep(1, &Reply::Hello(hello))));
+    // The STM32H743 twin's Hello: capacity by cells, the longest paths.
+    let twin = HelloReply {
+        board: "qemu-mps2-an386-twin-h743",
+        capacity: Capacity {
+            cells: 2_097_152,
+            max_steps: MAX_STEPS as u32,
+            ..hello.capacity
+        },
+        ..hello
+    };
+    out.push(("rep-hello-twin".into(), rep(1, &Reply::Hello(twin))));
     out.push(("rep-ack".into(), rep(2, &Reply::Ack)));
     let points = [
         Point::new(0, 0),
@@ -235,6 +306,19 @@ fn wire_frame_seeds(root: &Path) -> Result<Vec<(String, Vec<u8>)>> {
         ..path
     };
     out.push(("rep-path-max".into(), rep(14, &Reply::Path(max_path))));
+    // The twin's longest path as it plans it: MAX_STEPS steps through eight corridors, 16
+    // waypoints (`host/tests/qemu_twin.rs`, the serpentine), about 8.3 KB.
+    let corners: Vec<Point> = (0..16u16)
+        .map(|i| Point::new(if (i + 1) % 4 < 2 { 1 } else { 1024 }, 1 + 2 * (i / 2)))
+        .collect();
+    let long: Vec<u8> = (0..MAX_STEPS).map(|i| [0, 2, 4][i % 3]).collect();
+    let long_path = PathReply {
+        waypoints: Waypoints::Points(&corners),
+        directions: &long,
+        raw_cells: MAX_STEPS as u32 + 1,
+        ..path
+    };
+    out.push(("rep-path-long".into(), rep(15, &Reply::Path(long_path))));
     let mut over = vec![0x17u8; MAX_REPLY_WIRE];
     over.push(0);
     out.push(("rep-too-large".into(), over));

@@ -4,13 +4,16 @@
 //!
 //! - the request size limits of `docs/PROTOCOL.md`: the reader's 259 COBS bytes (delimiter not
 //!   counted), `TooLarge` reporting the frame's whole length, and the largest request's size;
+//! - its reply limits: `MAX_STEPS`, `MAX_WAYPOINTS`, `MAX_DIRECTIONS`, `MAX_REPLY` and
+//!   `MAX_REPLY_WIRE`, and that the widest path reply is exactly `MAX_REPLY` bytes;
 //! - the parameter table of `docs/ALGORITHM.md` against `Params::default()` and `Params::paper()`.
 
 use ohaca::protocol::{
-    encode_request, Feed, Request, RequestReader, Waypoints, MAX_CHUNK, MAX_REQUEST,
-    MAX_REQUEST_WIRE, MAX_UPDATE_CELLS,
+    encode_reply, encode_request, Feed, PathReply, Reply, Request, RequestReader, Waypoints,
+    MAX_CHUNK, MAX_DIRECTIONS, MAX_REPLY, MAX_REPLY_WIRE, MAX_REQUEST, MAX_REQUEST_WIRE, MAX_STEPS,
+    MAX_UPDATE_CELLS, MAX_WAYPOINTS, VERSION,
 };
-use ohaca::{DeadEnd, Params, SmoothingKind};
+use ohaca::{DeadEnd, Params, Point, SmoothingKind};
 
 fn doc(name: &str) -> String {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -102,12 +105,58 @@ fn the_request_size_limits_are_the_documents() {
     assert!(postcard_len(&params) < largest as usize);
 }
 
+#[test]
+fn the_reply_size_limits_are_the_documents() {
+    let text = doc("PROTOCOL.md");
+    assert_eq!(
+        number_after(&text, "# ohaca wire protocol, version"),
+        u64::from(VERSION)
+    );
+    assert_eq!(number_after(&text, "| `MAX_STEPS` |"), MAX_STEPS as u64);
+    assert_eq!(
+        number_after(&text, "| `MAX_WAYPOINTS` |"),
+        MAX_WAYPOINTS as u64
+    );
+    assert_eq!(
+        number_after(&text, "| `MAX_DIRECTIONS` |"),
+        MAX_DIRECTIONS as u64
+    );
+    assert_eq!(number_after(&text, "| `MAX_REPLY` |"), MAX_REPLY as u64);
+    assert_eq!(
+        number_after(&text, "reader needs `MAX_REPLY_WIRE` ="),
+        MAX_REPLY_WIRE as u64
+    );
+    // The widest path reply (every field at its longest varint, every step a waypoint) is
+    // exactly MAX_REPLY bytes of payload, and fits MAX_REPLY_WIRE on the wire.
+    let points = vec![Point::new(u16::MAX, u16::MAX); MAX_WAYPOINTS];
+    let dirs = vec![7u8; MAX_DIRECTIONS];
+    let widest = Reply::Path(PathReply {
+        raw_length: f32::MAX,
+        length: f32::MAX,
+        turns: u32::MAX,
+        iterations: u16::MAX,
+        best_iteration: u16::MAX,
+        moves: u64::MAX,
+        ticks: u64::MAX,
+        raw_cells: u32::MAX,
+        warm: true,
+        waypoints: Waypoints::Points(&points),
+        directions: &dirs,
+    });
+    let mut buf = vec![0u8; MAX_REPLY_WIRE];
+    let n = encode_reply(u32::MAX, &widest, &mut buf).expect("the widest path fits");
+    assert_eq!(decoded_len(&buf[..n - 1]), MAX_REPLY);
+}
+
 /// Payload bytes (postcard + CRC) of `req` with the longest id.
 fn postcard_len(req: &Request<'_>) -> usize {
     let mut buf = [0u8; 2 * MAX_REQUEST_WIRE];
     let n = encode_request(u32::MAX, req, &mut buf).expect("encode");
-    // Undo COBS: the decoded length is what the reader hands the decoder.
-    let body = &buf[..n - 1];
+    decoded_len(&buf[..n - 1])
+}
+
+/// Bytes of a COBS frame (without its delimiter) once decoded: what the reader hands the decoder.
+fn decoded_len(body: &[u8]) -> usize {
     let mut out = Vec::new();
     let mut i = 0;
     while i < body.len() {

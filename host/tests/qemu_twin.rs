@@ -3,7 +3,9 @@
 //! RAM regions at their sizes: `src/firmware/board/qemu/twin-h743-memory.x`), so what it plans
 //! here fits the chip. Maps of 1024 x 1024 and 2048 x 1024 cells go up over QEMU's UART and are
 //! planned at full resolution, bit for bit as the host core plans them with the device's
-//! workspace shape (`core_plan_steps` with Hello's `max_steps`).
+//! workspace shape (`core_plan_steps` with Hello's `max_steps`), and so are paths of up to the
+//! twin's 8,191 steps, whose replies (up to 8.3 KB) fit the protocol's `MAX_REPLY` since
+//! version 7.
 //!
 //! The twin is built once per run into `target/twin-h743` (`OHACA_TWIN_FIRMWARE=path/to/elf`
 //! uses another ELF). Without `qemu-system-arm` the tests fail unless `OHACA_SKIP_QEMU=1`.
@@ -176,10 +178,9 @@ fn the_longest_maze_128_128_2_scenario_plans_on_the_twin() {
 
 /// A 2048 x 1024 map, all the cells the twin holds: a path of 4,632 steps (four times what the
 /// STM32F411 keeps) is the host core's, bit for bit; a path of about 9,000 steps is
-/// `PathTooLong` with the twin's limit, as the host core says; a path of about 6,700 steps fits
-/// the planner but its reply does not fit the protocol's largest frame (`MAX_REPLY`, 5,248
-/// bytes): until the protocol carries longer paths it is refused with `Internal` (waypoints,
-/// directions), and the device goes on. (If a path is sent, it must be the host core's.)
+/// `PathTooLong` with the twin's limit, as the host core says; a path of 6,658 steps, whose
+/// reply (6.8 KB) was over protocol 6's largest frame (`MAX_REPLY`, 5,248 bytes, then `Error
+/// Internal`), is sent and is the host core's.
 #[test]
 fn a_2048x1024_map_and_paths_of_thousands_of_steps() {
     need_qemu!();
@@ -226,31 +227,94 @@ fn a_2048x1024_map_and_paths_of_thousands_of_steps() {
     let host = core_plan_steps(&map, start, far, &few, steps);
     assert_eq!(host.err(), Some(e), "the host core's answer");
 
-    // About 6,700 steps: kept by the planner; its reply is over the protocol's largest frame.
+    // About 6,700 steps: over protocol 6's largest reply, within version 7's.
     link.set_params(&defaults).expect("set params");
     let right = Point::new(2039, 702);
     let t0 = Instant::now();
-    let r = link.plan(start, right, None);
+    let dev = link.plan(start, right, None).expect("device plan");
     println!(
-        "2048x1024 {start:?} -> {right:?}: {:.1} s",
+        "2048x1024 {start:?} -> {right:?}: {} cells in {:.1} s",
+        dev.raw_cells,
         t0.elapsed().as_secs_f64()
     );
     let host = core_plan_steps(&map, start, right, &defaults, steps).expect("host plan");
-    match r {
-        Ok(dev) => assert_core_path("2048x1024, 6,700 steps", &host, &dev),
-        Err(e) => {
-            let e = error_code::<()>(Err(e));
-            let (wps, dirs) = (host.waypoints.len(), host.directions.len());
-            assert_eq!(
-                e,
-                ErrorReply::with(ErrorCode::Internal, wps as u32, dirs as u32),
-                "{e}"
-            );
-        }
-    }
+    assert_core_path("2048x1024, 6,700 steps", &host, &dev);
+    assert!(dev.raw_cells > 5300, "{}", dev.raw_cells);
     // The device goes on: the short plan again.
     let again = link.plan(start, goal, None).expect("device plan");
     assert_eq!(again.raw_cells, host_cells(&map, start, goal, steps));
+    let st = link.stats().expect("stats");
+    println!("stack peak {} bytes", st.stack_peak);
+    assert_eq!(link.stray_count(), 0, "{:?}", link.take_strays());
+}
+
+/// Eight corridors one cell wide, 1,024 cells long, at rows 1, 3, ..., 15 of a 1026 x 1024 map
+/// (blocked elsewhere), joined at alternate ends by one cell: a single way from `(1, 1)` through
+/// all of them, 8,198 steps to the far end of the last one. So the optimal path is the only one,
+/// and a goal on it sets the path's length to the step.
+fn serpentine() -> Map {
+    Map::from_fn(1026, 1024, |x, y| {
+        let corridor = y % 2 == 1 && y <= 15 && (1..=1024).contains(&x);
+        // The joint below corridor `y - 1`: at the right end after corridors 1, 5, 9, 13, at
+        // the left end after 3, 7, 11.
+        let joint = y % 2 == 0 && (2..=14).contains(&y) && x == if y % 4 == 2 { 1024 } else { 1 };
+        !(corridor || joint)
+    })
+}
+
+/// The longest path the twin plans, 8,191 steps (`max_steps`), through the eight 1-wide
+/// corridors of [`serpentine`]: planned, sent in one `Path` reply (8.3 KB, over protocol 6's
+/// 5,248-byte `MAX_REPLY`) and bit for bit the host core's; one step more is `PathTooLong`. The
+/// corridors leave an ant no choice (the tabu list forbids going back), so a default plan is
+/// cheap for its length: about `ants x iterations x steps` moves and nothing to search.
+#[test]
+fn a_path_of_8191_steps_comes_back_in_one_reply() {
+    need_qemu!();
+    let q = Qemu::tcp_with(twin_firmware());
+    let mut link = q.link();
+    let info = link.hello().expect("hello");
+    let steps = info.capacity.max_steps as usize;
+    assert_eq!(steps, STEPS as usize);
+    let map = serpentine();
+    let t0 = Instant::now();
+    link.set_map(&map).expect("upload");
+    println!(
+        "serpentine 1026x1024: upload {:.1} s over QEMU's UART",
+        t0.elapsed().as_secs_f64()
+    );
+    let defaults = Params::default();
+    let start = Point::new(1, 1);
+    // The far end of the last corridor (row 15, entered at the right, going left), `(1, 15)`,
+    // is 8,198 steps away: 7 short of it.
+    let goal = Point::new(8, 15);
+    let t0 = Instant::now();
+    let dev = link.plan(start, goal, None).expect("device plan");
+    println!(
+        "serpentine {start:?} -> {goal:?}: {} cells, {} waypoints, {} iterations in {:.1} s",
+        dev.raw_cells,
+        dev.waypoints.len(),
+        dev.iterations,
+        t0.elapsed().as_secs_f64()
+    );
+    let host = core_plan_steps(&map, start, goal, &defaults, steps).expect("host plan");
+    assert_core_path("serpentine, 8,191 steps", &host, &dev);
+    assert_eq!(dev.directions.len(), steps);
+    assert_eq!(dev.raw_cells as usize, steps + 1);
+
+    // One step more: no ant keeps it.
+    let few = Params {
+        ants: 4,
+        iterations: 2,
+        ..defaults
+    };
+    link.set_params(&few).expect("set params");
+    let beyond = Point::new(7, 15);
+    let e = error_code(link.plan(start, beyond, None));
+    assert_eq!(e.code, ErrorCode::PathTooLong, "{e}");
+    assert_eq!(
+        core_plan_steps(&map, start, beyond, &few, steps).err(),
+        Some(e)
+    );
     let st = link.stats().expect("stats");
     println!("stack peak {} bytes", st.stack_peak);
     assert_eq!(link.stray_count(), 0, "{:?}", link.take_strays());

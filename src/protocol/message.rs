@@ -10,8 +10,8 @@ use crate::planner::Params;
 use super::wire::PointDef;
 #[cfg(doc)] // the doc links
 use super::{
-    ErrorCode, PathStream, RleEncoder, MAX_CHUNK, MAX_DIRECTIONS, MAX_REQUEST, MAX_UPDATE_CELLS,
-    MAX_WAYPOINTS, VERSION,
+    ErrorCode, PathStream, RleEncoder, MAX_CHUNK, MAX_DIRECTIONS, MAX_REPLY, MAX_REQUEST,
+    MAX_STEPS, MAX_UPDATE_CELLS, MAX_WAYPOINTS, VERSION,
 };
 use super::{ErrorReply, Waypoints};
 
@@ -154,7 +154,8 @@ pub struct Capacity {
     /// `MapTooLarge`, detail = the side, limit = `max_side`).
     pub max_side: u16,
     /// Longest ant path the planner keeps, in steps: a way longer than this gets
-    /// `Error PathTooLong`.
+    /// `Error PathTooLong`. At most [`MAX_STEPS`], so every path the device plans fits one
+    /// [`PathReply`] of at most [`MAX_REPLY`] bytes.
     pub max_steps: u32,
     /// Most bytes per [`Request::SetMap`] chunk.
     pub max_chunk: u16,
@@ -187,7 +188,7 @@ pub struct PathReply<'a> {
     pub raw_cells: u32,
     /// True if the run kept the colony of the previous plan (a `PlanWarm` planned warm).
     pub warm: bool,
-    /// Waypoints, start first, goal last.
+    /// Waypoints, start first, goal last. At most [`MAX_WAYPOINTS`].
     #[serde(borrow)]
     pub waypoints: Waypoints<'a>,
     /// The raw path from the start as one direction per step (`0..8` = E, SE, S, SW, W, NW, N,

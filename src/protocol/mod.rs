@@ -65,8 +65,8 @@ pub use wire::{Waypoints, WAYPOINT_BYTES};
 /// bytes or meaning of a message (2: [`StatsReply::stack_peak`]; 3: run-length uploads, cell
 /// updates, warm plans, [`Capacity`]'s sides are the largest map held; 4: warm replies and
 /// `warm_patience`; 5: `refine_patience` and `refine`; 6: [`Capacity`] by cells, `max_side` and
-/// `max_steps`).
-pub const VERSION: u16 = 6;
+/// `max_steps`; 7: [`MAX_REPLY`] carries every path of [`MAX_STEPS`] steps).
+pub const VERSION: u16 = 7;
 
 /// The id of replies to frames whose request id could not be read. Hosts should not use it.
 pub const UNKNOWN_ID: u32 = 0;
@@ -74,19 +74,56 @@ pub const UNKNOWN_ID: u32 = 0;
 /// Most map bytes in one [`Request::SetMap`] chunk.
 pub const MAX_CHUNK: usize = 128;
 
-/// Most waypoints in a [`PathReply`].
-pub const MAX_WAYPOINTS: usize = 1024;
+/// Longest path, in steps, a device may plan ([`Capacity::max_steps`] is at most this): the
+/// STM32H743's 8,191, the largest of the boards. Every such path fits one [`PathReply`].
+pub const MAX_STEPS: usize = 8191;
 
-/// Most raw-path directions in a [`PathReply`].
-pub const MAX_DIRECTIONS: usize = 1024;
+/// Most waypoints in a [`PathReply`]: every cell of a path of [`MAX_STEPS`] steps.
+pub const MAX_WAYPOINTS: usize = MAX_STEPS + 1;
+
+/// Most raw-path directions in a [`PathReply`]: one a step of a path of [`MAX_STEPS`] steps.
+pub const MAX_DIRECTIONS: usize = MAX_STEPS;
 
 /// Largest request payload (postcard bytes plus CRC) a device must accept.
 pub const MAX_REQUEST: usize = 256;
 
+/// Bytes of postcard's varint of `n`.
+const fn varint_len(n: usize) -> usize {
+    let mut len: usize = 1;
+    let mut rest = n >> 7;
+    while rest > 0 {
+        len = len.wrapping_add(1); // at most 10
+        rest >>= 7;
+    }
+    len
+}
+
+/// Most bytes of a [`Reply::Path`] payload (postcard bytes plus CRC) with `waypoints` waypoints
+/// and `directions` directions: every fixed field at its widest (the id and the integers as the
+/// longest varints), then the two byte strings with their lengths, then the CRC.
+pub const fn path_payload(waypoints: usize, directions: usize) -> usize {
+    // id, variant, raw_length, length, turns, iterations, best_iteration, moves, ticks,
+    // raw_cells, warm.
+    const FIXED: usize = 5 + 1 + 4 + 4 + 5 + 3 + 3 + 10 + 10 + 5 + 1;
+    let points = waypoints.saturating_mul(WAYPOINT_BYTES);
+    FIXED
+        .saturating_add(varint_len(points))
+        .saturating_add(points)
+        .saturating_add(varint_len(directions))
+        .saturating_add(directions)
+        .saturating_add(4)
+}
+
 /// Largest reply payload (postcard bytes plus CRC) a host must accept: a [`PathReply`] with
-/// [`MAX_WAYPOINTS`] waypoints and [`MAX_DIRECTIONS`] directions fits. (A device need not hold
-/// one: [`PathStream`] encodes a path frame piece by piece.)
-pub const MAX_REPLY: usize = 5248;
+/// [`MAX_WAYPOINTS`] waypoints and [`MAX_DIRECTIONS`] directions, every path of [`MAX_STEPS`]
+/// steps, fits (41,019 bytes). A device need not hold one: [`PathStream`] encodes a path frame
+/// piece by piece.
+pub const MAX_REPLY: usize = path_payload(MAX_WAYPOINTS, MAX_DIRECTIONS);
+
+// The figure docs/PROTOCOL.md gives (`host-tests/tests/documents.rs` reads it there and encodes
+// the widest path reply): a change to `MAX_STEPS` or to `PathReply` is a new protocol version.
+// Each board checks its `max_steps` against `MAX_STEPS` (`firmware::board`).
+const _: () = assert!(MAX_REPLY == 41_019);
 
 /// Largest request frame on the wire, delimiter included.
 pub const MAX_REQUEST_WIRE: usize = wire_len(MAX_REQUEST);

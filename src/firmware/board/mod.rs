@@ -77,6 +77,10 @@ pub const LARGE: Capacity = Capacity {
     steps: 8191,
 };
 
+// A path the board plans always fits one path reply (`ohaca::protocol::MAX_STEPS`, from which
+// `MAX_REPLY` is derived).
+const _: () = assert!(CAPACITY.steps <= ohaca::protocol::MAX_STEPS);
+
 /// What a board provides.
 pub trait Board {
     /// Name reported in the Hello reply.

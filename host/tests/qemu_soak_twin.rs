@@ -1,0 +1,671 @@
+//! Faults at scale (issue 19, item 7): map uploads of 512 x 512 and 604 x 307 cells over QEMU's
+//! UART with injected byte drops and corruption, against the STM32H743's capacity twin (the
+//! F411-capacity firmware holds 65,536 cells, so it refuses both maps: `qemu_soak.rs` soaks it).
+//!
+//! Each round uploads `NewYork_0_512` (512 x 512, a city) and a generated 604 x 307 depot (the
+//! shape of Nav2's sample depot: walls, racks, aisles, noise), each raw and run-length coded,
+//! three chunks in flight like `ohaca_host::link::Link`. 15 % of the chunk frames are damaged on
+//! their way, one of six ways alike: a byte dropped, the delimiter dropped (so the frame runs
+//! into the next one), a bit flipped, a byte garbled, garbage inserted, or the frame cut short.
+//! The host reacts as a client written from docs/PROTOCOL.md would: after a lost or refused
+//! chunk it sends a lone `00` (to end a partial frame) and goes back to the first chunk not
+//! acknowledged (`BadChunk` says how far the device got). Before three uploads of every four
+//! (in turn) it also breaks one on purpose: abandoned half way (`Stats` says 0 x 0, a plan gets
+//! `NoMap`), a run-length code that overruns the map in a frame with a good CRC (`BadRle`, no
+//! map), or a restart with a wrong `total_len` (`BadMap`, and the open upload goes on
+//! untouched). Each is then redone.
+//!
+//! What the device must answer is computed by a model fed the exact bytes written: the protocol's
+//! own `RequestReader` and `decode_request`, and its `Upload` rules for the map (as
+//! `src/firmware/rx.rs`). Every reply is checked against it, in order (no timeouts are needed:
+//! the model knows when no reply is due). After each upload: `Stats` has the map's size, and a
+//! plan on it is the host core's, bit for bit, on the map the host meant to send (so no accepted
+//! byte was lost or changed). At the end, `Stats`' `frames_ok`, `frames_bad` and `rx_bytes` are
+//! exactly the model's, `rx_overruns` 0, `boots` 1.
+//!
+//! `OHACA_SOAK_SCALE_ROUNDS` rounds (default 1: about 30 s), seed `OHACA_SOAK_SEED`;
+//! `scripts/soak.sh` runs more rounds as its second phase. A summary is printed
+//! (`--nocapture`).
+
+#[macro_use]
+#[path = "common/qemu.rs"]
+mod qemu;
+
+use std::io::{Read, Write};
+use std::net::TcpStream;
+use std::sync::mpsc;
+use std::time::{Duration, Instant};
+
+use ohaca::protocol::{
+    decode_reply, decode_request, encode_request, Encoding, ErrorCode, ErrorReply, MapChunk,
+    MapLimits, ReplyReader, Request, RequestReader, RleEncoder, Upload, MAX_CHUNK, MAX_REPLY_WIRE,
+    MAX_REQUEST_WIRE,
+};
+use ohaca::{Params, Point};
+use ohaca_host::link::Response;
+use ohaca_host::Map;
+use qemu::{assert_core_path, core_plan_steps, have_qemu, maps, twin_firmware, Qemu};
+
+const DEFAULT_ROUNDS: usize = 1;
+const DEFAULT_SEED: u64 = 0x0ACA_5CA1;
+/// The twin's limits (`src/firmware/state.rs` with `LARGE`).
+const LIMITS: MapLimits = MapLimits {
+    max_cells: 2_097_152,
+    max_side: 4096,
+};
+/// Chunk frames in flight.
+const WINDOW: usize = 3;
+/// How long one reply may take (a plan on 512 x 512 without `-icount` takes a second or two).
+const REPLY_TIMEOUT: Duration = Duration::from_secs(120);
+
+/// SplitMix64.
+struct Rng(u64);
+
+impl Rng {
+    fn next(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+    fn below(&mut self, n: usize) -> usize {
+        (self.next() % n as u64) as usize
+    }
+    fn chance(&mut self, p: f64) -> bool {
+        ((self.next() >> 11) as f64 / (1u64 << 53) as f64) < p
+    }
+}
+
+/// A 604 x 307 depot: outer walls, racks (blocks 2 cells deep, 20-40 long) in rows with aisles,
+/// a few pillars and 1 % noise; the lower-left and upper-right corners are free.
+fn depot(seed: u64) -> Map {
+    let mut rng = Rng(seed);
+    let (w, h) = (604u16, 307u16);
+    let mut blocked = vec![false; usize::from(w) * usize::from(h)];
+    let set = |x: u16, y: u16, b: &mut Vec<bool>| {
+        if x < w && y < h {
+            b[usize::from(y) * usize::from(w) + usize::from(x)] = true;
+        }
+    };
+    for x in 0..w {
+        set(x, 0, &mut blocked);
+        set(x, h - 1, &mut blocked);
+    }
+    for y in 0..h {
+        set(0, y, &mut blocked);
+        set(w - 1, y, &mut blocked);
+    }
+    let mut y = 20;
+    while y + 2 < h - 20 {
+        let mut x = 30 + rng.below(10) as u16;
+        while x < w - 40 {
+            let len = 20 + rng.below(21) as u16;
+            for dx in 0..len.min(w - 30 - x) {
+                set(x + dx, y, &mut blocked);
+                set(x + dx, y + 1, &mut blocked);
+            }
+            x += len + 6 + rng.below(6) as u16;
+        }
+        y += 9 + rng.below(4) as u16;
+    }
+    for _ in 0..60 {
+        let (px, py) = (
+            rng.below(usize::from(w)) as u16,
+            rng.below(usize::from(h)) as u16,
+        );
+        for d in 0..9 {
+            set(px + d % 3, py + d / 3, &mut blocked);
+        }
+    }
+    for c in blocked.iter_mut() {
+        if rng.chance(0.01) {
+            *c = true;
+        }
+    }
+    for (x, y) in [(1, h - 2), (w - 2, 1), (2, h - 2), (1, h - 3)] {
+        blocked[usize::from(y) * usize::from(w) + usize::from(x)] = false;
+    }
+    Map::from_fn(w, h, |x, y| {
+        blocked[usize::from(y) * usize::from(w) + usize::from(x)]
+    })
+}
+
+type Incoming = Result<(u32, Response), String>;
+
+/// Read reply frames until the connection closes.
+fn read_replies(mut s: TcpStream, tx: mpsc::Sender<Incoming>) {
+    let mut reader = Box::new(ReplyReader::new());
+    let mut buf = vec![0u8; 8192];
+    loop {
+        let n = match s.read(&mut buf) {
+            Ok(0) => {
+                let _ = tx.send(Err("the device closed the connection".into()));
+                return;
+            }
+            Ok(n) => n,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+            Err(e) => {
+                let _ = tx.send(Err(format!("read: {e}")));
+                return;
+            }
+        };
+        for &b in &buf[..n] {
+            if let Some(f) = reader.push(b).into_frame(MAX_REPLY_WIRE) {
+                let r = f
+                    .and_then(decode_reply)
+                    .map(|(id, r)| (id, Response::from(&r)))
+                    .map_err(|e| format!("undecodable reply frame: {e}"));
+                if tx.send(r).is_err() {
+                    return;
+                }
+            }
+        }
+    }
+}
+
+/// A reply the model predicts.
+#[derive(Debug, PartialEq)]
+enum Want {
+    /// `Ack`, `Error` (the receive task's replies, exactly).
+    Exact(u32, Response),
+    /// `Stats` with this id (checked by the caller).
+    Stats(u32),
+    /// A plan's reply with this id (checked by the caller).
+    Plan(u32),
+}
+
+/// The device's map state as `src/firmware/rx.rs` keeps it.
+struct Model {
+    upload: Upload,
+    bits: Vec<u8>,
+    size: Option<(u16, u16)>,
+}
+
+impl Model {
+    /// What `src/firmware/rx.rs` answers to `req`, and its effect on the model's map.
+    fn apply(&mut self, id: u32, req: &Request<'_>) -> Want {
+        let c = match *req {
+            Request::SetMap {
+                width,
+                height,
+                offset,
+                total_len,
+                chunk,
+            } => (Encoding::Raw, width, height, offset, total_len, chunk),
+            Request::SetMapRle {
+                width,
+                height,
+                offset,
+                total_len,
+                chunk,
+            } => (Encoding::Rle, width, height, offset, total_len, chunk),
+            Request::Stats => return Want::Stats(id),
+            Request::Plan { .. } | Request::PlanWarm { .. } if self.size.is_some() => {
+                return Want::Plan(id)
+            }
+            Request::Plan { .. } | Request::PlanWarm { .. } => {
+                return Want::Exact(id, Response::Error(ErrorReply::new(ErrorCode::NoMap)))
+            }
+            Request::SetParams(_) => return Want::Exact(id, Response::Ack),
+            ref other => panic!("a damaged frame decoded as {other:?}: CRC collision?"),
+        };
+        let (encoding, width, height, offset, total_len, chunk) = c;
+        let c = MapChunk {
+            encoding,
+            width,
+            height,
+            offset,
+            total_len,
+            chunk,
+        };
+        let starts = match self.upload.accept(&c, LIMITS) {
+            Ok(s) => s,
+            Err(e) => return Want::Exact(id, Response::Error(e)),
+        };
+        if starts {
+            self.size = None;
+        }
+        match self.upload.write(&c, &mut self.bits) {
+            Ok(Some(size)) => {
+                self.size = Some(size);
+                Want::Exact(id, Response::Ack)
+            }
+            Ok(None) => Want::Exact(id, Response::Ack),
+            Err(e) => Want::Exact(id, Response::Error(e)),
+        }
+    }
+}
+
+/// The device as the host models it, and the link to it.
+struct Device {
+    out: TcpStream,
+    rx: mpsc::Receiver<Incoming>,
+    reader: Box<RequestReader>,
+    model: Model,
+    next_id: u32,
+    frames_ok: u32,
+    frames_bad: u32,
+    rx_bytes: u64,
+    faults: [u32; 6],
+    resent: u32,
+}
+
+const FAULTS: [&str; 6] = [
+    "dropped byte",
+    "dropped delimiter",
+    "flipped bit",
+    "garbled byte",
+    "inserted garbage",
+    "cut short",
+];
+
+impl Device {
+    fn new(q: &Qemu) -> Device {
+        let s = q.connect();
+        let r = s.try_clone().expect("clone the stream");
+        let (tx, rx) = mpsc::channel();
+        std::thread::spawn(move || read_replies(r, tx));
+        let mut d = Device {
+            out: s,
+            rx,
+            reader: Box::new(RequestReader::new()),
+            model: Model {
+                upload: Upload::new(),
+                bits: vec![0; LIMITS.bytes()],
+                size: None,
+            },
+            next_id: 1,
+            frames_ok: 0,
+            frames_bad: 0,
+            rx_bytes: 0,
+            faults: [0; 6],
+            resent: 0,
+        };
+        // A fresh connection: end whatever partial frame a previous client left.
+        let none = d.write(&[0]);
+        assert!(none.is_empty());
+        d
+    }
+
+    fn id(&mut self) -> u32 {
+        self.next_id += 1;
+        self.next_id
+    }
+
+    /// Write `bytes` and return the replies they call for, in order, from the model.
+    fn write(&mut self, bytes: &[u8]) -> Vec<Want> {
+        self.out.write_all(bytes).expect("write to the device");
+        self.rx_bytes += bytes.len() as u64;
+        let mut want = Vec::new();
+        for &b in bytes {
+            let Some(f) = self.reader.push(b).into_frame(MAX_REQUEST_WIRE) else {
+                continue;
+            };
+            match f.and_then(decode_request) {
+                Err(e) => {
+                    self.frames_bad += 1;
+                    want.push(Want::Exact(e.id(), Response::Error(e.reply())));
+                }
+                Ok((id, req)) => {
+                    self.frames_ok += 1;
+                    want.push(self.model.apply(id, &req));
+                }
+            }
+        }
+        want
+    }
+
+    fn recv(&mut self) -> (u32, Response) {
+        match self.rx.recv_timeout(REPLY_TIMEOUT) {
+            Ok(Ok(r)) => r,
+            Ok(Err(e)) => panic!("{e}"),
+            Err(e) => panic!("no reply within {REPLY_TIMEOUT:?}: {e}"),
+        }
+    }
+
+    /// Read the replies `want` predicts and check the exact ones; returns them all.
+    fn expect(&mut self, want: &[Want]) -> Vec<(u32, Response)> {
+        let mut got = Vec::with_capacity(want.len());
+        for w in want {
+            let r = self.recv();
+            match w {
+                Want::Exact(id, resp) => {
+                    assert_eq!((&r.0, &r.1), (id, resp), "reply vs the model")
+                }
+                Want::Stats(id) => {
+                    assert_eq!(r.0, *id);
+                    assert!(matches!(r.1, Response::Stats(_)), "{r:?}");
+                }
+                Want::Plan(id) => assert_eq!(r.0, *id),
+            }
+            got.push(r);
+        }
+        got
+    }
+
+    /// Send one request (whole) and read its replies.
+    fn call(&mut self, req: &Request<'_>) -> (u32, Response) {
+        let id = self.id();
+        let want = self.write(&frame(id, req));
+        assert_eq!(want.len(), 1, "{want:?}");
+        self.expect(&want).remove(0)
+    }
+
+    fn stats(&mut self) -> ohaca::protocol::StatsReply {
+        match self.call(&Request::Stats).1 {
+            Response::Stats(s) => s,
+            r => panic!("{r:?}"),
+        }
+    }
+
+    /// Damage `f` (a frame with its delimiter) at random; counts the kind.
+    fn damage(&mut self, f: &mut Vec<u8>, rng: &mut Rng) {
+        let k = rng.below(FAULTS.len());
+        self.faults[k] += 1;
+        let last = f.len() - 1;
+        let at = rng.below(last);
+        match k {
+            0 => {
+                f.remove(at);
+            }
+            1 => {
+                f.pop();
+            }
+            2 => f[at] ^= 1 << rng.below(8),
+            3 => f[at] = rng.next() as u8,
+            4 => {
+                let n = 1 + rng.below(8);
+                for _ in 0..n {
+                    f.insert(at, rng.next() as u8 | 1);
+                }
+            }
+            _ => {
+                f.truncate(at.max(1));
+                f.push(0);
+            }
+        }
+    }
+
+    /// Upload `code` (the map's packed bits or its run-length code) in chunks, `faulty` of the
+    /// chunk frames damaged on the way, until the device has all of it; returns the chunk frames
+    /// written.
+    fn upload(
+        &mut self,
+        map: &Map,
+        enc: Encoding,
+        code: &[u8],
+        rng: &mut Rng,
+        faulty: f64,
+        stop_after: Option<usize>,
+    ) -> usize {
+        let chunks: Vec<&[u8]> = code.chunks(MAX_CHUNK).collect();
+        let mut next = 0; // the first chunk not known to be acknowledged
+        let mut written = 0;
+        let mut stalled = 0;
+        while next < chunks.len() {
+            let end = (next + WINDOW).min(chunks.len());
+            let mut bytes = Vec::new();
+            let mut ids = Vec::new();
+            for (k, chunk) in chunks.iter().enumerate().take(end).skip(next) {
+                let id = self.id();
+                let req = chunk_request(map, enc, code.len(), k, chunk);
+                let mut f = frame(id, &req);
+                if rng.chance(faulty) {
+                    self.damage(&mut f, rng);
+                }
+                bytes.extend(f);
+                ids.push((id, k));
+            }
+            written += ids.len();
+            let want = self.write(&bytes);
+            let mut got = self.expect(&want);
+            let all_acked = |got: &[(u32, Response)]| {
+                ids.iter().all(|(id, _)| {
+                    got.iter()
+                        .any(|(i, r)| i == id && matches!(r, Response::Ack))
+                })
+            };
+            if !all_acked(&got) {
+                // A lost or refused chunk: end a partial frame (whose reply then comes: a frame
+                // that lost only its delimiter is whole again), then go back.
+                self.resent += 1;
+                let want = self.write(&[0]);
+                got.extend(self.expect(&want));
+            }
+            // A run-length code that overran the map closed the upload: nothing to redo.
+            if got
+                .iter()
+                .any(|(_, r)| matches!(r, Response::Error(e) if e.code == ErrorCode::BadRle))
+            {
+                return written;
+            }
+            // The chunks acknowledged in order from `next`: the device holds every byte before
+            // the first one that is not (a chunk is accepted only if it continues what arrived).
+            let acked = ids
+                .iter()
+                .take_while(|(id, _)| {
+                    got.iter()
+                        .any(|(i, r)| i == id && matches!(r, Response::Ack))
+                })
+                .count();
+            stalled = if acked == 0 { stalled + 1 } else { 0 };
+            assert!(
+                stalled < 50,
+                "no progress at chunk {next} of {}: {got:?}",
+                chunks.len()
+            );
+            next += acked;
+            if stop_after.is_some_and(|n| next >= n) {
+                return written;
+            }
+        }
+        written
+    }
+}
+
+fn frame(id: u32, req: &Request<'_>) -> Vec<u8> {
+    let mut buf = [0u8; MAX_REQUEST_WIRE];
+    let n = encode_request(id, req, &mut buf).expect("encode");
+    buf[..n].to_vec()
+}
+
+fn chunk_request<'a>(
+    map: &Map,
+    enc: Encoding,
+    total: usize,
+    k: usize,
+    chunk: &'a [u8],
+) -> Request<'a> {
+    let (width, height) = (map.width, map.height);
+    let (offset, total_len) = ((k * MAX_CHUNK) as u32, total as u32);
+    match enc {
+        Encoding::Raw => Request::SetMap {
+            width,
+            height,
+            offset,
+            total_len,
+            chunk,
+        },
+        Encoding::Rle => Request::SetMapRle {
+            width,
+            height,
+            offset,
+            total_len,
+            chunk,
+        },
+    }
+}
+
+fn code_of(map: &Map, enc: Encoding) -> Vec<u8> {
+    match enc {
+        Encoding::Raw => map.bits.clone(),
+        Encoding::Rle => RleEncoder::new(&map.bits, map.cells() as u32).collect(),
+    }
+}
+
+/// A free cell near `(x, y)` (searching right, then down).
+fn free_near(map: &Map, x: u16, y: u16) -> Point {
+    for dy in 0..map.height {
+        for dx in 0..map.width {
+            let (px, py) = ((x + dx) % map.width, (y + dy) % map.height);
+            if !map.is_blocked(Point::new(px, py)) {
+                return Point::new(px, py);
+            }
+        }
+    }
+    panic!("no free cell");
+}
+
+#[test]
+fn uploads_of_512x512_and_604x307_survive_drops_and_corruption() {
+    need_qemu!();
+    let rounds: usize = std::env::var("OHACA_SOAK_SCALE_ROUNDS")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(DEFAULT_ROUNDS);
+    let seed: u64 = std::env::var("OHACA_SOAK_SEED")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(DEFAULT_SEED);
+    let mut rng = Rng(seed);
+    let mut q = Qemu::tcp_with(twin_firmware());
+    let mut dev = Device::new(&q);
+    let t0 = Instant::now();
+    let new_york = Map::load(maps().join("large/NewYork_0_512.map")).expect("NewYork_0_512");
+    let depot = depot(seed);
+    let steps = 8191;
+    // Cheap plans: the point is the map, not the colony.
+    let params = Params {
+        ants: 8,
+        iterations: 4,
+        ..Params::default()
+    };
+    let (id, r) = dev.call(&Request::SetParams(params));
+    assert_eq!(r, Response::Ack, "{id}");
+    let (mut uploads, mut chunk_frames, mut broken, mut plans) = (0, 0, [0u32; 3], 0);
+    for round in 0..rounds {
+        for (name, map) in [("NewYork_0_512", &new_york), ("depot 604x307", &depot)] {
+            for enc in [Encoding::Raw, Encoding::Rle] {
+                let code = code_of(map, enc);
+                // A broken upload first (each kind once a round, in turn), then the real one.
+                let kind = (round + uploads) % 4;
+                match kind {
+                    0 => {
+                        // Abandoned part way: no map until it is redone.
+                        broken[0] += 1;
+                        let half = code.len().div_ceil(MAX_CHUNK) / 2;
+                        chunk_frames += dev.upload(map, enc, &code, &mut rng, 0.15, Some(half));
+                        let st = dev.stats();
+                        assert_eq!((st.map_width, st.map_height), (0, 0), "{st:?}");
+                        let plan = Request::Plan {
+                            start: Point::new(0, 0),
+                            goal: Point::new(1, 1),
+                            seed: None,
+                        };
+                        let (_, r) = dev.call(&plan);
+                        assert_eq!(r, Response::Error(ErrorReply::new(ErrorCode::NoMap)));
+                    }
+                    1 => {
+                        // A run-length code that overruns the map, in a frame with a good CRC.
+                        broken[1] += 1;
+                        let cells = map.cells() as u32;
+                        let bad: Vec<u8> = RleEncoder::new(&map.bits, cells)
+                            .chain([0x7f, 0x7f])
+                            .collect();
+                        chunk_frames += dev.upload(map, Encoding::Rle, &bad, &mut rng, 0.15, None);
+                        let st = dev.stats();
+                        assert_eq!((st.map_width, st.map_height), (0, 0), "{st:?}");
+                    }
+                    2 => {
+                        // An upload under way, then a restart with a wrong total_len: BadMap,
+                        // and the open upload carries on (the real upload below restarts it).
+                        broken[2] += 1;
+                        chunk_frames += dev.upload(map, enc, &code, &mut rng, 0.15, Some(3));
+                        let mut req = chunk_request(map, Encoding::Raw, 5, 0, &[1, 2, 3]);
+                        if let Request::SetMap { total_len, .. } = &mut req {
+                            *total_len = 5;
+                        }
+                        let (_, r) = dev.call(&req);
+                        assert!(
+                            matches!(r, Response::Error(e) if e.code == ErrorCode::BadMap),
+                            "{r:?}"
+                        );
+                    }
+                    _ => {}
+                }
+                let t = Instant::now();
+                chunk_frames += dev.upload(map, enc, &code, &mut rng, 0.15, None);
+                uploads += 1;
+                assert_eq!(dev.model.size, Some((map.width, map.height)));
+                assert_eq!(
+                    &dev.model.bits[..map.bits.len()],
+                    &map.bits[..],
+                    "the model's map is the map sent"
+                );
+                let st = dev.stats();
+                assert_eq!((st.map_width, st.map_height), (map.width, map.height));
+                let up = t.elapsed().as_secs_f64();
+                // A plan across the map: the host core's on the map meant, bit for bit.
+                let start = free_near(map, rng.below(64) as u16, rng.below(64) as u16);
+                let goal = free_near(
+                    map,
+                    map.width - 64 + rng.below(60) as u16,
+                    map.height - 64 + rng.below(60) as u16,
+                );
+                let seed = rng.next() % 1000;
+                let (_, r) = dev.call(&Request::Plan {
+                    start,
+                    goal,
+                    seed: Some(seed),
+                });
+                let core = core_plan_steps(map, start, goal, &Params { seed, ..params }, steps);
+                let outcome = match (r, core) {
+                    (Response::Path(p), Ok(c)) => {
+                        assert_core_path(name, &c, &p);
+                        format!("{} cells", p.raw_cells)
+                    }
+                    (Response::Error(e), Err(c)) => {
+                        assert_eq!(e, c, "{name}");
+                        format!("{e}")
+                    }
+                    (r, c) => panic!("{name}: device {r:?}, core {c:?}"),
+                };
+                plans += 1;
+                println!(
+                    "round {round} {name} {enc:?} (broken first: {}): {} B of code, upload \
+                     {up:.1} s; plan {start:?} -> {goal:?}: {outcome}",
+                    ["abandoned", "BadRle", "BadMap restart", "no"][kind],
+                    code.len()
+                );
+            }
+        }
+    }
+    let st = dev.stats();
+    assert_eq!(st.frames_ok, dev.frames_ok, "{st:?}");
+    assert_eq!(st.frames_bad, dev.frames_bad, "{st:?}");
+    assert_eq!(u64::from(st.rx_bytes), dev.rx_bytes, "{st:?}");
+    assert_eq!((st.rx_overruns, st.boots, st.queued), (0, 1, 0), "{st:?}");
+    assert!(q.is_running(), "QEMU exited: the firmware crashed");
+    let faults: Vec<String> = FAULTS
+        .iter()
+        .zip(dev.faults)
+        .map(|(n, c)| format!("{n} {c}"))
+        .collect();
+    println!(
+        "soak at scale (seed {seed:#x}, {rounds} rounds): {uploads} uploads and {plans} plans, \
+         broken on purpose {} abandoned / {} BadRle / {} BadMap restart; {chunk_frames} chunk \
+         frames, faults: {}; {} go-backs; device frames ok {} bad {}, {} bytes; stack peak {} B; \
+         {:.1} s",
+        broken[0],
+        broken[1],
+        broken[2],
+        faults.join(", "),
+        dev.resent,
+        st.frames_ok,
+        st.frames_bad,
+        st.rx_bytes,
+        st.stack_peak,
+        t0.elapsed().as_secs_f64()
+    );
+}
