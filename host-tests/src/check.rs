@@ -315,7 +315,9 @@ pub fn check_plan(
     };
     let early = patience > 0
         && (u32::from(its) == u32::from(streak_from) + 1 + u32::from(patience)
-            || refines && curve.len() != usize::from(its) && its > best_it + patience);
+            || refines
+                && curve.len() != usize::from(its)
+                && u32::from(its) > u32::from(best_it) + u32::from(patience));
     if its != p.iterations && !early {
         return Err(format!(
             "stopped after {its} of {} iterations (best at {best_it}, patience {patience})",
