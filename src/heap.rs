@@ -26,6 +26,7 @@ type Vecs = OwnedBuffers<
     Vec<u32>,
     Vec<u8>,
     Vec<Dir>,
+    Vec<Dir>,
     Vec<Point>,
     Vec<u32>,
     Vec<CurvePoint>,
@@ -36,6 +37,8 @@ type Vecs = OwnedBuffers<
 #[derive(Clone, Debug, Default)]
 pub struct HeapStorage {
     cells: usize,
+    /// No buffers for the iteration's best and worst paths ([`HeapStorage::replaying`]).
+    replay: bool,
     buffers: Vecs,
 }
 
@@ -104,7 +107,7 @@ impl HeapStorage {
     ) -> Result<Self, AllocError> {
         let mut s = HeapStorage::new(cells, iterations)?;
         let steps = steps.max(1);
-        for t in &mut s.buffers.tours {
+        for t in s.buffers.tours.iter_mut().chain(&mut s.buffers.kept) {
             t.truncate(steps);
         }
         s.buffers.points.truncate(steps.saturating_add(1));
@@ -121,6 +124,17 @@ impl HeapStorage {
             s.buffers.moves.clear();
         }
         Ok(s)
+    }
+
+    /// Drop the buffers of the iteration's best and worst paths, as a device's storage may
+    /// ([`crate::Storage`]'s `KEPT` = 0): runs walk those two ants again instead, with the same
+    /// paths bit for bit.
+    pub fn replaying(mut self) -> Self {
+        self.replay = true;
+        for t in &mut self.buffers.kept {
+            *t = Vec::new();
+        }
+        self
     }
 
     /// Grow the buffers (never shrink) to hold at least `cells` cells and `iterations` curve
@@ -146,6 +160,11 @@ impl HeapStorage {
         let steps = cells.max(1);
         for t in &mut b.tours {
             grow(t, steps, 0).map_err(e)?;
+        }
+        if !self.replay {
+            for t in &mut b.kept {
+                grow(t, steps, 0).map_err(e)?;
+            }
         }
         grow(&mut b.points, steps.saturating_add(1), Point::default()).map_err(e)?;
         grow(&mut b.links, cells.max(GUIDE_BLOCKS), 0).map_err(e)?;
@@ -181,7 +200,8 @@ impl HeapStorage {
         for t in b.tau.iter_mut().chain(b.delta.iter_mut()) {
             *t = core::array::from_fn(|_| (next() % 1000) as f32 / 7.0);
         }
-        for byte in b.moves.iter_mut().chain(b.tours.iter_mut().flatten()) {
+        let tours = b.tours.iter_mut().chain(&mut b.kept).flatten();
+        for byte in b.moves.iter_mut().chain(tours) {
             *byte = next() as u8;
         }
         for p in &mut b.points {

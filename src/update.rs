@@ -77,11 +77,22 @@ pub fn wolves(
 ) {
     let (best_tour, l_best, b) = best;
     let (worst_tour, l_worst, w) = worst;
-    if l_worst <= l_best || l_best <= 0.0 {
-        return;
+    if let Some((reward, punish)) = wolves_amounts(q, (l_best, b), (l_worst, w)) {
+        deposit(delta, grid, start, best_tour, reward);
+        deposit(delta, grid, start, worst_tour, punish);
     }
-    deposit(delta, grid, start, best_tour, b as f32 * q / l_best);
-    deposit(delta, grid, start, worst_tour, -(w as f32 * q / l_worst));
+}
+
+/// The amounts [`wolves`] deposits, in its order: `b * q / l_best` on the best path, then
+/// `-(w * q / l_worst)` on the worst; `None` when `l_worst <= l_best` (or `l_best <= 0`). A
+/// caller that has the two paths one at a time (a workspace that replays them instead of keeping
+/// them) deposits these itself, in this order, and gets [`wolves`]'s increments bit for bit.
+pub fn wolves_amounts(q: f32, best: (f32, u32), worst: (f32, u32)) -> Option<(f32, f32)> {
+    let ((l_best, b), (l_worst, w)) = (best, worst);
+    if l_worst <= l_best || l_best <= 0.0 {
+        return None;
+    }
+    Some((b as f32 * q / l_best, -(w as f32 * q / l_worst)))
 }
 
 #[cfg(test)]

@@ -34,6 +34,7 @@ fn main() {
     let (mut start, mut goal) = (Point::new(184, 0), Point::new(8, 254));
     let mut seeds = 1u64;
     let mut params = Params::default();
+    let mut steps = STEPS;
     let mut it = args.iter();
     while let Some(flag) = it.next() {
         let v = it.next().expect("every option takes a value");
@@ -43,12 +44,13 @@ fn main() {
             "--goal" => goal = point(v),
             "--seeds" => seeds = v.parse().expect("--seeds N"),
             "--patience" => params.patience = v.parse().expect("--patience P"),
+            "--steps" => steps = v.parse().expect("--steps N"),
             _ => panic!("unknown option {flag}"),
         }
     }
     let m = Map::load(&map).unwrap_or_else(|e| panic!("{e}"));
     let grid = m.grid();
-    let mut st = HeapStorage::with_steps(m.cells(), STEPS, m.cells() <= 1024, 1024)
+    let mut st = HeapStorage::with_steps(m.cells(), steps, m.cells() <= 1024, 1024)
         .unwrap_or_else(|e| panic!("{e}"));
     for seed in 1..=seeds {
         let p = Params { seed, ..params };

@@ -1,8 +1,9 @@
 //! Where the map buffer and the planner's buffers live in RAM, per board, and the one function
 //! that hands them out at boot: [`take`].
 //!
-//! - **STM32F411 and the default QEMU board** (maps of up to 65,536 cells): the map (8 KiB) and
-//!   one `ohaca::planner::Storage` static, both zero-initialised in `.bss`.
+//! - **STM32F411 and the default QEMU board** (maps of up to 65,536 cells, paths of up to 2,047
+//!   steps): the map (8 KiB) and one `ohaca::planner::Storage` static, both zero-initialised in
+//!   `.bss`.
 //! - **STM32H743 and its QEMU twin** (`twin-h743`; maps of up to 2,097,152 cells, paths of up
 //!   to 8,191 steps): the map (256 KiB) and the planner's two per-cell bit sets (256 KiB each)
 //!   do not fit one RAM region (the largest, the AXI SRAM, has 512 KiB), so every buffer is a
@@ -38,14 +39,21 @@ mod layout {
     use crate::firmware::state::{MAP_BYTES, PLAN_CELLS, PLAN_STEPS};
 
     /// Two bits a map cell (tabu list, pruned cells), the pheromone budget, the coarse route,
-    /// four ant paths of [`PLAN_STEPS`] steps, links, and the move table for maps of up to 1024
-    /// cells (`ohaca::planner::workspace` lists what each holds).
+    /// two ant paths of [`PLAN_STEPS`] steps (the ant's, the run's best: the iteration's best and
+    /// worst are walked again at the update, which is what lets 2,047-step paths fit), their
+    /// cells, links (4,096: tightening's hash table of `2 * (PLAN_STEPS + 1)` slots, and the
+    /// coarse route's heap), the move table for maps of up to 1024 cells, and no convergence
+    /// curve (the device never reports one). `ohaca::planner::workspace` lists what each holds.
     pub type PlanStorage = ohaca::planner::Storage<
         { ohaca::bitmap::words(PLAN_CELLS) },
         { PLAN_STEPS + 1 },
         4096,
         1024,
+        0,
+        0,
     >;
+    // Tightening's hash table holds every path the device keeps.
+    const _: () = assert!(2 * (PLAN_STEPS + 1) <= 4096);
 
     /// Bytes of the planner's storage.
     pub const BYTES: usize = PlanStorage::BYTES;

@@ -177,16 +177,22 @@ fn start_equals_goal() {
 fn storage_size_matches_the_formula() {
     assert_eq!(core::mem::size_of::<CurvePoint>(), 16);
     type Device = Storage<{ crate::bitmap::words(65536) }, 1024, 4096, 1024>;
-    // Pheromone and increments, two bit sets, the move table, four tours, points, links, curve,
-    // the coarse route.
+    type Kept = Storage<{ crate::bitmap::words(65536) }, 1024, 4096, 1024, 128, 1024>;
+    // Pheromone and increments, two bit sets, the move table, two tours (the iteration's best
+    // and worst are walked again), points, links, curve, the coarse route.
     let want =
-        2 * 16 * 1024 + 2 * 8192 + 1024 + 4 * 1024 + 4 * 1024 + 4 * 4096 + 16 * 128 + 4 * 4096;
+        2 * 16 * 1024 + 2 * 8192 + 1024 + 2 * 1024 + 4 * 1024 + 4 * 4096 + 16 * 128 + 4 * 4096;
     assert_eq!(Device::BYTES, want);
-    // `Workspace::bytes` for the same capacities (2047 steps) gives the same but for the fourth
-    // byte of each tour the storage rounds up to.
+    assert_eq!(Kept::BYTES, want + 2 * 1024);
+    // `Workspace::bytes` for the same capacities (1023 steps) gives the same but for the last
+    // byte of each tour the storage rounds up to, and the links beyond the 2048 it needs.
     assert_eq!(
         Workspace::bytes(65536, 1023, false, 128) + 1024 + 4 * (4096 - 2048),
-        want - 4
+        want + 2 * 1024 - 4
+    );
+    assert_eq!(
+        Workspace::bytes_walking_again(65536, 1023, false, 128) + 1024 + 4 * (4096 - 2048),
+        want - 2
     );
 }
 
@@ -719,4 +725,106 @@ fn a_refining_run_counts_gains_of_one_percent_or_less_as_stale() {
         );
     }
     assert!(small_gains > 0, "no seed had a gain of 1 % or less");
+}
+
+/// What a run leaves that could tell two workspaces apart: the path, its lengths by their bits,
+/// the iterations, the moves, the dropped and abandoned ants and the curve (its means follow the
+/// pheromone of every iteration).
+type Fingerprint = (Vec<Dir>, Vec<Point>, u32, u32, u16, u16, u64, Vec<[u32; 3]>);
+
+fn fingerprint(
+    g: &Grid<'_>,
+    s: Point,
+    goal: Point,
+    p: &Params,
+    st: &mut crate::heap::HeapStorage,
+) -> Result<Fingerprint, Error> {
+    let plan = plan(g, s, goal, p, st.workspace())?;
+    Ok((
+        plan.directions().to_vec(),
+        plan.waypoints().to_vec(),
+        plan.raw_length.to_bits(),
+        plan.length.to_bits(),
+        plan.iterations,
+        plan.best_iteration,
+        plan.moves,
+        plan.curve()
+            .iter()
+            .map(|c| [c.best.to_bits(), c.mean.to_bits(), u32::from(c.arrived)])
+            .collect(),
+    ))
+}
+
+#[test]
+fn walking_the_iterations_best_and_worst_again_plans_what_keeping_them_does() {
+    use crate::ant::DeadEnd;
+    use crate::heap::HeapStorage;
+    // Every algorithm (with and without the wolves rule), both dead-end rules, with and without
+    // tightening, short and full runs, on maps with and without blocks and the coarse route,
+    // with the local search's move budget (maze) and with ants dropped for their length.
+    let mut cases: Vec<(Vec<u8>, u16, u16, Point, Point, Params, usize)> = Vec::new();
+    for seed in 1..=3u64 {
+        let (b, w, h) = large_map(seed);
+        for algorithm in [
+            Algorithm::Aca,
+            Algorithm::Paca,
+            Algorithm::Haca,
+            Algorithm::Ohaca,
+        ] {
+            for (dead_end, tighten, patience) in [
+                (DeadEnd::Backtrack, true, 10),
+                (DeadEnd::Die, false, 0),
+                (DeadEnd::Backtrack, false, 0),
+            ] {
+                let p = Params {
+                    seed,
+                    algorithm,
+                    dead_end,
+                    tighten,
+                    patience,
+                    iterations: 12,
+                    ants: 20,
+                    ..Params::default()
+                };
+                let ends = (Point::new(0, 0), Point::new(63, 47));
+                cases.push((b.clone(), w, h, ends.0, ends.1, p, usize::MAX));
+            }
+        }
+        let (b, w, h) = grid(&ROWS);
+        let p = Params {
+            seed,
+            patience: 0,
+            iterations: 20,
+            ..Params::default()
+        };
+        cases.push((b, w, h, Point::new(0, 0), Point::new(7, 5), p, usize::MAX));
+    }
+    let (b, w, h) = maze_10();
+    for seed in 1..=2 {
+        let p = Params {
+            seed,
+            ..Params::default()
+        };
+        let ends = (Point::new(91, 82), Point::new(90, 31));
+        cases.push((b.clone(), w, h, ends.0, ends.1, p, usize::MAX));
+        // Paths of at most 480 steps: most ants are dropped, some arrive (optimum 454 cells).
+        cases.push((b.clone(), w, h, ends.0, ends.1, p, 480));
+    }
+    let mut wolves_seen = 0;
+    for (b, w, h, s, goal, p, steps) in &cases {
+        let g = Grid::new(*w, *h, b).unwrap();
+        let iterations = usize::from(p.iterations);
+        let make = || {
+            if *steps == usize::MAX {
+                HeapStorage::new(g.cells(), iterations).unwrap()
+            } else {
+                HeapStorage::with_steps(g.cells(), *steps, false, iterations).unwrap()
+            }
+        };
+        let kept = fingerprint(&g, *s, *goal, p, &mut make());
+        let walked = fingerprint(&g, *s, *goal, p, &mut make().replaying());
+        assert_eq!(kept, walked, "{p:?}, {steps} steps");
+        wolves_seen += usize::from(p.algorithm.wolves() && kept.is_ok());
+    }
+    assert!(wolves_seen >= 20, "{wolves_seen}");
 }

@@ -60,11 +60,14 @@ pub struct Capacity {
 }
 
 /// The STM32F411's capacity (128 KiB of RAM), and the default QEMU board's, which copies it so
-/// that what QEMU proves holds on the chip: 65,536 cells (8 KiB of map), paths of 1,023 steps.
+/// that what QEMU proves holds on the chip: 65,536 cells (8 KiB of map), paths of 2,047 steps
+/// (102 m at 5 cm; `maps/large/maze-128-128-2`'s longest scenario has 1,379). A step costs 6 bytes
+/// here (two tours of a byte a step, the iteration's best and worst being walked again, and a
+/// 4-byte path cell; tightening's links are the 4,096 words the coarse route needs anyway).
 #[cfg(not(any(feature = "twin-h743", feature = "board-stm32h743")))]
 pub const SMALL: Capacity = Capacity {
     cells: 65_536,
-    steps: 1023,
+    steps: 2047,
 };
 
 /// The STM32H743's capacity, and its QEMU twin's: 2,097,152 cells (2048 x 1024, or Nav2's

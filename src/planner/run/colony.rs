@@ -5,11 +5,12 @@
 
 use crate::ant::{Ant, DeadEnd, Lost, Walk};
 use crate::geometry::steps_length;
-use crate::grid::{Dir, Moves};
+use crate::grid::{Dir, Moves, Point};
 use crate::pheromone::Table;
+use crate::rng::Xoshiro128pp;
 use crate::route::Route;
 use crate::tighten::tighten;
-use crate::update::{deposit, wolves};
+use crate::update::{deposit, wolves_amounts};
 
 use crate::planner::plan::CurvePoint;
 use crate::planner::workspace::Workspace;
@@ -73,19 +74,58 @@ impl Best {
     }
 }
 
+/// How to walk one ant of an iteration again: the generator's state before its walk and its move
+/// budget. The pheromone, the pruning marks and the route do not change during an iteration (the
+/// ants deposit into the increments), so the same state gives the same walk, bit for bit.
+#[derive(Clone, Debug)]
+pub(super) struct Replay {
+    rng: Xoshiro128pp,
+    budget: u32,
+}
+
 /// What the ants of one iteration found: the shortest and the longest path (with how many ants
 /// took a path of that length) and the sum of the lengths, for the update and the record.
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Debug, Default)]
 pub(super) struct Iteration {
     best: Option<(Best, u32)>,
     worst: Option<(Best, u32)>,
+    /// The best path's ant, on a workspace without `iter_best` (walked again at the update).
+    best_replay: Option<Replay>,
+    /// The worst path's ant, on a workspace without `iter_worst`.
+    worst_replay: Option<Replay>,
     sum: f32,
     arrived: u32,
 }
 
+/// One ant's walk, tightened ([`tighten`]) when `tight` and the walk may have a shortcut: the path
+/// the ant deposits on, in `tour`.
+#[allow(clippy::too_many_arguments)]
+fn walk_tightened(
+    ant: &Ant<'_, '_, '_>,
+    tight: bool,
+    rng: &mut Xoshiro128pp,
+    tabu: &mut [u32],
+    tour: &mut [Dir],
+    points: &mut [Point],
+    links: &mut [u32],
+) -> Result<Walk, Lost> {
+    let walk = ant.walk(rng, tabu, tour)?;
+    Ok(if tight && walk.may_tighten {
+        tighten(ant.moves, ant.start, walk, tour, points, links, tabu)
+    } else {
+        walk
+    })
+}
+
 impl Run<'_, '_> {
     /// Every ant walks start -> goal on `tau(t)` and deposits `Q / L` into the increment table;
-    /// the iteration's best and worst paths are kept for the wolves rule.
+    /// then the wolves rule rewards the iteration's best path and punishes its worst (also into
+    /// the increments), and a best path shorter than the run's becomes the run's (`best`).
+    ///
+    /// The best and worst paths are copied into `iter_best` and `iter_worst` as the ants find
+    /// them, or, on a workspace without those buffers (empty), walked again from their ants'
+    /// [`Replay`] once every ant has walked: two more walks an iteration for two tours fewer,
+    /// the same increments and the same best path bit for bit (`docs/ALGORITHM.md`, "Memory").
     pub(super) fn walk_ants(&mut self, mut on_tour: impl FnMut(&[Dir])) -> Iteration {
         let p = self.params;
         let Workspace {
@@ -97,6 +137,7 @@ impl Run<'_, '_> {
             tour,
             iter_best,
             iter_worst,
+            best,
             points,
             links,
             guide,
@@ -124,6 +165,7 @@ impl Run<'_, '_> {
             route: self.routed.then_some(&route),
             budget: u32::MAX,
         };
+        let (keep_best, keep_worst) = (!iter_best.is_empty(), !iter_worst.is_empty());
         let mut it = Iteration::default();
         // The move budget (see `MOVE_BUDGET`): from the cheapest walk that arrived in this run.
         let bounded = self.iteration > 0 && self.refines && p.dead_end == DeadEnd::Backtrack;
@@ -131,31 +173,32 @@ impl Run<'_, '_> {
             if let (true, Some(c)) = (bounded, self.cheapest) {
                 ant.budget = c.saturating_mul(MOVE_BUDGET);
             }
-            let walk = match ant.walk(&mut self.rng, tabu, tour) {
-                Ok(w) => w,
-                Err(Lost::Exhausted) => {
-                    // Only possible when the flood fill could not decide: now it is decided.
-                    self.no_path = true;
-                    break;
-                }
-                Err(Lost::Died) => continue,
-                Err(Lost::Budget) => {
-                    self.moves = self.moves.saturating_add(u64::from(ant.budget));
-                    self.abandoned = self.abandoned.saturating_add(1);
-                    continue;
-                }
-                Err(Lost::Overflow) => {
-                    self.dropped = self.dropped.saturating_add(1);
-                    continue;
-                }
-            };
+            let before = (!keep_best || !keep_worst).then(|| Replay {
+                rng: self.rng.clone(),
+                budget: ant.budget,
+            });
+            let walk =
+                match walk_tightened(&ant, p.tighten, &mut self.rng, tabu, tour, points, links) {
+                    Ok(w) => w,
+                    Err(Lost::Exhausted) => {
+                        // Only possible when the flood fill could not decide: now it is decided.
+                        self.no_path = true;
+                        break;
+                    }
+                    Err(Lost::Died) => continue,
+                    Err(Lost::Budget) => {
+                        self.moves = self.moves.saturating_add(u64::from(ant.budget));
+                        self.abandoned = self.abandoned.saturating_add(1);
+                        continue;
+                    }
+                    Err(Lost::Overflow) => {
+                        self.dropped = self.dropped.saturating_add(1);
+                        continue;
+                    }
+                };
+            // Tightening keeps the walk's moves.
             self.moves = self.moves.saturating_add(u64::from(walk.moves));
             self.cheapest = Some(self.cheapest.map_or(walk.moves, |c| c.min(walk.moves)));
-            let walk = if p.tighten && walk.may_tighten {
-                tighten(&moves, self.start, walk, tour, points, links, tabu)
-            } else {
-                walk
-            };
             let Some(path) = tour.get(..walk.steps) else {
                 continue;
             };
@@ -169,7 +212,11 @@ impl Run<'_, '_> {
                 Some((cur, n)) if cur.same_length(&b) => *n = n.saturating_add(1),
                 Some((cur, _)) if len >= cur.length() => {}
                 _ => {
-                    copy_tour(iter_best, path);
+                    if keep_best {
+                        copy_tour(iter_best, path);
+                    } else {
+                        it.best_replay.clone_from(&before);
+                    }
                     it.best = Some((b, 1));
                 }
             }
@@ -177,34 +224,84 @@ impl Run<'_, '_> {
                 Some((cur, n)) if cur.same_length(&b) => *n = n.saturating_add(1),
                 Some((cur, _)) if len <= cur.length() => {}
                 _ => {
-                    copy_tour(iter_worst, path);
+                    if keep_worst {
+                        copy_tour(iter_worst, path);
+                    } else {
+                        it.worst_replay.clone_from(&before);
+                    }
                     it.worst = Some((b, 1));
                 }
+            }
+        }
+        // The iteration's best path becomes the run's when it is shorter (see `record`).
+        let new_best = it
+            .best
+            .map(|(b, _)| b)
+            .filter(|b| self.best.is_none_or(|g| b.length() < g.length()));
+        // Walk the ant of `r` again into `buf`: the path it deposited on, `steps` long.
+        let mut again = |r: &Option<Replay>, steps: usize, buf: &mut [Dir]| -> bool {
+            let Some(r) = r else { return false };
+            ant.budget = r.budget;
+            let mut rng = r.rng.clone();
+            matches!(
+                walk_tightened(&ant, p.tighten, &mut rng, tabu, buf, points, links),
+                Ok(w) if w.steps == steps
+            )
+        };
+        let mut placed = false;
+        let wolves = match (p.algorithm.wolves(), it.best, it.worst) {
+            (true, Some((b, nb)), Some((w, nw))) => {
+                wolves_amounts(p.q, (b.length(), nb), (w.length(), nw)).map(|a| (b, w, a))
+            }
+            _ => None,
+        };
+        if let Some((b, w, (reward, punish))) = wolves {
+            // `update::wolves`'s two deposits, in its order, each path from where it is.
+            let bt = if keep_best {
+                iter_best.get(..b.steps)
+            } else {
+                // A new run best is walked straight into `best`, where `record` wants it.
+                placed = new_best.is_some();
+                let buf: &mut [Dir] = if placed { best } else { tour };
+                if again(&it.best_replay, b.steps, buf) {
+                    buf.get(..b.steps)
+                } else {
+                    placed = false;
+                    None
+                }
+            };
+            if let Some(bt) = bt {
+                deposit(&mut delta, self.grid, self.start, bt, reward);
+            }
+            let wt = if keep_worst {
+                iter_worst.get(..w.steps)
+            } else if again(&it.worst_replay, w.steps, tour) {
+                tour.get(..w.steps)
+            } else {
+                None
+            };
+            if let Some(wt) = wt {
+                deposit(&mut delta, self.grid, self.start, wt, punish);
+            }
+        }
+        if let (Some(b), false) = (new_best, placed) {
+            if keep_best {
+                if let Some(src) = iter_best.get(..b.steps) {
+                    copy_tour(best, src);
+                }
+            } else {
+                again(&it.best_replay, b.steps, best);
             }
         }
         it
     }
 
-    /// The wolves rule (HACA, OHACA), then `tau = clamp((1 - rho) tau + delta)`.
-    pub(super) fn update(&mut self, it: &Iteration) {
+    /// `tau = clamp((1 - rho) tau + delta)` (the wolves terms are in `delta` already).
+    pub(super) fn update(&mut self) {
         let p = self.params;
         let ws = &mut self.ws;
         let mut tau = Table::new(self.blocks, ws.tau);
         let mut delta = Table::new(self.blocks, ws.delta);
-        if let (true, Some((b, nb)), Some((w, nw))) = (p.algorithm.wolves(), it.best, it.worst) {
-            if let (Some(bt), Some(wt)) =
-                (ws.iter_best.get(..b.steps), ws.iter_worst.get(..w.steps))
-            {
-                wolves(
-                    &mut delta,
-                    self.grid,
-                    self.start,
-                    p.q,
-                    (bt, b.length(), nb),
-                    (wt, w.length(), nw),
-                );
-            }
-        }
         tau.evaporate_and_merge(&mut delta, p.rho, p.tau_min, p.tau_max);
     }
 
@@ -218,9 +315,7 @@ impl Run<'_, '_> {
         // In a run that refines, only a gain of more than `REFINE_GAIN` ends a stale streak.
         let significant = |b: &Best, mark: f32| !self.refines || b.length() < mark * REFINE_GAIN;
         if let Some(b) = improved {
-            if let Some(src) = self.ws.iter_best.get(..b.steps) {
-                copy_tour(self.ws.best, src);
-            }
+            // Its path is in `best` already (`walk_ants`).
             self.best = Some(b);
             self.best_iteration = self.iteration;
             if self.mark.is_none_or(|m| significant(&b, m)) {

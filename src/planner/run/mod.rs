@@ -344,7 +344,7 @@ impl<'g, 'a> Run<'g, 'a> {
             return false;
         }
         let it = self.walk_ants(on_tour);
-        self.update(&it);
+        self.update();
         self.record(&it);
         !self.done
     }
