@@ -90,7 +90,8 @@ pub struct Ant<'g, 't, 'h> {
     pub alpha: f32,
     /// Dead-end behaviour.
     pub dead_end: DeadEnd,
-    /// Cells no ant enters ([`crate::prune`]); every walk's tabu list starts as this set.
+    /// Cells no ant enters ([`crate::prune`]); every walk's tabu list starts as this set. Empty:
+    /// none (a workspace without pruning marks).
     pub dead: &'t [u32],
     /// Sub-goals of the potential field on large maps ([`crate::route`]); `None`: the goal.
     pub route: Option<&'t Route<'t>>,
@@ -143,7 +144,11 @@ impl Ant<'_, '_, '_> {
         pow: impl Fn(f32) -> f32,
     ) -> Result<Walk, Lost> {
         let grid = self.moves.grid();
-        bitmap::copy(tabu, self.dead, grid.cells());
+        if self.dead.is_empty() {
+            bitmap::clear(tabu, grid.cells());
+        } else {
+            bitmap::copy(tabu, self.dead, grid.cells());
+        }
         let offsets = grid.offsets();
         let blocks = self.tau.blocks();
         let tau = self.tau.flat();
@@ -201,7 +206,7 @@ impl Ant<'_, '_, '_> {
                 m &= m.wrapping_sub(1);
                 let ni = ci.wrapping_add_signed(offsets.get(di).copied().unwrap_or(0));
                 // At most 8: one per bit of the mask.
-                seen = seen.wrapping_add(u32::from(!bitmap::get(self.dead, ni)));
+                seen = seen.wrapping_add(u32::from(!bitmap::marked(self.dead, ni)));
             }
             let mut mask = allowed & !tabu_moves;
             let edges = blocks.edges(cur);
@@ -266,7 +271,7 @@ impl Ant<'_, '_, '_> {
                 mask &= mask.wrapping_sub(1);
                 let ni = goal.wrapping_add_signed(offsets.get(di).copied().unwrap_or(0));
                 // At most 8, one per bit of the mask.
-                let visited = bitmap::get(tabu, ni) && !bitmap::get(self.dead, ni);
+                let visited = bitmap::get(tabu, ni) && !bitmap::marked(self.dead, ni);
                 seen = seen.wrapping_add(u32::from(visited));
             }
             may_tighten = seen > 1;

@@ -20,6 +20,13 @@ pub fn get(bits: &[u32], i: usize) -> bool {
     }
 }
 
+/// Whether cell `i` is in the optional set `bits`: an empty set has no cells (where [`get`]
+/// reads every cell beyond a set as in it). For the pruning marks, which a workspace may lack.
+#[inline]
+pub fn marked(bits: &[u32], i: usize) -> bool {
+    !bits.is_empty() && get(bits, i)
+}
+
 /// Add cell `i` to the set.
 #[inline]
 pub fn set(bits: &mut [u32], i: usize) {

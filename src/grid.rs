@@ -21,9 +21,24 @@ const _: () = assert!(
     "cell indices need a usize of at least 32 bits"
 );
 
-/// A cell coordinate. `x` = column, `y` = row from the top.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Default)]
+/// A cell coordinate. `x` = column, `y` = row from the top. Four bytes, no padding
+/// (`bytemuck::Pod`: a compact workspace carves its path cells out of an arena of words,
+/// `crate::planner::arena`).
+#[derive(
+    Clone,
+    Copy,
+    Debug,
+    PartialEq,
+    Eq,
+    Hash,
+    PartialOrd,
+    Ord,
+    Default,
+    bytemuck::Pod,
+    bytemuck::Zeroable,
+)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[repr(C)]
 pub struct Point {
     /// Column, 0 = leftmost.
     pub x: u16,

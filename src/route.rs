@@ -104,7 +104,7 @@ pub fn blocks(width: u16, height: u16) -> Blocks {
 }
 
 /// Build the route to `goal`: links, distances and next blocks, into `words` (one per block of
-/// `blocks`). `dead` marks pruned cells; `heap` is scratch of one word per block. Returns false
+/// `blocks`). `dead` marks pruned cells (empty: none); `heap` is scratch of one word per block. Returns false
 /// (and no route: every ant pulled to the goal) if a buffer is too short.
 pub fn build(
     moves: &Moves<'_>,
@@ -237,7 +237,7 @@ fn block_links(moves: &Moves<'_>, blocks: Blocks, dead: &[u32], bx: u16, by: u16
             let xs = x as u16; // <= w - 1
             let p = Point::new(xs, y);
             let ci = grid.index(p);
-            if !crate::bitmap::get(dead, ci) {
+            if !crate::bitmap::marked(dead, ci) {
                 let mut leaving = 0u8;
                 if xs & last == 0 {
                     leaving |= 0x38;
@@ -256,7 +256,7 @@ fn block_links(moves: &Moves<'_>, blocks: Blocks, dead: &[u32], bx: u16, by: u16
                     let d = m.trailing_zeros() as usize & 7;
                     m &= m.wrapping_sub(1);
                     let ni = ci.wrapping_add_signed(offsets.get(d).copied().unwrap_or(0));
-                    if crate::bitmap::get(dead, ni) {
+                    if crate::bitmap::marked(dead, ni) {
                         continue;
                     }
                     let q = crate::grid::neighbour(p, d as Dir);
@@ -288,7 +288,7 @@ fn links(moves: &Moves<'_>, blocks: Blocks, dead: &[u32], words: &mut [u32]) {
         while x < w {
             let p = Point::new(x, y);
             let ci = grid.index(p);
-            if !crate::bitmap::get(dead, ci) {
+            if !crate::bitmap::marked(dead, ci) {
                 // Only the moves that leave the block: across its left, right, top or bottom side.
                 let mut leaving = 0u8;
                 if x & last == 0 {
@@ -309,7 +309,7 @@ fn links(moves: &Moves<'_>, blocks: Blocks, dead: &[u32], words: &mut [u32]) {
                     let d = m.trailing_zeros() as usize & 7;
                     m &= m.wrapping_sub(1);
                     let ni = ci.wrapping_add_signed(offsets.get(d).copied().unwrap_or(0));
-                    if crate::bitmap::get(dead, ni) {
+                    if crate::bitmap::marked(dead, ni) {
                         continue;
                     }
                     let q = crate::grid::neighbour(p, d as Dir);

@@ -21,8 +21,9 @@ use crate::grid::{is_diagonal, neighbour, opposite, Dir, Moves, Point};
 ///
 /// `cells` is scratch of at least `steps + 1` points. `pos` finds a cell's position on the path:
 /// with one entry per map cell it is indexed by cell; shorter, it is an open-addressing hash
-/// table over the path's cells, which needs a power of two of at least twice the path's cells
-/// (a longer path is returned untightened). Both give the same result.
+/// table over the path's cells, which needs a power of two of at least twice the path's cells as
+/// slots, two 16-bit slots a word for paths of fewer than 65,535 cells (a longer path is returned
+/// untightened). Both give the same result.
 ///
 /// `visited` is the walk's tabu set (every cell of the path is in it): a neighbour outside it is
 /// not on the path and is not looked up. An empty set looks up every neighbour; same result.
@@ -151,8 +152,12 @@ pub fn tighten(
 /// Cell -> position on a path: a per-cell array, or a hash table over the path's cells.
 struct PathIndex<'a> {
     slots: &'a mut [u32],
-    /// `Some(bits)`: hash table of `2^bits` slots holding `position + 1` (0 = empty).
+    /// `Some(bits)`: hash table of `2^bits` slots holding `position + 1` (0 = empty), two 16-bit
+    /// slots a word (paths of fewer than 65,535 cells) or one 32-bit slot a word.
     hash: Option<u32>,
+    /// The hash table's slots are 16-bit halves of the words (slot `k`: word `k / 2`, the low
+    /// half for even `k`).
+    half: bool,
 }
 
 impl<'a> PathIndex<'a> {
@@ -161,16 +166,57 @@ impl<'a> PathIndex<'a> {
             return Some(PathIndex {
                 slots: pos,
                 hash: None,
+                half: false,
             });
         }
-        // The smallest power of two of at least 2n slots (load factor <= 1/2).
+        // The smallest power of two of at least 2n slots (load factor <= 1/2); positions + 1
+        // below 2^16 fit a half word, so the same words hold twice the slots.
         let want = n.checked_mul(2)?.checked_next_power_of_two()?;
-        let slots = pos.get_mut(..want)?;
+        let half = n < usize::from(u16::MAX);
+        let slots = pos.get_mut(..if half { want.div_ceil(2) } else { want })?;
         slots.fill(0);
         Some(PathIndex {
             slots,
             hash: Some(want.trailing_zeros()),
+            half,
         })
+    }
+
+    /// Slots of the hash table.
+    #[inline]
+    fn len(&self) -> usize {
+        if self.half {
+            self.slots.len().wrapping_mul(2) // a slice of words: far below usize::MAX / 2
+        } else {
+            self.slots.len()
+        }
+    }
+
+    /// Hash slot `k` (`None` beyond the table).
+    #[inline]
+    fn slot(&self, k: usize) -> Option<u32> {
+        if self.half {
+            let w = *self.slots.get(k >> 1)?;
+            Some(if k & 1 == 0 { w & 0xFFFF } else { w >> 16 })
+        } else {
+            self.slots.get(k).copied()
+        }
+    }
+
+    /// Write `v` (below 2^16 in half slots) into hash slot `k`.
+    #[inline]
+    fn set_slot(&mut self, k: usize, v: u32) {
+        if self.half {
+            if let Some(w) = self.slots.get_mut(k >> 1) {
+                *w = if k & 1 == 0 {
+                    (*w & 0xFFFF_0000) | (v & 0xFFFF)
+                } else {
+                    (*w & 0xFFFF) | (v << 16)
+                };
+            }
+        } else if let Some(s) = self.slots.get_mut(k) {
+            *s = v;
+        }
     }
 
     #[inline]
@@ -186,17 +232,16 @@ impl<'a> PathIndex<'a> {
             }
             return;
         };
-        let mask = self.slots.len().wrapping_sub(1);
+        let len = self.len();
+        let mask = len.wrapping_sub(1);
         let mut h = Self::home(bits, cell) & mask;
         // At most n entries in 2n slots: an empty slot is always found.
-        for _ in 0..self.slots.len() {
-            match self.slots.get_mut(h) {
-                Some(s) if *s == 0 => {
-                    *s = i.wrapping_add(1); // i < n <= 2^31
-                    return;
-                }
-                _ => h = h.wrapping_add(1) & mask,
+        for _ in 0..len {
+            if self.slot(h) == Some(0) {
+                self.set_slot(h, i.wrapping_add(1)); // i < n <= 2^31 (< 2^16 - 1 in half slots)
+                return;
             }
+            h = h.wrapping_add(1) & mask;
         }
     }
 
@@ -208,10 +253,11 @@ impl<'a> PathIndex<'a> {
             let j = *self.slots.get(cell)? as usize;
             return (cell_at(j) == Some(cell)).then_some(j);
         };
-        let mask = self.slots.len().wrapping_sub(1);
+        let len = self.len();
+        let mask = len.wrapping_sub(1);
         let mut h = Self::home(bits, cell) & mask;
-        for _ in 0..self.slots.len() {
-            let v = *self.slots.get(h)?;
+        for _ in 0..len {
+            let v = self.slot(h)?;
             if v == 0 {
                 return None;
             }
@@ -222,5 +268,74 @@ impl<'a> PathIndex<'a> {
             h = h.wrapping_add(1) & mask;
         }
         None
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::ant::{Ant, DeadEnd};
+    use crate::grid::Grid;
+    use crate::heuristic::{Attraction, Heuristic};
+    use crate::pheromone::{Blocks, Table};
+    use crate::rng::Xoshiro128pp;
+
+    #[test]
+    fn the_hash_tables_tighten_as_the_per_cell_index_does() {
+        // Weakly guided walks on a 48 x 40 map with random obstacles wander and bulge; each is
+        // tightened with a per-cell index, with the smallest hash table of 16-bit slots (half a
+        // word a slot), and with one word too few (the walk comes back untightened).
+        let (w, h) = (48u16, 40u16);
+        let mut changed = 0;
+        for seed in 0..40u64 {
+            let mut rng = Xoshiro128pp::from_u64(seed);
+            let mut bits = vec![0u8; (usize::from(w) * usize::from(h)).div_ceil(8)];
+            for i in 0..usize::from(w) * usize::from(h) {
+                if i > 0 && i + 1 < bits.len() * 8 && rng.next_unit() < 0.2 {
+                    bits[i / 8] |= 1 << (i % 8);
+                }
+            }
+            let g = Grid::new(w, h, &bits).unwrap();
+            let (start, goal) = (Point::new(0, 0), Point::new(w - 1, h - 1));
+            if !g.is_free(goal) {
+                continue;
+            }
+            let mut tau_buf = vec![[1.0f32; 4]; 1024];
+            let tau = Table::new(Blocks::new(w, h), &mut tau_buf);
+            let heur = Heuristic::new(goal, Some(Attraction { a: 0.3, xi: 1.0 }), 0.5);
+            let moves = Moves::new(g, &[]);
+            let ant = Ant {
+                moves: &moves,
+                start,
+                goal,
+                tau: &tau,
+                heuristic: &heur,
+                alpha: 1.0,
+                dead_end: DeadEnd::Backtrack,
+                dead: &[],
+                route: None,
+                budget: u32::MAX,
+            };
+            let mut tabu = vec![0u32; crate::bitmap::words(g.cells())];
+            let mut tour = vec![0u8; g.cells()];
+            let Ok(walk) = ant.walk(&mut rng, &mut tabu, &mut tour) else {
+                continue;
+            };
+            let n = walk.steps + 1;
+            let run = |links: usize| {
+                let mut t = tour.clone();
+                let mut cells = vec![Point::default(); n];
+                let mut pos = vec![0u32; links];
+                let out = tighten(&moves, start, walk, &mut t, &mut cells, &mut pos, &tabu);
+                (out, t[..out.steps].to_vec())
+            };
+            let direct = run(g.cells());
+            let words = (2 * n).next_power_of_two() / 2;
+            assert_eq!(run(words), direct, "seed {seed}");
+            let (short, path) = run(words - 1);
+            assert_eq!((short, path.as_slice()), (walk, &tour[..walk.steps]));
+            changed += usize::from(direct.0.steps < walk.steps);
+        }
+        assert!(changed >= 10, "{changed}");
     }
 }

@@ -4,7 +4,11 @@
 //! ```text
 //! cargo run --release -p ohaca-host-tests --target host-tuple --example large -- \
 //!     [--maps NAME,NAME,...] [--scen N] [--seeds N] [--ants M] [--iterations N] [--patience P]
-//!     [--refine-patience P]
+//!     [--refine-patience P] [--steps N] [--arena WORDS]
+//!
+//! `--steps N` bounds the ant paths as a device does; `--arena WORDS` plans in an arena of that
+//! many words laid out by `ohaca::planner::arena::carve` (the STM32F411's: 25856), paths bounded
+//! by `--steps` (default 2047).
 //! ```
 //!
 //! For each map: the `N` (default 20) scenarios of largest `optimal` of its scenario file, the exact
@@ -27,6 +31,8 @@ fn main() {
     let mut seeds = 1u64;
     let mut scen = 20usize;
     let mut only: Option<Vec<String>> = None;
+    let mut steps: Option<usize> = None;
+    let mut arena: Option<usize> = None;
     let mut it = args.iter();
     while let Some(flag) = it.next() {
         let v = it.next().expect("every option takes a value");
@@ -38,6 +44,8 @@ fn main() {
             "--iterations" => params.iterations = v.parse().expect("--iterations N"),
             "--patience" => params.patience = v.parse().expect("--patience P"),
             "--refine-patience" => params.refine_patience = v.parse().expect("--refine-patience P"),
+            "--steps" => steps = Some(v.parse().expect("--steps N")),
+            "--arena" => arena = Some(v.parse().expect("--arena WORDS")),
             _ => panic!("unknown option {flag}"),
         }
     }
@@ -69,11 +77,28 @@ fn main() {
                 opt,
                 case.stated_opt8
             );
-            let mut st = ohaca_host_tests::heap::storage(m.map.cells());
+            let cells = m.map.cells();
+            let mut st = match steps {
+                Some(s) if arena.is_none() => {
+                    ohaca::heap::HeapStorage::with_steps(cells, s, cells <= 1024, 1024)
+                        .expect("host storage")
+                }
+                _ => ohaca_host_tests::heap::storage(cells),
+            };
+            let mut words = vec![0u32; arena.unwrap_or(0)];
+            let mut curve = vec![ohaca::planner::CurvePoint::default(); 1024];
             let grid = m.map.grid();
             let p = Params { seed, ..params };
             let t0 = Instant::now();
-            let r = plan(&grid, case.start, case.goal, &p, st.workspace());
+            let ws = match arena {
+                Some(_) => {
+                    let c = ohaca::planner::arena::carve(&mut words, cells, steps.unwrap_or(2047))
+                        .expect("the map fits the arena");
+                    c.workspace.with_curve(&mut curve)
+                }
+                None => st.workspace(),
+            };
+            let r = plan(&grid, case.start, case.goal, &p, ws);
             let time = t0.elapsed().as_secs_f64();
             match r {
                 Err(e) => (false, 0.0, 0.0, 0, 0, time, astar, format!("{e}")),

@@ -21,10 +21,12 @@
 //! | `run` | [`Run`]: the loop as a state machine (setup, walk + update + record, polish) |
 //! | `plan` | [`Plan`], [`RawPath`], [`CurvePoint`]: the result |
 //! | `warm` | [`Memory`], [`Area`]: warm starts after map changes, and the pheromone repair |
+//! | [`arena`] | [`arena::carve`]: a map and a workspace laid out in one arena, per map size |
 //!
 //! [`Run::step`] does one iteration, so the firmware can yield to its executor between iterations
 //! and cancel a plan by dropping (or finishing) the run. [`plan`] runs it to the end.
 
+pub mod arena;
 mod params;
 mod plan;
 mod run;

@@ -134,10 +134,27 @@ impl<'a> Workspace<'a> {
         }
     }
 
-    /// The largest map (in cells) this workspace can plan on.
+    /// The same workspace recording the convergence curve in `curve` (one entry an iteration;
+    /// [`crate::planner::arena::carve`]'s workspaces have none).
+    pub fn with_curve(self, curve: &'a mut [CurvePoint]) -> Self {
+        Workspace { curve, ..self }
+    }
+
+    /// The largest map (in cells) this workspace can plan on: as many as its bit sets hold, and
+    /// with fewer than [`BLOCKS`] pheromone entries at most that many, except on a workspace
+    /// without pruning marks (`dead` empty, [`Workspace::carve`]'s compact layout), where a map
+    /// of more cells than `tau` has entries gets blocks of cells
+    /// ([`Workspace::pheromone_budget`]).
     pub fn capacity(&self) -> usize {
+        let blocks = self.pheromone_budget();
+        if self.dead.is_empty() {
+            return if blocks == 0 {
+                0
+            } else {
+                self.tabu.len().saturating_mul(32)
+            };
+        }
         let bits = self.tabu.len().min(self.dead.len()).saturating_mul(32);
-        let blocks = self.tau.len().min(self.delta.len());
         // Maps of up to `blocks` cells fit whatever the bits say beyond; larger maps need the
         // whole pheromone budget.
         if blocks >= BLOCKS {
@@ -145,6 +162,13 @@ impl<'a> Workspace<'a> {
         } else {
             bits.min(blocks)
         }
+    }
+
+    /// Most pheromone entries a run on this workspace uses: [`BLOCKS`], or fewer if `tau` and
+    /// `delta` are shorter (a map of more cells than that gets blocks of cells: coarser pheromone,
+    /// the same rule as on every map of more than [`BLOCKS`] cells).
+    pub fn pheromone_budget(&self) -> usize {
+        self.tau.len().min(self.delta.len()).min(BLOCKS)
     }
 
     /// The longest ant path (in steps) this workspace keeps.
@@ -162,6 +186,27 @@ impl<'a> Workspace<'a> {
         .into_iter()
         .min()
         .unwrap_or(0)
+    }
+
+    /// The local search's scratch on large maps, two slices of `words` words, from buffers free
+    /// once the iterations are over: the links and the coarse route's words (every storage but a
+    /// compact one), else the tabu bit set in place of whichever is too short, or split in two
+    /// (a compact workspace, [`crate::planner::arena`]). `None`: not enough.
+    pub(super) fn refine_scratch<'x>(
+        links: &'x mut [u32],
+        guide: &'x mut [u32],
+        tabu: &'x mut [u32],
+        words: usize,
+    ) -> Option<(&'x mut [u32], &'x mut [u32])> {
+        match (links.len() >= words, guide.len() >= words) {
+            (true, true) => Some((links.get_mut(..words)?, guide.get_mut(..words)?)),
+            (true, false) => Some((links.get_mut(..words)?, tabu.get_mut(..words)?)),
+            (false, true) => Some((tabu.get_mut(..words)?, guide.get_mut(..words)?)),
+            (false, false) => {
+                let (a, b) = tabu.split_at_mut_checked(words)?;
+                Some((a, b.get_mut(..words)?))
+            }
+        }
     }
 
     /// Cut every buffer to what a `cells`-cell map with pheromone layout `blocks` uses, or fail
@@ -296,7 +341,7 @@ where
 /// use ohaca::planner::Storage;
 /// // 256 x 256 maps, paths of up to 2047 steps, the move table for small maps, no curve.
 /// type Device = Storage<{ words(65536) }, 2048, 4096, 1024, 0>;
-/// assert!(Device::BYTES < 92 * 1024);
+/// assert!(Device::BYTES < 94 * 1024);
 /// // The same keeping the iteration's two paths: 4 KiB more.
 /// type Kept = Storage<{ words(65536) }, 2048, 4096, 1024, 0, 2048>;
 /// assert_eq!(Kept::BYTES, Device::BYTES + 2 * 2048);

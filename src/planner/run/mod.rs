@@ -19,6 +19,7 @@ mod polish;
 mod setup;
 
 pub use colony::REFINE_GAIN;
+pub(crate) use polish::REFINE_WORDS;
 
 use crate::error::{Endpoint, Error};
 use crate::geometry::{polyline_length, turns};
@@ -34,7 +35,7 @@ use super::plan::{CurvePoint, Plan};
 use super::warm::{self, Area, Kept, Memory};
 use super::workspace::Workspace;
 use colony::Best;
-use polish::{Polish, REFINE_WORDS, SMALL_REFINE_LINKS};
+use polish::{Polish, SMALL_REFINE_LINKS};
 
 /// A planning run in progress. See the module docs.
 pub struct Run<'g, 'a> {
@@ -191,7 +192,8 @@ impl<'g, 'a> Run<'g, 'a> {
     ) -> Result<Self, Error> {
         params.validate()?;
         let cells = grid.cells();
-        let blocks = Blocks::new(grid.width(), grid.height());
+        let (width, height) = (grid.width(), grid.height());
+        let blocks = Blocks::with_budget(width, height, ws.pheromone_budget());
         let ws = ws.fit(cells, blocks)?;
         for (p, e) in [(start, Endpoint::Start), (goal, Endpoint::Goal)] {
             if !grid.contains(p) {
@@ -202,7 +204,11 @@ impl<'g, 'a> Run<'g, 'a> {
             }
         }
         Moves::fill(grid, ws.moves);
-        let guide_blocks = route::blocks(grid.width(), grid.height());
+        let guide_blocks = match ws.guide.len() {
+            // A workspace with fewer route words than `GUIDE_BLOCKS` routes on larger blocks.
+            n @ 1..route::GUIDE_BLOCKS => Blocks::with_budget(width, height, n),
+            _ => route::blocks(width, height),
+        };
         match warm {
             None => ws.tau.fill([params.tau0; 4]),
             Some((changes, _)) => {
@@ -240,7 +246,7 @@ impl<'g, 'a> Run<'g, 'a> {
         // `Storage` with at least 4,096 links, and `HeapStorage`; on large maps like the coarse
         // route, on small ones from the links alone).
         let scratch = if blocks.shift() > 0 {
-            ws.links.len() >= REFINE_WORDS && ws.guide.len() >= REFINE_WORDS
+            Workspace::refine_scratch(ws.links, ws.guide, ws.tabu, REFINE_WORDS).is_some()
         } else {
             ws.links.len() >= SMALL_REFINE_LINKS
         };

@@ -14,6 +14,7 @@ use crate::planner::plan::RawPath;
 
 use super::colony::Best;
 use super::Run;
+use crate::planner::workspace::Workspace;
 
 /// Window side of the local search ([`Params::refine`]). Its scratch is the links and the coarse
 /// route's words, free after the last iteration: two slices of [`Scratch::words`]`(52)` = 4,056
@@ -21,7 +22,7 @@ use super::Run;
 /// words each on maps with a route). Measured on the 20 longest scenarios of the 20 large Moving
 /// AI maps (`refine_large` example): mean raw/opt8 1.0009 at 52, 1.0011 at 48, 1.0007 at 64.
 pub const REFINE_SIDE: usize = 52;
-pub(super) const REFINE_WORDS: usize = Scratch::words(REFINE_SIDE);
+pub(crate) const REFINE_WORDS: usize = Scratch::words(REFINE_SIDE);
 const _: () = assert!(REFINE_WORDS <= GUIDE_BLOCKS);
 /// Window side of the local search on small maps (at most [`crate::pheromone::BLOCKS`] = 1,024
 /// cells, which have no coarse route to lend): 32, a window of 1,024 cells, as large as the map.
@@ -116,9 +117,8 @@ impl Run<'_, '_> {
                 // Large maps: the links and the coarse route's words; small maps: two halves of
                 // the links (see `SMALL_REFINE_SIDE`).
                 let (a, b) = if self.blocks.shift() > 0 {
-                    let a = ws.links.get_mut(..REFINE_WORDS).unwrap_or_default();
-                    let b = ws.guide.get_mut(..REFINE_WORDS).unwrap_or_default();
-                    (a, b)
+                    Workspace::refine_scratch(ws.links, ws.guide, ws.tabu, REFINE_WORDS)
+                        .unwrap_or((&mut [], &mut []))
                 } else {
                     let (a, rest) = ws
                         .links

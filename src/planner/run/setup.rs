@@ -38,7 +38,8 @@ impl Run<'_, '_> {
                 self.setup = Setup::Prune;
             }
             Setup::Prune => {
-                self.pruned = if p.prune {
+                // A workspace without pruning marks (`dead` empty) plans without pruning.
+                self.pruned = if p.prune && !ws.dead.is_empty() {
                     let moves = Moves::new(*grid, ws.moves);
                     self.marks = true;
                     match self.reuse {
@@ -74,6 +75,13 @@ impl Run<'_, '_> {
                 // has no attraction).
                 self.routed = self.blocks.shift() > 0 && p.algorithm.attracts() && {
                     let moves = Moves::new(*grid, ws.moves);
+                    // The heap: the links, or the tabu bit set (free until the first ant) on a
+                    // compact workspace, whose links are fewer than the route's blocks.
+                    let heap = if ws.links.len() >= self.guide_blocks.count() {
+                        &mut *ws.links
+                    } else {
+                        &mut *ws.tabu
+                    };
                     if self.relinked && self.marks {
                         // The last run's links, repaired where the map or the marks changed.
                         route::repair(
@@ -82,7 +90,7 @@ impl Run<'_, '_> {
                             self.goal,
                             ws.dead,
                             ws.guide,
-                            ws.links,
+                            heap,
                             self.touched.map(Area::corners),
                         )
                     } else {
@@ -92,7 +100,7 @@ impl Run<'_, '_> {
                             self.goal,
                             ws.dead,
                             ws.guide,
-                            ws.links,
+                            heap,
                         )
                     }
                 };

@@ -1,0 +1,357 @@
+//! One arena of words for a map and the planner's buffers: how a board with little RAM plans
+//! maps of very different sizes at full resolution ([`carve`]).
+//!
+//! A [`Storage`](super::Storage) sizes every buffer for the largest map it takes. On the
+//! STM32F411 that is 65,536 cells: the map (8 KiB) plus two bits a cell (tabu list, pruning
+//! marks), 32 KiB of pheromone, the coarse route and the links, 101 KiB in all. A map of
+//! 262,144 cells (512 x 512) needs 32 KiB for its own bits and 32 KiB for the tabu list alone,
+//! so it cannot have everything a 256 x 256 map has. The arena holds the map *and* the planner's
+//! buffers, and [`carve`] lays them out for the map at hand:
+//!
+//! | layout | when | what | words at its largest map in the F411's 25,856 |
+//! | --- | --- | --- | --- |
+//! | full | it fits (on the F411: maps of up to 65,536 cells) | the map, `tabu` and `dead` (1 bit a cell each), `tau` and `delta` ([`BLOCKS`] entries), the route's [`GUIDE_BLOCKS`] words, [`LINKS`] links, `steps + 1` path cells and two tours (the iteration's best and worst are walked again), the move table on maps of up to 1,024 cells | 25,856 (65,536 cells, 2,047 steps) |
+//! | compact | the full one does not fit | the map, `tabu`; **no pruning marks** (the run does not prune), pheromone on at most [`COMPACT_BLOCKS`] blocks, the same route, links for tightening's hash table only, as many path steps as the rest holds (at most the caller's bound) | 25,856 (262,144 cells, 1,876 steps) |
+//!
+//! The full layout gives a run exactly the buffers the F411's former `Storage` gave it, so its
+//! plans are the same bit for bit. The compact one plans like any workspace without pruning
+//! marks and with coarser pheromone blocks: the coarse route's heap and the local search's
+//! scratch come from the tabu bit set, which is free before the first ant and after the last.
+//! Why these and not other savings, measured on the 512 x 512 maps (`BENCHMARKS.md`, section 1b,
+//! "Compact layout"): the route's block size decides the quality (a route on 1,024 blocks instead
+//! of 4,096 took `NewYork_0_512` from 1.0019 to 1.0167 of the optimum), the pheromone's does not
+//! (64 blocks instead of 1,024: the same means), and pruning only saves moves.
+//!
+//! Guarantees: the layout depends only on the arena's length, the map's cells and the step
+//! bound (a host that carves an arena of the device's length plans what the device plans); the
+//! map always starts at the arena's first word (a receiver writes it there before any plan);
+//! no panics and no `unsafe` (the casts are `bytemuck`'s checked ones).
+
+use bytemuck::{try_cast_slice_mut, Pod};
+
+use crate::bitmap::words;
+use crate::error::Error;
+use crate::grid::{Dir, Point};
+use crate::pheromone::BLOCKS;
+use crate::route::GUIDE_BLOCKS;
+
+use super::run::REFINE_WORDS;
+use super::workspace::{Buffers, Workspace};
+
+/// Pheromone entries of the compact layout: 256 blocks (32 x 32 cells each on a 512 x 512
+/// map). Measured: `BENCHMARKS.md`, section 1b, "Compact layout".
+pub const COMPACT_BLOCKS: usize = 64;
+/// Route blocks of the compact layout: 1,024 (16 x 16 cells each on a 512 x 512 map).
+pub const COMPACT_GUIDE: usize = 4096;
+/// Links of both layouts: tightening's hash table (`2 (steps + 1)` slots), the coarse route's
+/// heap, the flood fill's ring, the smoothing's links and one half of the local search's
+/// scratch.
+pub const LINKS: usize = 4096;
+/// The fewest path steps a layout may leave: a map whose compact layout leaves fewer is too
+/// large for the arena.
+pub const MIN_STEPS: usize = 1023;
+/// Maps of up to this many cells get the move table (as the F411's `Storage` did).
+const MOVES: usize = 1024;
+
+/// A map buffer and a workspace carved out of one arena ([`carve`]).
+#[derive(Debug)]
+pub struct Carved<'a> {
+    /// The map's bits (the arena's first `words(cells)` words, as bytes): what
+    /// [`crate::grid::Grid::new`] reads.
+    pub map: &'a mut [u8],
+    /// Every buffer of the run.
+    pub workspace: Workspace<'a>,
+    /// The compact layout (no pruning, coarser pheromone and route).
+    pub compact: bool,
+}
+
+/// Words the full layout takes for a map of `cells` cells and paths of `steps` steps (saturating).
+pub const fn full_words(cells: usize, steps: usize) -> usize {
+    let w = words(cells);
+    let pheromone = if cells < BLOCKS { cells } else { BLOCKS };
+    let moves = if cells <= MOVES { cells.div_ceil(4) } else { 0 };
+    w.saturating_mul(3)
+        .saturating_add(pheromone.saturating_mul(8))
+        .saturating_add(GUIDE_BLOCKS)
+        .saturating_add(LINKS)
+        .saturating_add(path_words(steps))
+        .saturating_add(moves)
+}
+
+/// Words the compact layout takes for a map of `cells` cells and paths of `steps` steps
+/// (saturating).
+pub const fn compact_words(cells: usize, steps: usize) -> usize {
+    words(cells)
+        .saturating_mul(2)
+        .saturating_add(COMPACT_BLOCKS.saturating_mul(8))
+        .saturating_add(GUIDE_BLOCKS)
+        .saturating_add(compact_links(cells, steps))
+        .saturating_add(path_words(steps))
+}
+
+/// Links of the compact layout: tightening's hash table (two 16-bit slots a word, at least
+/// `2 (steps + 1)` slots, a power of two), the smoothing's `steps + 1`, and on a map whose tabu
+/// bit set is shorter than one slice of the local search's scratch, that slice.
+const fn compact_links(cells: usize, steps: usize) -> usize {
+    let hash = match steps
+        .saturating_add(1)
+        .saturating_mul(2)
+        .checked_next_power_of_two()
+    {
+        Some(slots) => slots / 2,
+        None => usize::MAX,
+    };
+    if words(cells) < REFINE_WORDS && hash < REFINE_WORDS {
+        REFINE_WORDS
+    } else {
+        hash
+    }
+}
+
+/// Words of the path cells and the two tours for paths of `steps` steps: `steps + 1` cells of a
+/// word, `2 (steps + 1)` bytes of tours.
+const fn path_words(steps: usize) -> usize {
+    let n = steps.saturating_add(1);
+    n.saturating_add(n.saturating_mul(2).div_ceil(4))
+}
+
+/// The most cells an arena of `arena` words plans at full resolution: the largest map whose
+/// compact layout leaves [`MIN_STEPS`] steps (a multiple of 32 cells).
+pub const fn capacity(arena: usize) -> usize {
+    let hash = compact_links(usize::MAX / 64, MIN_STEPS);
+    let fixed = COMPACT_BLOCKS
+        .saturating_mul(8)
+        .saturating_add(GUIDE_BLOCKS)
+        .saturating_add(path_words(MIN_STEPS));
+    let Some(left) = arena.checked_sub(fixed.saturating_add(hash)) else {
+        return 0;
+    };
+    let w = left / 2;
+    if w >= REFINE_WORDS {
+        return w.saturating_mul(32);
+    }
+    // A tabu set shorter than the local search's slice: the links hold that slice.
+    match arena.checked_sub(fixed.saturating_add(REFINE_WORDS)) {
+        Some(left) => (left / 2).saturating_mul(32),
+        None => 0,
+    }
+}
+
+/// The longest path a map of `cells` cells gets in an arena of `arena` words with paths bounded
+/// to `max_steps`, and whether its layout is the compact one; `None`: the map is too large.
+pub const fn steps_for(arena: usize, cells: usize, max_steps: usize) -> Option<(usize, bool)> {
+    if full_words(cells, max_steps) <= arena {
+        return Some((max_steps, false));
+    }
+    // Each step costs at least a word: start at what that leaves, then step down (a few
+    // hundred steps at most on the F411's maps).
+    let Some(left) = arena.checked_sub(compact_words(cells, 0)) else {
+        return None;
+    };
+    let mut s = if left < max_steps { left } else { max_steps };
+    while s > 0 && compact_words(cells, s) > arena {
+        s = s.wrapping_sub(1); // s > 0
+    }
+    if s < MIN_STEPS && s < max_steps {
+        return None;
+    }
+    Some((s, true))
+}
+
+/// Take the next `n` words of `rest`.
+fn take<'a>(rest: &mut &'a mut [u32], n: usize) -> Option<&'a mut [u32]> {
+    let (head, tail) = core::mem::take(rest).split_at_mut_checked(n)?;
+    *rest = tail;
+    Some(head)
+}
+
+/// Take the next `n` elements of type `T` (rounded up to a whole number of words) of `rest`.
+fn take_as<'a, T: Pod>(rest: &mut &'a mut [u32], n: usize) -> Option<&'a mut [T]> {
+    let bytes = n.checked_mul(core::mem::size_of::<T>())?;
+    let w = take(rest, bytes.div_ceil(4))?;
+    let all: &mut [T] = try_cast_slice_mut(w).ok()?;
+    all.get_mut(..n)
+}
+
+/// Lay out the map of `cells` cells and a workspace for it, with paths of at most `max_steps`
+/// steps, in `arena` (see the module docs for the two layouts). The map is the arena's first
+/// `words(cells)` words whatever the layout. Fails with [`Error::MapTooLarge`] when neither
+/// layout fits (the error's capacity is [`capacity`]`(arena.len())`).
+pub fn carve(arena: &mut [u32], cells: usize, max_steps: usize) -> Result<Carved<'_>, Error> {
+    let too_large = Error::MapTooLarge {
+        cells: u32::try_from(cells).unwrap_or(u32::MAX),
+        capacity: u32::try_from(capacity(arena.len())).unwrap_or(u32::MAX),
+    };
+    let (steps, compact) = steps_for(arena.len(), cells, max_steps).ok_or(too_large)?;
+    lay(arena, cells, steps, compact).ok_or(too_large)
+}
+
+/// [`carve`]'s layout, in the order of the module docs' table.
+fn lay(mut rest: &mut [u32], cells: usize, steps: usize, compact: bool) -> Option<Carved<'_>> {
+    let n = steps.checked_add(1)?;
+    let w = words(cells);
+    let map = take_as::<u8>(&mut rest, w.checked_mul(4)?)?;
+    let tabu = take(&mut rest, w)?;
+    let (dead, blocks, links) = if compact {
+        (&mut [][..], COMPACT_BLOCKS, compact_links(cells, steps))
+    } else {
+        (take(&mut rest, w)?, cells.min(BLOCKS), LINKS)
+    };
+    let tau = take_as::<[f32; 4]>(&mut rest, blocks)?;
+    let delta = take_as::<[f32; 4]>(&mut rest, blocks)?;
+    let guide = take(&mut rest, GUIDE_BLOCKS)?;
+    let links = take(&mut rest, links)?;
+    let points = take_as::<Point>(&mut rest, n)?;
+    let tours = take_as::<Dir>(&mut rest, n.checked_mul(2)?)?;
+    let (tour, best) = tours.split_at_mut_checked(n)?;
+    let moves = if !compact && cells <= MOVES {
+        take_as::<u8>(&mut rest, cells)?
+    } else {
+        &mut []
+    };
+    Some(Carved {
+        map,
+        workspace: Workspace::new(Buffers {
+            tau,
+            delta,
+            tabu,
+            dead,
+            moves,
+            tours: [tour, &mut [], &mut [], best],
+            points,
+            links,
+            curve: &mut [],
+            guide,
+        }),
+        compact,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::grid::Grid;
+    use crate::planner::{plan, Params, Storage};
+    use alloc::vec;
+    use alloc::vec::Vec;
+
+    /// The STM32F411's arena: its former map buffer (8 KiB) and `Storage` (95,232 B).
+    const F411: usize = 25_856;
+
+    #[test]
+    fn the_layouts_of_the_f411s_arena() {
+        // The former `Storage` had the 1,024-byte move table (256 words) whatever the map.
+        assert_eq!(full_words(65_536, 2047) + 256, F411);
+        assert_eq!(steps_for(F411, 65_536, 2047), Some((2047, false)));
+        // Without the move table the full layout holds a little more.
+        assert_eq!(steps_for(F411, 68_256, 2047), Some((2047, false)));
+        assert_eq!(steps_for(F411, 68_257, 2047), Some((2047, true)));
+        assert_eq!(steps_for(F411, 604 * 307, 2047), Some((2047, true)));
+        assert_eq!(steps_for(F411, 512 * 512, 2047), Some((1876, true)));
+        assert_eq!(compact_words(512 * 512, 1876), F411);
+        let cap = capacity(F411);
+        assert_eq!(cap, 299_008);
+        assert!(steps_for(F411, cap, 2047).is_some_and(|(s, c)| c && s >= MIN_STEPS));
+        assert_eq!(steps_for(F411, cap + 32, 2047), None);
+        // Every map size between: a layout that fits, the compact one leaving at least MIN_STEPS.
+        for cells in (1..=cap).step_by(997) {
+            let (s, compact) = steps_for(F411, cells, 2047).unwrap();
+            let words = if compact {
+                compact_words(cells, s)
+            } else {
+                full_words(cells, s)
+            };
+            assert!(words <= F411 && s >= MIN_STEPS, "{cells}: {s} {compact}");
+            let mut arena = vec![0u32; F411];
+            let c = carve(&mut arena, cells, 2047).unwrap();
+            assert_eq!((c.workspace.steps(), c.compact), (s, compact), "{cells}");
+            assert!(c.workspace.capacity() >= cells && c.map.len() * 8 >= cells);
+        }
+        let mut arena = vec![0u32; F411];
+        assert_eq!(
+            carve(&mut arena, cap + 32, 2047).unwrap_err(),
+            Error::MapTooLarge {
+                cells: 299_040,
+                capacity: 299_008
+            }
+        );
+    }
+
+    /// A `w x h` map with random walls (`density`), its corners free.
+    fn walls(w: u16, h: u16, density: f32, seed: u64) -> Vec<u8> {
+        let mut rng = crate::rng::Xoshiro128pp::from_u64(seed);
+        let cells = usize::from(w) * usize::from(h);
+        let mut b = vec![0u8; cells.div_ceil(8)];
+        for i in 1..cells - 1 {
+            if rng.next_unit() < density {
+                b[i / 8] |= 1 << (i % 8);
+            }
+        }
+        b
+    }
+
+    #[test]
+    fn the_full_layout_plans_what_the_f411s_storage_planned() {
+        type F411Storage = Storage<{ crate::bitmap::words(65_536) }, 2048, 4096, 1024, 0, 0>;
+        let mut storage = alloc::boxed::Box::new(F411Storage::new());
+        for (w, h, seed) in [
+            (30u16, 30u16, 1u64),
+            (256, 256, 2),
+            (200, 150, 3),
+            (31, 33, 4),
+        ] {
+            let bits = walls(w, h, 0.25, seed);
+            let g = Grid::new(w, h, &bits).unwrap();
+            let (s, goal) = (Point::new(0, 0), Point::new(w - 1, h - 1));
+            let p = Params {
+                seed,
+                ..Params::default()
+            };
+            let a = plan(&g, s, goal, &p, storage.workspace())
+                .map(|pl| (pl.directions().to_vec(), pl.waypoints().to_vec(), pl.moves));
+            let mut arena = vec![0u32; F411];
+            let c = carve(&mut arena, g.cells(), 2047).unwrap();
+            assert!(!c.compact);
+            let b = plan(&g, s, goal, &p, c.workspace)
+                .map(|pl| (pl.directions().to_vec(), pl.waypoints().to_vec(), pl.moves));
+            assert_eq!(a, b, "{w} x {h}");
+        }
+    }
+
+    #[test]
+    fn the_compact_layout_plans_valid_paths_near_the_full_ones() {
+        // A 160 x 120 map in an arena too small for its full layout.
+        let (w, h) = (160u16, 120u16);
+        let cells = usize::from(w) * usize::from(h);
+        let arena_words = compact_words(cells, 2047);
+        assert!(full_words(cells, 2047) > arena_words);
+        let mut ratio = 0.0;
+        for seed in 1..=6u64 {
+            let bits = walls(w, h, 0.3, seed);
+            let g = Grid::new(w, h, &bits).unwrap();
+            let (s, goal) = (Point::new(0, 0), Point::new(w - 1, h - 1));
+            let p = Params {
+                seed,
+                ..Params::default()
+            };
+            let mut heap = crate::heap::HeapStorage::new(cells, 128).unwrap();
+            let Ok(full) = plan(&g, s, goal, &p, heap.workspace()) else {
+                continue;
+            };
+            let mut arena = vec![0u32; arena_words];
+            assert_eq!(steps_for(arena_words, cells, 2047), Some((2047, true)));
+            let c = carve(&mut arena, cells, 2047).unwrap();
+            assert!(c.compact);
+            assert_eq!(c.workspace.steps(), 2047);
+            let compact = plan(&g, s, goal, &p, c.workspace).unwrap();
+            assert_eq!(compact.pruned, 0);
+            let raw: Vec<Point> = compact.raw().collect();
+            assert_eq!((raw[0], *raw.last().unwrap()), (s, goal));
+            for (pair, &d) in raw.windows(2).zip(compact.directions()) {
+                assert_eq!(g.step(pair[0], d), Some(pair[1]));
+            }
+            ratio += f64::from(compact.raw_length / full.raw_length) / 6.0;
+        }
+        assert!(ratio < 1.01, "{ratio}");
+    }
+}
