@@ -35,6 +35,7 @@ fn main() {
     let mut seeds = 1u64;
     let mut params = Params::default();
     let mut steps = STEPS;
+    let mut arena: Option<usize> = None;
     let mut it = args.iter();
     while let Some(flag) = it.next() {
         let v = it.next().expect("every option takes a value");
@@ -45,6 +46,7 @@ fn main() {
             "--seeds" => seeds = v.parse().expect("--seeds N"),
             "--patience" => params.patience = v.parse().expect("--patience P"),
             "--steps" => steps = v.parse().expect("--steps N"),
+            "--arena" => arena = Some(v.parse().expect("--arena WORDS")),
             _ => panic!("unknown option {flag}"),
         }
     }
@@ -54,7 +56,16 @@ fn main() {
         .unwrap_or_else(|e| panic!("{e}"));
     for seed in 1..=seeds {
         let p = Params { seed, ..params };
-        let mut run = Run::new(&grid, start, goal, &p, st.workspace()).expect("plan");
+        let mut words = vec![0u32; arena.unwrap_or(0)];
+        let ws = match arena {
+            Some(_) => {
+                ohaca::planner::arena::carve(&mut words, m.cells(), steps)
+                    .expect("the map fits the arena")
+                    .workspace
+            }
+            None => st.workspace(),
+        };
+        let mut run = Run::new(&grid, start, goal, &p, ws).expect("plan");
         while run.step() {}
         let pl = run.finish().expect("a path");
         let mut h = DefaultHasher::new();

@@ -1,9 +1,12 @@
 //! Where the map buffer and the planner's buffers live in RAM, per board, and the one function
 //! that hands them out at boot: [`take`].
 //!
-//! - **STM32F411 and the default QEMU board** (maps of up to 65,536 cells, paths of up to 2,047
-//!   steps): the map (8 KiB) and one `ohaca::planner::Storage` static, both zero-initialised in
-//!   `.bss`.
+//! - **STM32F411 and the default QEMU board** (maps of up to 262,144 cells, paths of up to
+//!   2,047 steps): one arena of 103,424 bytes in `.bss`, inside `state::MAP`'s lock: the map in
+//!   its first bytes, the planner's buffers after it, laid out per map by
+//!   `ohaca::planner::arena::carve` when a plan starts ([`lend`]). A 256 x 256 map leaves the
+//!   planner every buffer the former fixed `Storage` had; a 512 x 512 one takes 32 KiB and
+//!   leaves the compact layout.
 //! - **STM32H743 and its QEMU twin** (`twin-h743`; maps of up to 2,097,152 cells, paths of up
 //!   to 8,191 steps): the map (256 KiB) and the planner's two per-cell bit sets (256 KiB each)
 //!   do not fit one RAM region (the largest, the AXI SRAM, has 512 KiB), so every buffer is a
@@ -28,46 +31,75 @@
 //! their statics are `Region`s, `MaybeUninit` memory that [`take`] fills with zeros element by
 //! element before it lends it out, once. Nothing reads them before.
 
-pub use layout::{take, MapBuf, PlanStorage, BYTES, MAP_INIT};
+pub use layout::{lend, take, MapBuf, PlanStorage, BYTES, MAP_INIT};
 
-/// The planner's storage as one `Storage` static (STM32F411 and the default QEMU board).
+/// The map and the planner's buffers in one arena behind the map's lock (STM32F411 and the
+/// default QEMU board).
 #[cfg(not(feature = "twin-h743"))]
 #[cfg(not(feature = "board-stm32h743"))]
 mod layout {
+    use ohaca::grid::Grid;
+    use ohaca::planner::arena::{self, F411_WORDS};
+    use ohaca::planner::Workspace;
     use static_cell::ConstStaticCell;
 
     use crate::firmware::state::{MAP_BYTES, PLAN_CELLS, PLAN_STEPS};
 
-    /// Two bits a map cell (tabu list, pruned cells), the pheromone budget, the coarse route,
-    /// two ant paths of [`PLAN_STEPS`] steps (the ant's, the run's best: the iteration's best and
-    /// worst are walked again at the update, which is what lets 2,047-step paths fit), their
-    /// cells, links (4,096: tightening's hash table of `2 * (PLAN_STEPS + 1)` slots, and the
-    /// coarse route's heap), the move table for maps of up to 1024 cells, and no convergence
-    /// curve (the device never reports one). `ohaca::planner::workspace` lists what each holds.
-    pub type PlanStorage = ohaca::planner::Storage<
-        { ohaca::bitmap::words(PLAN_CELLS) },
-        { PLAN_STEPS + 1 },
-        4096,
-        1024,
-        0,
-        0,
-    >;
-    // Tightening's hash table holds every path the device keeps.
-    const _: () = assert!(2 * (PLAN_STEPS + 1) <= 4096);
+    /// The arena's words (`ohaca::planner::arena::F411_WORDS`).
+    const WORDS: usize = F411_WORDS;
+    // Every map the device takes fits the arena at full resolution, and its map bytes are the
+    // arena's first words (what the receiver writes).
+    const _: () = assert!(arena::capacity(WORDS) >= PLAN_CELLS);
+    const _: () = assert!(MAP_BYTES <= 4 * WORDS);
 
-    /// Bytes of the planner's storage.
-    pub const BYTES: usize = PlanStorage::BYTES;
+    /// The planner's own storage: nothing beyond the arena in the map's lock ([`lend`] carves
+    /// the workspace out of it for each plan).
+    pub struct PlanStorage;
 
-    /// The map buffer: the array itself, inside `state::MAP`'s lock (in `.bss`).
-    pub type MapBuf = [u8; MAP_BYTES];
-    /// Its value at boot.
-    pub const MAP_INIT: MapBuf = [0; MAP_BYTES];
+    /// Bytes of the planner's buffers at the largest map (the arena without the map).
+    pub const BYTES: usize = 4 * WORDS - MAP_BYTES;
 
-    /// Zero-initialised, so it lives in `.bss`.
-    static STORAGE: ConstStaticCell<PlanStorage> = ConstStaticCell::new(PlanStorage::new());
+    /// The arena: the map in its first [`MAP_BYTES`] bytes (what the receiver writes and
+    /// `Deref` shows), the planner's buffers after the map of each plan (`lend`).
+    pub struct MapBuf([u32; WORDS]);
 
-    /// Hand out the planner's storage (the map is already in `state::MAP`). Call once, at boot,
-    /// before any task runs; a second call panics.
+    /// Its value at boot (zeroed, in `.bss`).
+    pub const MAP_INIT: MapBuf = MapBuf([0; WORDS]);
+
+    impl core::ops::Deref for MapBuf {
+        type Target = [u8];
+        fn deref(&self) -> &[u8] {
+            let bytes: &[u8] = bytemuck::cast_slice(&self.0[..]);
+            bytes.get(..MAP_BYTES).unwrap_or(&[])
+        }
+    }
+
+    impl core::ops::DerefMut for MapBuf {
+        fn deref_mut(&mut self) -> &mut [u8] {
+            let bytes: &mut [u8] = bytemuck::cast_slice_mut(&mut self.0[..]);
+            bytes.get_mut(..MAP_BYTES).unwrap_or(&mut [])
+        }
+    }
+
+    /// The map of `width x height` cells and a workspace for one plan on it, both from the
+    /// arena (`ohaca::planner::arena::carve`: every buffer on maps of up to 68,256 cells, the
+    /// compact layout beyond).
+    pub fn lend<'a>(
+        map: &'a mut MapBuf,
+        _storage: &'a mut PlanStorage,
+        width: u16,
+        height: u16,
+    ) -> Result<(Grid<'a>, Workspace<'a>), ohaca::Error> {
+        let cells = usize::from(width) * usize::from(height);
+        let carved = arena::carve(&mut map.0, cells, PLAN_STEPS)?;
+        let bits: &'a [u8] = carved.map;
+        Ok((Grid::new(width, height, bits)?, carved.workspace))
+    }
+
+    static STORAGE: ConstStaticCell<PlanStorage> = ConstStaticCell::new(PlanStorage);
+
+    /// Hand out the planner's storage (the arena is already in `state::MAP`). Call once, at
+    /// boot, before any task runs; a second call panics.
     pub fn take() -> &'static mut PlanStorage {
         STORAGE.take()
     }
@@ -241,6 +273,20 @@ mod layout {
                 guide: self.guide,
             })
         }
+    }
+
+    /// The map of `width x height` cells and the planner's workspace for one plan on it.
+    pub fn lend<'a>(
+        map: &'a mut MapBuf,
+        storage: &'a mut PlanStorage,
+        width: u16,
+        height: u16,
+    ) -> Result<(ohaca::grid::Grid<'a>, Workspace<'a>), ohaca::Error> {
+        let bits: &'a [u8] = map;
+        Ok((
+            ohaca::grid::Grid::new(width, height, bits)?,
+            storage.workspace(),
+        ))
     }
 
     /// Build the planner's storage from the statics and lend the map static to `state::MAP`:

@@ -3,8 +3,9 @@
 //! yielding to the executor after every piece so frames keep arriving and `Cancel` works.
 //! A path is streamed into the UART as it is encoded ([`PathStream`]), a piece at a time: no
 //! buffer for a whole frame (up to 40 KiB). The planner reads the map in place: it holds
-//! [`MAP`]'s lock from `Run::new` to `Run::finish`, and a writer (a map upload, a cell update)
-//! cancels the plan first, so it gives the lock up at its next yield.
+//! [`MAP`]'s lock from `Run::new` until its path is sent (on the small boards the planner's
+//! buffers share the map's arena), and a writer (a map upload, a cell update) cancels the plan
+//! first, so it gives the lock up at its next yield, or once its path is out.
 
 use core::sync::atomic::Ordering;
 
@@ -12,10 +13,10 @@ use embassy_futures::yield_now;
 use embassy_time::Instant;
 use embedded_io_async::Write;
 
-use ohaca::grid::Grid;
 use ohaca::planner::Run;
 use ohaca::protocol::{ErrorCode, ErrorReply, PathReply, PathStream, Reply, Waypoints};
 
+use super::buffers;
 use super::stack;
 use super::state::{self, count, Job, PlanStorage, TxPort, JOBS, MAP, PLANNING};
 use super::tx::sent_one;
@@ -61,18 +62,18 @@ async fn plan(
     }
     // The map, in place. A writer cancels before it waits for the lock, so check again once
     // it is ours: a plan never starts on a map that changed after it was received.
-    let map = MAP.lock().await;
+    let mut map = MAP.lock().await;
     if state::cancelled(job.generation) {
         return Err(cancelled());
     }
     let (width, height) = state::map_size().ok_or(ErrorReply::new(ErrorCode::NoMap))?;
-    let grid = Grid::new(width, height, &map[..])?;
+    let (grid, ws) = buffers::lend(&mut map, storage, width, height)?;
     let t0 = Instant::now();
     // A warm plan keeps the colony if it is for this map and goal; both kinds record theirs for
     // the next `PlanWarm` once the run started (a refused plan leaves the pheromone as it was).
     // The memory is read and written under the map's lock.
     let mut memory = state::colony();
-    let (start, goal, params, ws) = (job.start, job.goal, &job.params, storage.workspace());
+    let (start, goal, params) = (job.start, job.goal, &job.params);
     let mut run = if job.warm {
         Run::warm(&grid, start, goal, params, ws, &mut memory)
     } else {
@@ -127,8 +128,6 @@ async fn plan(
     state::set_colony(memory);
     let plan = run.finish()?;
     let t_end = Instant::now();
-    // The path is in `storage`: the map is free for writers while it is sent.
-    drop(map);
     let ticks = t_end.saturating_duration_since(t0).as_ticks();
     defmt::info!(
         "plan {}: {} iterations, length {}, {} waypoints, {} ticks (new {}, steps {}, finish {})",
@@ -162,8 +161,9 @@ async fn plan(
             plan.directions().len() as u32,
         )
     })?;
-    // The frame goes out while the plan's buffers (in `storage`) are still borrowed, so the next
-    // plan starts once it is sent.
+    // The frame goes out while the plan's buffers are still borrowed (and with them the map's
+    // lock: on the small boards they are in the same arena), so the next plan, and a writer,
+    // start once it is sent.
     let mut piece = [0u8; PIECE];
     let mut tx = port.lock().await;
     let mut sent = true;

@@ -60,13 +60,16 @@ pub struct Capacity {
 }
 
 /// The STM32F411's capacity (128 KiB of RAM), and the default QEMU board's, which copies it so
-/// that what QEMU proves holds on the chip: 65,536 cells (8 KiB of map), paths of 2,047 steps
-/// (102 m at 5 cm; `maps/large/maze-128-128-2`'s longest scenario has 1,379). A step costs 6 bytes
-/// here (two tours of a byte a step, the iteration's best and worst being walked again, and a
-/// 4-byte path cell; tightening's links are the 4,096 words the coarse route needs anyway).
+/// that what QEMU proves holds on the chip: 262,144 cells (512 x 512, or Nav2's 604 x 307 depot
+/// at 5 cm) at full resolution, and paths of up to 2,047 steps (102 m at 5 cm;
+/// `maps/large/maze-128-128-2`'s longest scenario has 1,379). The map and the planner share one
+/// arena of 103,424 bytes (`ohaca::planner::arena`): maps of up to 68,256 cells get every
+/// buffer (the pruning marks, 1,024 pheromone entries) and 2,047 steps; larger ones the compact
+/// layout (no pruning, 64 pheromone entries) and as many steps as are left, 1,876 at 512 x 512
+/// (`Error PathTooLong` says the bound of the plan).
 #[cfg(not(any(feature = "twin-h743", feature = "board-stm32h743")))]
 pub const SMALL: Capacity = Capacity {
-    cells: 65_536,
+    cells: 262_144,
     steps: 2047,
 };
 
