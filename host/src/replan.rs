@@ -145,17 +145,20 @@ pub trait Planner {
     fn plan(&mut self, start: Point, goal: Point, warm: bool) -> Result<Planned, String>;
 }
 
-/// The host core, planning as the device does (its 1,023-step path bound and move table), so
-/// its paths are the device's bit for bit.
+/// The host core, planning as the STM32F411 firmware does (in an arena of its size laid out by
+/// `ohaca::planner::arena::carve`, its 2,047-step path bound), so its paths are the device's bit
+/// for bit; on a map too large for that arena, with heap storage and the same path bound.
 pub struct HostPlanner {
     map: Map,
     params: Params,
     storage: HeapStorage,
+    /// The firmware's arena (empty: the map does not fit it, `storage` plans).
+    arena: Vec<u32>,
     memory: Memory,
 }
 
 /// The device's longest ant path (`firmware::state::PLAN_STEPS`).
-pub const DEVICE_STEPS: usize = 1023;
+pub const DEVICE_STEPS: usize = 2047;
 
 impl HostPlanner {
     /// A planner with `params` and no map yet.
@@ -164,6 +167,7 @@ impl HostPlanner {
             map: Map::from_fn(0, 0, |_, _| false),
             params,
             storage: HeapStorage::default(),
+            arena: Vec::new(),
             memory: Memory::new(),
         }
     }
@@ -172,13 +176,20 @@ impl HostPlanner {
 impl Planner for HostPlanner {
     fn set_map(&mut self, map: &Map) -> Result<(), String> {
         self.map = map.clone();
-        self.storage = HeapStorage::with_steps(
-            map.cells(),
-            DEVICE_STEPS,
-            true,
-            usize::from(self.params.iterations),
-        )
-        .map_err(|e| e.to_string())?;
+        let words = ohaca::planner::arena::F411_WORDS;
+        if map.cells() <= ohaca::planner::arena::capacity(words) {
+            self.arena = vec![0; words];
+            self.storage = HeapStorage::default();
+        } else {
+            self.arena = Vec::new();
+            self.storage = HeapStorage::with_steps(
+                map.cells(),
+                DEVICE_STEPS,
+                true,
+                usize::from(self.params.iterations),
+            )
+            .map_err(|e| e.to_string())?;
+        }
         self.memory.forget();
         Ok(())
     }
@@ -193,7 +204,13 @@ impl Planner for HostPlanner {
 
     fn plan(&mut self, start: Point, goal: Point, warm: bool) -> Result<Planned, String> {
         let grid = self.map.grid().map_err(|e| e.to_string())?;
-        let ws = self.storage.workspace();
+        let ws = if self.arena.is_empty() {
+            self.storage.workspace()
+        } else {
+            ohaca::planner::arena::carve(&mut self.arena, self.map.cells(), DEVICE_STEPS)
+                .map_err(|e| e.to_string())?
+                .workspace
+        };
         let mut run = if warm {
             Run::warm(&grid, start, goal, &self.params, ws, &mut self.memory)
         } else {

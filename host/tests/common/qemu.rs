@@ -363,8 +363,14 @@ pub fn core_plan(
     goal: Point,
     params: &Params,
 ) -> Result<CorePath, ErrorReply> {
-    // The device's capacities: ant paths of up to 1023 steps (`firmware::state::PLAN_STEPS`).
-    core_plan_with(map, start, goal, params, 1023, true)
+    // The device's arena (`ohaca::planner::arena::F411_WORDS`) and its ant paths of up to
+    // 2,047 steps (`firmware::state::PLAN_STEPS`).
+    let grid = map.grid().map_err(ErrorReply::from)?;
+    params.validate().map_err(ErrorReply::from)?;
+    let mut arena = vec![0u32; ohaca::planner::arena::F411_WORDS];
+    let ws = ohaca::planner::arena::carve(&mut arena, map.cells(), 2047)?.workspace;
+    let plan = ohaca::plan(&grid, start, goal, params, ws)?;
+    Ok(core_path(&plan))
 }
 
 /// [`core_plan`] for a device that keeps ant paths of up to `steps` steps (Hello's
@@ -394,7 +400,12 @@ fn core_plan_with(
         HeapStorage::with_steps(map.cells(), steps, moves, usize::from(params.iterations))
             .expect("host storage");
     let plan = ohaca::plan(&grid, start, goal, params, storage.workspace())?;
-    Ok(CorePath {
+    Ok(core_path(&plan))
+}
+
+/// The fields of a `Path` reply from a host plan.
+fn core_path(plan: &ohaca::Plan<'_>) -> CorePath {
+    CorePath {
         raw_length: plan.raw_length,
         length: plan.length,
         turns: plan.turns,
@@ -405,7 +416,7 @@ fn core_plan_with(
         warm: plan.warm,
         waypoints: plan.waypoints().to_vec(),
         directions: plan.directions().to_vec(),
-    })
+    }
 }
 
 /// The device's path must be the host core's, bit for bit (floats compared by their bits).
