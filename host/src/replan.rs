@@ -145,7 +145,7 @@ pub trait Planner {
     fn plan(&mut self, start: Point, goal: Point, warm: bool) -> Result<Planned, String>;
 }
 
-/// The host core, planning as the device does (its 1,023-step path bound and move table), so
+/// The host core, planning as the device does (its 2,047-step path bound and move table), so
 /// its paths are the device's bit for bit.
 pub struct HostPlanner {
     map: Map,
@@ -154,8 +154,9 @@ pub struct HostPlanner {
     memory: Memory,
 }
 
-/// The device's longest ant path (`firmware::state::PLAN_STEPS`).
-pub const DEVICE_STEPS: usize = 1023;
+/// The device's longest ant path (`firmware::state::PLAN_STEPS`: the STM32F411's and the default
+/// QEMU board's, Hello's `capacity.max_steps`).
+pub const DEVICE_STEPS: usize = 2047;
 
 impl HostPlanner {
     /// A planner with `params` and no map yet.
