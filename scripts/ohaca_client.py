@@ -488,7 +488,7 @@ def synthetic_maps():
     return [
         ("open-32x32", open32, (0, 0), (31, 31)),
         ("snake-32x32", snake, (0, 0), (0, 30)),
-        # A long path within the device's 256 columns and 1,023-step ant paths: along row 0,
+        # A long path within the device's 65,536 cells and 2,047-step ant paths: along row 0,
         # down at the right end, back along row 2, down at the left, along row 4 (772 cells).
         ("zigzag-256x5", ["." * 256, "@" * 255 + ".", "." * 256, "." + "@" * 255, "." * 256],
          (0, 0), (255, 4)),

@@ -63,8 +63,9 @@ pub enum Error {
     /// died at a dead end (or the run was finished before its first iteration).
     NoAntArrived,
     /// The goal is reachable, but no ant reached it and some ants were dropped because their
-    /// paths grew longer than the workspace keeps (`Workspace::steps`; 1,023 steps on the
-    /// device): the way to the goal is longer than that, or the ants wandered that far.
+    /// paths grew longer than the workspace keeps (`Workspace::steps`; 2,047 steps on the
+    /// STM32F411 and the default QEMU board, 8,191 on the STM32H743): the way to the goal is
+    /// longer than that, or the ants wandered that far.
     PathTooLong {
         /// Ants dropped over the run.
         ants: u32,

@@ -1,12 +1,14 @@
-//! One plan as the device makes it (ant paths bounded to the firmware's 1,023 steps, no move
-//! table on maps of more than 1,024 cells), for profiling the core on the host with callgrind,
-//! whose instruction counts follow the device's: the phases are the functions `Run::new`,
-//! `Run::step` and `Run::finish`.
+//! One plan as the device makes it (ant paths bounded to the STM32F411 firmware's 2,047 steps, or
+//! `--steps N`, e.g. the STM32H743's 8191; no move table on maps of more than 1,024 cells; the
+//! iteration's best and worst ants walked again instead of kept), for profiling the core on the
+//! host with callgrind, whose instruction counts follow the device's: the phases are the
+//! functions `Run::new`, `Run::step` and `Run::finish`.
 //!
 //! ```text
 //! cargo build --release -p ohaca-host-tests --target host-tuple --example device_plan
 //! valgrind --tool=callgrind target/x86_64-unknown-linux-gnu/release/examples/device_plan \
-//!     [--map maps/large/Boston_0_256.map] [--start 184,0] [--goal 8,254] [--seeds 1] [--patience P]
+//!     [--map maps/large/Boston_0_256.map] [--start 184,0] [--goal 8,254] [--seeds 1] [--patience P] \
+//!     [--steps 2047]
 //! ```
 //!
 //! Prints one line per seed: iterations, lengths, ant moves and a hash of the raw path and the
@@ -20,8 +22,8 @@ use ohaca::planner::Run;
 use ohaca::Params;
 use ohaca_host_tests::maps::Map;
 
-/// The firmware's `PLAN_STEPS`.
-const STEPS: usize = 1023;
+/// The firmware's `PLAN_STEPS` on the STM32F411 and the default QEMU board.
+const STEPS: usize = 2047;
 
 fn point(s: &str) -> Point {
     let (x, y) = s.split_once(',').expect("X,Y");
@@ -53,7 +55,8 @@ fn main() {
     let m = Map::load(&map).unwrap_or_else(|e| panic!("{e}"));
     let grid = m.grid();
     let mut st = HeapStorage::with_steps(m.cells(), steps, m.cells() <= 1024, 1024)
-        .unwrap_or_else(|e| panic!("{e}"));
+        .unwrap_or_else(|e| panic!("{e}"))
+        .replaying();
     for seed in 1..=seeds {
         let p = Params { seed, ..params };
         let mut words = vec![0u32; arena.unwrap_or(0)];

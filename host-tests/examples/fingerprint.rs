@@ -8,7 +8,8 @@
 //!
 //! `OHACA_NO_PRUNE=1` turns dead-end pruning off (`Params::prune`). `--large N`: the `N` longest
 //! scenarios of every large map (`maps/large/`) instead, seeds 1 and 2, OHACA only, once with the
-//! host's storage and once bounded like the device's (`device` lines: 1,023 steps, no move table).
+//! host's storage and once bounded like the STM32F411's (`device` lines: 2,047 steps, no move
+//! table, the iteration's best and worst ants walked again instead of kept).
 
 use std::hash::{DefaultHasher, Hash, Hasher};
 
@@ -36,8 +37,9 @@ fn large(scen: usize) {
     for m in large_maps(scen) {
         let grid = m.map.grid();
         let mut host = ohaca_host_tests::heap::storage(m.map.cells());
-        let mut device = HeapStorage::with_steps(m.map.cells(), 1023, false, 1024)
-            .unwrap_or_else(|e| panic!("{e}"));
+        let mut device = HeapStorage::with_steps(m.map.cells(), 2047, false, 1024)
+            .unwrap_or_else(|e| panic!("{e}"))
+            .replaying();
         for (c, case) in m.cases.iter().enumerate() {
             for seed in 1..=2u64 {
                 let p = Params {

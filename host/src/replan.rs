@@ -157,7 +157,8 @@ pub struct HostPlanner {
     memory: Memory,
 }
 
-/// The device's longest ant path (`firmware::state::PLAN_STEPS`).
+/// The device's longest ant path (`firmware::state::PLAN_STEPS`: the STM32F411's and the default
+/// QEMU board's, Hello's `capacity.max_steps`).
 pub const DEVICE_STEPS: usize = 2047;
 
 impl HostPlanner {

@@ -28,8 +28,8 @@ use ohaca::{Algorithm, Params, Point};
 use ohaca_host::link::{DevicePath, Link, LinkError, PlanJob, Response, Stray, Transport};
 use ohaca_host::{plan_map, Map, PlanReport};
 use qemu::{
-    assert_core_path, cobs, core_plan, expected_errors, frame_of, free_port, have_qemu, maps, Qemu,
-    TIMEOUT,
+    assert_core_path, cobs, core_plan, core_plan_steps, expected_errors, frame_of, free_port,
+    have_qemu, longest_scenario, maps, Qemu, DEVICE_STEPS, TIMEOUT,
 };
 use serde_json::Value;
 
@@ -1651,10 +1651,10 @@ fn a_cell_update_during_a_plan_cancels_it() {
     assert_eq!(link.stray_count(), 0, "{:?}", link.take_strays());
 }
 
-/// A plan whose only way is longer than the device keeps (a serpentine of 64-cell rows: about
-/// 2,000 steps, over the firmware's 1,023) ends with `PathTooLong`, giving the ants dropped and
-/// the step limit, not the old, misleading `NoAntArrived`; the device keeps serving, and a goal
-/// within reach on the same map is planned.
+/// A plan whose only way is longer than the device keeps (a serpentine of 128-cell rows: about
+/// 4,000 steps, over the firmware's 2,047) ends with `PathTooLong`, giving the ants dropped and
+/// the step limit, not the old, misleading `NoAntArrived`, as the host core with the device's
+/// bound says; the device keeps serving, and a goal within reach on the same map is planned.
 #[test]
 fn a_path_longer_than_the_device_keeps_is_path_too_long() {
     need_qemu!();
@@ -1663,8 +1663,8 @@ fn a_path_longer_than_the_device_keeps_is_path_too_long() {
     let defaults = link.hello().expect("hello").defaults;
     // Walls on every odd row, open at the right end on rows 1, 5, 9, ... and at the left on 3,
     // 7, 11, ...: the way from the top left to the bottom left runs the whole width every two rows.
-    let map = Map::from_fn(64, 63, |x, y| {
-        y % 2 == 1 && if y % 4 == 1 { x != 63 } else { x != 0 }
+    let map = Map::from_fn(128, 63, |x, y| {
+        y % 2 == 1 && if y % 4 == 1 { x != 127 } else { x != 0 }
     });
     link.set_map(&map).expect("upload");
     let params = Params {
@@ -1673,15 +1673,78 @@ fn a_path_longer_than_the_device_keeps_is_path_too_long() {
         ..defaults
     };
     link.set_params(&params).expect("set params");
-    let e = error_code(link.plan(Point::new(0, 0), Point::new(0, 62), None));
-    assert_eq!(e, ErrorReply::with(ErrorCode::PathTooLong, 8, 1023));
+    let (s, g) = (Point::new(0, 0), Point::new(0, 62));
+    let e = error_code(link.plan(s, g, None));
+    assert_eq!(e, ErrorReply::with(ErrorCode::PathTooLong, 8, 2047));
+    assert_eq!(core_plan(&map, s, g, &params).err(), Some(e));
     assert_eq!(
         e.to_string(),
-        "path longer than the device keeps (8 ants dropped, limit 1023 steps)"
+        "path longer than the device keeps (8 ants dropped, limit 2047 steps)"
     );
     let near = link
         .plan(Point::new(0, 0), Point::new(0, 8), None)
         .expect("a goal within reach");
     assert!(near.raw_cells > 1);
+    assert_eq!(link.stray_count(), 0, "{:?}", link.take_strays());
+}
+
+/// `maps/large/maze-128-128-2`'s longest scenario ((86, 122) to (17, 99) through a maze of 2-wide
+/// corridors: the optimum has 1,379 steps, over the 1,023 this build kept while it stored the
+/// iteration's best and worst paths) plans on the STM32F411-capacity firmware, whose Hello
+/// reports 2,047 steps: bit for bit as the host core plans it with that bound (the host keeps
+/// the two paths the device walks again), and its raw path is the optimum. The upload's and the
+/// plan's times (well under a second each in QEMU) are printed (`--nocapture`), not asserted.
+#[test]
+fn the_longest_maze_128_128_2_scenario_plans_on_the_device() {
+    need_qemu!();
+    let q = Qemu::tcp();
+    let mut link = q.link();
+    let info = link.hello().expect("hello");
+    let steps = info.capacity.max_steps as usize;
+    assert_eq!(steps, DEVICE_STEPS, "{info:?}");
+    assert_eq!(
+        steps,
+        ohaca_host::replan::DEVICE_STEPS,
+        "the host's replan bound"
+    );
+    let map = load("large/maze-128-128-2.map");
+    assert!(map.cells() <= info.capacity.cells as usize);
+    let t0 = Instant::now();
+    link.set_map(&map).expect("upload");
+    let upload = t0.elapsed();
+    let (start, goal) = longest_scenario("large/maze-128-128-2-random-1.scen");
+    assert_eq!((start, goal), (Point::new(86, 122), Point::new(17, 99)));
+    let params = Params {
+        seed: 1,
+        ..info.defaults
+    };
+    let t0 = Instant::now();
+    let dev = link.plan(start, goal, Some(1)).expect("device path");
+    let took = t0.elapsed();
+    let host = core_plan_steps(&map, start, goal, &params, steps).expect("host plan");
+    assert_core_path("maze-128-128-2", &host, &dev);
+    assert_eq!(dev.raw_cells, 1380, "the optimum's 1,379 steps");
+    assert!(
+        (f64::from(dev.raw_length) - 1458.1148).abs() < 0.001,
+        "raw {}",
+        dev.raw_length
+    );
+    // The bound is what lets it through: with the old one no ant arrives.
+    let old = core_plan_steps(&map, start, goal, &params, 1023).err();
+    assert_eq!(
+        old.map(|e| (e.code, e.limit)),
+        Some((ErrorCode::PathTooLong, 1023))
+    );
+    println!(
+        "maze-128-128-2 {start:?} -> {goal:?}: upload {:.1} s, plan {:.1} s over QEMU's UART; \
+         {} cells, raw {}, length {}, {} iterations, {} ticks",
+        upload.as_secs_f64(),
+        took.as_secs_f64(),
+        dev.raw_cells,
+        dev.raw_length,
+        dev.length,
+        dev.iterations,
+        dev.ticks
+    );
     assert_eq!(link.stray_count(), 0, "{:?}", link.take_strays());
 }

@@ -20,32 +20,11 @@ use ohaca::{Params, Point};
 use ohaca_host::link::{LinkError, PlanJob};
 use ohaca_host::replan::{DevicePlanner, HostPlanner, Planned, Planner};
 use ohaca_host::Map;
-use qemu::{assert_core_path, core_plan, have_qemu, maps, Qemu};
+use qemu::{assert_core_path, core_plan, have_qemu, longest_scenario, maps, Qemu};
 
 /// The F411's capacity (`src/firmware/board/mod.rs`, `SMALL`).
 const CELLS: u32 = 262_144;
 const STEPS: u32 = 2047;
-
-/// The longest scenario of a Moving AI scenario file (start, goal).
-fn longest_scenario(scen: &str) -> (Point, Point) {
-    let text = std::fs::read_to_string(maps().join(scen)).expect("scenario file");
-    let mut best: Option<(f64, Point, Point)> = None;
-    for l in text.lines().skip(1) {
-        let f: Vec<&str> = l.split('\t').collect();
-        let n = |i: usize| f.get(i).and_then(|v| v.trim().parse::<u16>().ok());
-        let (Some(sx), Some(sy), Some(gx), Some(gy)) = (n(4), n(5), n(6), n(7)) else {
-            continue;
-        };
-        let Some(len) = f.get(8).and_then(|v| v.trim().parse::<f64>().ok()) else {
-            continue;
-        };
-        if best.is_none_or(|(b, _, _)| len > b) {
-            best = Some((len, Point::new(sx, sy), Point::new(gx, gy)));
-        }
-    }
-    let (_, s, g) = best.expect("scenarios");
-    (s, g)
-}
 
 #[test]
 fn the_f411_build_takes_262144_cells_and_refuses_more() {

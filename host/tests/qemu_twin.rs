@@ -22,7 +22,9 @@ use ohaca::protocol::{ErrorCode, ErrorReply};
 use ohaca::{Params, Point};
 use ohaca_host::link::{LinkError, PlanJob};
 use ohaca_host::Map;
-use qemu::{assert_core_path, core_plan_steps, have_qemu, maps, twin_firmware, Qemu};
+use qemu::{
+    assert_core_path, core_plan_steps, have_qemu, longest_scenario, maps, twin_firmware, Qemu,
+};
 
 /// The H743's capacity (`src/firmware/board/mod.rs`, `LARGE`).
 const CELLS: u32 = 2_097_152;
@@ -33,27 +35,6 @@ fn error_code<T: std::fmt::Debug>(r: Result<T, LinkError>) -> ErrorReply {
         Err(LinkError::Device { error, .. }) => error,
         other => panic!("expected a device error, got {other:?}"),
     }
-}
-
-/// The longest scenario of a Moving AI scenario file (start, goal).
-fn longest_scenario(scen: &str) -> (Point, Point) {
-    let text = std::fs::read_to_string(maps().join(scen)).expect("scenario file");
-    let mut best: Option<(f64, Point, Point)> = None;
-    for l in text.lines().skip(1) {
-        let f: Vec<&str> = l.split('\t').collect();
-        let n = |i: usize| f.get(i).and_then(|v| v.trim().parse::<u16>().ok());
-        let (Some(sx), Some(sy), Some(gx), Some(gy)) = (n(4), n(5), n(6), n(7)) else {
-            continue;
-        };
-        let Some(len) = f.get(8).and_then(|v| v.trim().parse::<f64>().ok()) else {
-            continue;
-        };
-        if best.is_none_or(|(b, _, _)| len > b) {
-            best = Some((len, Point::new(sx, sy), Point::new(gx, gy)));
-        }
-    }
-    let (_, s, g) = best.expect("scenarios");
-    (s, g)
 }
 
 /// A 2048 x 1024 map (exactly the twin's 2,097,152 cells), blocked but for four corridors four
@@ -144,9 +125,10 @@ fn a_1024x1024_city_plans_bit_identical_to_the_host() {
     assert_eq!(link.stray_count(), 0, "{:?}", link.take_strays());
 }
 
-/// `maze-128-128-2`'s longest scenario (a 1-wide maze; the optimum has 1,379 steps, more than the
-/// STM32F411 build's 1,023, which answers `PathTooLong`): the twin plans it, bit for bit as the
-/// host core with the twin's capacity, and its raw path is the optimum.
+/// `maze-128-128-2`'s longest scenario (a maze of 2-wide corridors; the optimum has 1,379 steps,
+/// which the STM32F411 build's 2,047 also hold: `qemu_e2e`'s
+/// `the_longest_maze_128_128_2_scenario_plans_on_the_device`): the twin plans it, bit for bit as
+/// the host core with the twin's capacity, and its raw path is the optimum.
 #[test]
 fn the_longest_maze_128_128_2_scenario_plans_on_the_twin() {
     need_qemu!();
@@ -176,7 +158,7 @@ fn the_longest_maze_128_128_2_scenario_plans_on_the_twin() {
     );
 }
 
-/// A 2048 x 1024 map, all the cells the twin holds: a path of 4,632 steps (four times what the
+/// A 2048 x 1024 map, all the cells the twin holds: a path of 4,632 steps (over twice what the
 /// STM32F411 keeps) is the host core's, bit for bit; a path of about 9,000 steps is
 /// `PathTooLong` with the twin's limit, as the host core says; a path of 6,658 steps, whose
 /// reply (6.8 KB) was over protocol 6's largest frame (`MAX_REPLY`, 5,248 bytes, then `Error

@@ -39,7 +39,8 @@ pub const PLAN_CELLS: usize = MAX_CELLS;
 /// plan no ant finishes that way is `Error PathTooLong`): the board's [`board::CAPACITY`]. A
 /// straight path across a 256 x 256 map has at most 255 steps, but a maze's or a long corridor's
 /// (4096 x 16) can be far longer: the longest scenario of `maps/large/maze-128-128-2` has 1,379
-/// steps (BENCHMARKS.md, section 4).
+/// steps (BENCHMARKS.md, section 4), within the 2,047 of the STM32F411 and the default QEMU
+/// board (the STM32H743 and its twin keep 8,191).
 pub const PLAN_STEPS: usize = board::CAPACITY.steps;
 /// The planner's storage (`super::buffers`): one `ohaca::planner::Storage` static on the small
 /// boards, buffers spread over the RAM regions on the STM32H743 and its twin.

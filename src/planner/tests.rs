@@ -176,13 +176,13 @@ fn start_equals_goal() {
 #[test]
 fn storage_size_matches_the_formula() {
     assert_eq!(core::mem::size_of::<CurvePoint>(), 16);
-    type Device = Storage<{ crate::bitmap::words(65536) }, 1024, 4096, 1024>;
+    type Walking = Storage<{ crate::bitmap::words(65536) }, 1024, 4096, 1024>;
     type Kept = Storage<{ crate::bitmap::words(65536) }, 1024, 4096, 1024, 128, 1024>;
     // Pheromone and increments, two bit sets, the move table, two tours (the iteration's best
     // and worst are walked again), points, links, curve, the coarse route.
     let want =
         2 * 16 * 1024 + 2 * 8192 + 1024 + 2 * 1024 + 4 * 1024 + 4 * 4096 + 16 * 128 + 4 * 4096;
-    assert_eq!(Device::BYTES, want);
+    assert_eq!(Walking::BYTES, want);
     assert_eq!(Kept::BYTES, want + 2 * 1024);
     // `Workspace::bytes` for the same capacities (1023 steps) gives the same but for the last
     // byte of each tour the storage rounds up to, and the links beyond the 2048 it needs.
@@ -193,6 +193,19 @@ fn storage_size_matches_the_formula() {
     assert_eq!(
         Workspace::bytes_walking_again(65536, 1023, false, 128) + 1024 + 4 * (4096 - 2048),
         want - 2
+    );
+    // The STM32F411's and the default QEMU board's storage (`firmware::buffers`: paths of 2,047
+    // steps, no curve, the iteration's best and worst walked again) is the boot log's 95,232
+    // bytes; its 4,096 links are exactly what tightening needs for 2,047 steps.
+    type F411 = Storage<{ crate::bitmap::words(65536) }, 2048, 4096, 1024, 0, 0>;
+    assert_eq!(
+        F411::BYTES,
+        2 * 16 * 1024 + 2 * 8192 + 1024 + 2 * 2048 + 4 * 2048 + 4 * 4096 + 4 * 4096
+    );
+    assert_eq!(F411::BYTES, 95_232);
+    assert_eq!(
+        Workspace::bytes_walking_again(65536, 2047, false, 0) + 1024 + 2,
+        F411::BYTES
     );
 }
 

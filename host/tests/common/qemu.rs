@@ -339,6 +339,28 @@ pub fn expected_errors(bytes: &[u8]) -> Vec<(u32, ErrorReply)> {
 
 // ---- the host's reference ------------------------------------------------------------------
 
+/// The longest scenario of a Moving AI scenario file under `maps/` (start, goal): the largest
+/// optimum, the first of equals.
+pub fn longest_scenario(scen: &str) -> (Point, Point) {
+    let text = std::fs::read_to_string(maps().join(scen)).expect("scenario file");
+    let mut best: Option<(f64, Point, Point)> = None;
+    for l in text.lines().skip(1) {
+        let f: Vec<&str> = l.split('\t').collect();
+        let n = |i: usize| f.get(i).and_then(|v| v.trim().parse::<u16>().ok());
+        let (Some(sx), Some(sy), Some(gx), Some(gy)) = (n(4), n(5), n(6), n(7)) else {
+            continue;
+        };
+        let Some(len) = f.get(8).and_then(|v| v.trim().parse::<f64>().ok()) else {
+            continue;
+        };
+        if best.is_none_or(|(b, _, _)| len > b) {
+            best = Some((len, Point::new(sx, sy), Point::new(gx, gy)));
+        }
+    }
+    let (_, s, g) = best.expect("scenarios");
+    (s, g)
+}
+
 /// A plan as the host's copy of the core computes it: every field of a `Path` reply but
 /// `ticks`.
 #[derive(Clone, Debug, PartialEq)]
@@ -355,6 +377,10 @@ pub struct CorePath {
     pub directions: Vec<u8>,
 }
 
+/// The default QEMU firmware's longest ant path, the STM32F411's (`firmware::state::PLAN_STEPS`,
+/// Hello's `capacity.max_steps`; `qemu_e2e`'s maze test checks it against Hello).
+pub const DEVICE_STEPS: usize = 2047;
+
 /// Plan as the firmware does (`ohaca::plan` on the map's grid), on the host: the path, or the
 /// error reply the device must send.
 pub fn core_plan(
@@ -368,14 +394,16 @@ pub fn core_plan(
     let grid = map.grid().map_err(ErrorReply::from)?;
     params.validate().map_err(ErrorReply::from)?;
     let mut arena = vec![0u32; ohaca::planner::arena::F411_WORDS];
-    let ws = ohaca::planner::arena::carve(&mut arena, map.cells(), 2047)?.workspace;
+    let ws = ohaca::planner::arena::carve(&mut arena, map.cells(), DEVICE_STEPS)?.workspace;
     let plan = ohaca::plan(&grid, start, goal, params, ws)?;
     Ok(core_path(&plan))
 }
 
 /// [`core_plan`] for a device that keeps ant paths of up to `steps` steps (Hello's
 /// `capacity.max_steps`), with the device's workspace shape: links for `steps`, the move table
-/// only on maps of up to 1024 cells, as the firmware has it (`firmware::buffers`).
+/// only on maps of up to 1024 cells, as the firmware has it (`firmware::buffers`). The host keeps
+/// the iteration's best and worst paths where the STM32F411 build walks those ants again, so a
+/// match also checks that both ways plan alike.
 pub fn core_plan_steps(
     map: &Map,
     start: Point,
