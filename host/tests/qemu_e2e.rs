@@ -1021,20 +1021,20 @@ fn send_command_over_tcp() {
     let big = maps().join("movingai/random-32-32-10.map");
     let dir = tempfile::tempdir().expect("tempdir");
     let huge = dir.path().join("huge.map");
-    let mut text = String::from("type octile\nheight 300\nwidth 300\nmap\n");
-    for _ in 0..300 {
-        text.push_str(&".".repeat(300));
+    let mut text = String::from("type octile\nheight 600\nwidth 600\nmap\n");
+    for _ in 0..600 {
+        text.push_str(&".".repeat(600));
         text.push('\n');
     }
     std::fs::write(&huge, text).expect("write map");
-    let mut a = base(&["--start", "0,0", "--goal", "299,299", "--json"]);
+    let mut a = base(&["--start", "0,0", "--goal", "599,599", "--json"]);
     a[4] = huge.display().to_string();
     let o = ohaca(&a);
     assert_eq!(o.status.code(), Some(0), "{o:?}");
     let err = String::from_utf8_lossy(&o.stderr).into_owned();
     assert_eq!(err.lines().count(), 1, "{err}");
     assert!(
-        err.starts_with("note: ") && err.contains("resampled, 2x2 cells per cell: 150x150"),
+        err.starts_with("note: ") && err.contains("resampled, 2x2 cells per cell: 300x300"),
         "{err}"
     );
     let line = json_lines(&o).remove(0);
@@ -1042,17 +1042,18 @@ fn send_command_over_tcp() {
     assert_eq!(line["raw"][0], serde_json::json!([0, 0]), "{line}");
     assert_eq!(
         line["waypoints"].as_array().and_then(|w| w.last()),
-        Some(&serde_json::json!([299, 299])),
+        Some(&serde_json::json!([599, 599])),
         "{line}"
     );
 
-    // A ROS map shaped like Nav2's TurtleBot sandbox: 384 x 384 cells of 5 cm, unknown but an
-    // 80 x 80 known area. Cropped to the known area it fits at full resolution: no resampling,
+    // A ROS map shaped like Nav2's TurtleBot sandbox, grown to 600 x 600 cells of 5 cm (more than
+    // the device's 262,144: Nav2's 384 x 384 now fits as it is), unknown but an 80 x 80 known
+    // area. Cropped to the known area it fits at full resolution: no resampling,
     // start and goal stay the free cells they are, and the path is the host's on the crop,
     // reported in the original cells and metres.
-    let mut pgm = b"P5\n384 384\n255\n".to_vec();
-    for y in 0..384u32 {
-        for x in 0..384u32 {
+    let mut pgm = b"P5\n600 600\n255\n".to_vec();
+    for y in 0..600u32 {
+        for x in 0..600u32 {
             let known = (150..230).contains(&x) && (150..230).contains(&y);
             let wall = known && x == 190 && y < 215;
             pgm.push(if !known {
@@ -1118,7 +1119,7 @@ fn send_command_over_tcp() {
         "{m}"
     );
     assert!(
-        (m[1].as_f64().unwrap() - (-10.0 + (383.0 - 152.0 + 0.5) * 0.05)).abs() < 1e-6,
+        (m[1].as_f64().unwrap() - (-10.0 + (599.0 - 152.0 + 0.5) * 0.05)).abs() < 1e-6,
         "{m}"
     );
 
@@ -1130,7 +1131,7 @@ fn send_command_over_tcp() {
     let err = String::from_utf8_lossy(&o.stderr).into_owned();
     assert_eq!(err.lines().count(), 1, "{err}");
     assert!(err.contains("map too large for the device"), "{err}");
-    assert!(err.contains("90000 cells"), "{err}");
+    assert!(err.contains("360000 cells"), "{err}");
 
     // --goals: one JSON line per request, in order, identical to the host's plans.
     let goals = dir.path().join("goals.txt");
