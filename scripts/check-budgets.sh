@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Memory budgets of the release firmware for the real board (STM32F411CE: 128 KiB RAM, 512 KiB
-# flash; issue 10: RAM <= 112 KiB, flash <= 256 KiB, maps of up to 65,536 cells (any shape) held at one bit a cell and planned at full resolution):
+# flash; issue 10: RAM <= 112 KiB, flash <= 256 KiB, maps of up to 262,144 cells (any shape) held at one bit a cell and planned at full resolution; issue 19):
 #
 #   flash      = .vector_table + .text + .rodata + .data (its load image)    <= FLASH_BUDGET (262144)
 #   static RAM = .data + .bss + .uninit
@@ -146,7 +146,7 @@ ram_ok=$(verdict "$ram" "$RAM_BUDGET")
 [ "$flash_ok" = ok ] || status=1
 [ "$ram_ok" = ok ] || status=1
 echo
-echo "== budgets: STM32F411 release firmware, maps of up to 65,536 cells (any shape) planned at full resolution, 50 ants"
+echo "== budgets: STM32F411 release firmware, maps of up to 262,144 cells (any shape) planned at full resolution in one arena, 50 ants"
 printf '| %-58s | %8s | %8s | %-11s |\n' "item" "bytes" "budget" "verdict"
 printf '| %-58s | %8s | %8s | %-11s |\n' "---" "---" "---" "---"
 printf '| %-58s | %8d | %8d | %-11s |\n' "flash (.vector_table + .text + .rodata + .data)" "$flash" "$FLASH_BUDGET" "$flash_ok"

@@ -677,8 +677,8 @@ impl Soak {
                     encode(id, &req(w, h, 0, t, &chunk))
                 }
                 5 => {
-                    // Sides that fit, cells that do not (any shape: 4096 x 17 > 65,536).
-                    let (w, h) = (4096u16, r.range(17, 100) as u16);
+                    // Sides that fit, cells that do not (any shape: 4096 x 65 > 262,144).
+                    let (w, h) = (4096u16, r.range(65, 100) as u16);
                     let t = (u32::from(w) * u32::from(h)).div_ceil(8);
                     encode(id, &req(w, h, 0, t, &chunk))
                 }

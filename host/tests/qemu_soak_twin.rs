@@ -1,6 +1,7 @@
 //! Faults at scale (issue 19, item 7): map uploads of 512 x 512 and 604 x 307 cells over QEMU's
 //! UART with injected byte drops and corruption, against the STM32H743's capacity twin (the
-//! F411-capacity firmware holds 65,536 cells, so it refuses both maps: `qemu_soak.rs` soaks it).
+//! F411-capacity firmware holds these maps too since its arena, `qemu_large.rs` plans them
+//! there; `qemu_soak.rs` soaks it with smaller ones).
 //!
 //! Each round uploads `NewYork_0_512` (512 x 512, a city) and a generated 604 x 307 depot (the
 //! shape of Nav2's sample depot: walls, racks, aisles, noise), each raw and run-length coded,

@@ -5,8 +5,9 @@
 //! its lock for a whole plan and reads it in place (no copy); the receiver writes uploads and
 //! cell updates into it. A writer first bumps [`GENERATION`] (cancelling the running plan, which
 //! sees it at its next yield and releases the lock: a writer waits at most one planner
-//! iteration), and an upload first clears [`MAP_SIZE`] (no map until its last chunk), so a plan
-//! never reads a half-written or changed map.
+//! iteration, or the sending of a path already started), and an upload first clears
+//! [`MAP_SIZE`] (no map until its last chunk), so a plan never reads a half-written or changed
+//! map.
 
 use core::cell::Cell;
 use core::sync::atomic::{AtomicBool, AtomicU32, Ordering};
@@ -25,11 +26,11 @@ use super::buffers::{MapBuf, MAP_INIT};
 use super::stack;
 
 /// Most cells of a map the device holds and plans on, whatever its shape: the board's
-/// [`board::CAPACITY`] (65,536 cells, 8 KiB at one bit a cell, on the STM32F411 and the default
-/// QEMU board, so what QEMU proves holds on the chip; 2,097,152 cells on the STM32H743 and its
-/// QEMU twin).
+/// [`board::CAPACITY`] (262,144 cells, 32 KiB at one bit a cell in the arena the planner's
+/// buffers share, on the STM32F411 and the default QEMU board, so what QEMU proves holds on the
+/// chip; 2,097,152 cells on the STM32H743 and its QEMU twin).
 pub const MAX_CELLS: usize = board::CAPACITY.cells;
-/// Longest side of a map the device takes (a 4096 x 16 corridor has as many cells as 256 x 256).
+/// Longest side of a map the device takes (a 4096 x 64 corridor has as many cells as 512 x 512).
 pub const MAX_SIDE: u16 = 4096;
 /// Bytes of the map buffer.
 pub const MAP_BYTES: usize = MAX_CELLS.div_ceil(8);
@@ -40,10 +41,12 @@ pub const PLAN_CELLS: usize = MAX_CELLS;
 /// straight path across a 256 x 256 map has at most 255 steps, but a maze's or a long corridor's
 /// (4096 x 16) can be far longer: the longest scenario of `maps/large/maze-128-128-2` has 1,379
 /// steps (BENCHMARKS.md, section 4), within the 2,047 of the STM32F411 and the default QEMU
-/// board (the STM32H743 and its twin keep 8,191).
+/// board (the STM32H743 and its twin keep 8,191). On the small boards' maps of more than 68,256
+/// cells the arena leaves fewer (`ohaca::planner::arena::steps_for`: 1,876 at 512 x 512).
 pub const PLAN_STEPS: usize = board::CAPACITY.steps;
-/// The planner's storage (`super::buffers`): one `ohaca::planner::Storage` static on the small
-/// boards, buffers spread over the RAM regions on the STM32H743 and its twin.
+/// The planner's storage (`super::buffers`): nothing of its own on the small boards (its
+/// buffers are carved out of [`MAP`]'s arena per plan), buffers spread over the RAM regions on
+/// the STM32H743 and its twin.
 pub use super::buffers::PlanStorage;
 /// The map limits, for [`ohaca::protocol::Upload`].
 pub const LIMITS: MapLimits = MapLimits {
@@ -80,8 +83,9 @@ pub struct Out(pub u32, pub Reply<'static>);
 pub type TxPort = Mutex<Raw, board::Tx>;
 
 /// The map buffer, packed as `ohaca::grid` stores a map; [`MAP_SIZE`] says what it holds. On the
-/// small boards the [`MAP_BYTES`] bytes themselves; on the STM32H743 and its twin a static of
-/// the AXI SRAM that `super::buffers::take` lends to this lock at boot (`super::buffers`).
+/// small boards the first [`MAP_BYTES`] bytes of the arena the planner's buffers share (103,424
+/// bytes in all, `super::buffers`); on the STM32H743 and its twin a static of the AXI SRAM that
+/// `super::buffers::take` lends to this lock at boot.
 pub static MAP: Mutex<Raw, MapBuf> = Mutex::new(MAP_INIT);
 /// Width and height of the complete map in [`MAP`]; `None`: no map (none yet, an upload in
 /// progress, or a failed one).

@@ -11,7 +11,7 @@ use static_cell::ConstStaticCell;
 
 use super::{Board, Capacity};
 
-/// Maps of up to 65,536 cells, paths of up to 2,047 steps.
+/// Maps of up to 262,144 cells, paths of up to 2,047 steps (fewer above 68,256 cells).
 pub const CAPACITY: Capacity = super::SMALL;
 
 bind_interrupts!(struct Irqs {

@@ -170,7 +170,7 @@ fn hello() -> HelloReply<'static> {
         firmware_version: "0.1.0",
         board: "qemu-mps2-an386",
         capacity: Capacity {
-            cells: 65536,
+            cells: 262_144,
             max_side: 4096,
             max_steps: 2047,
             max_chunk: MAX_CHUNK as u16,
