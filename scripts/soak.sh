@@ -4,11 +4,11 @@
 #     frames (default 100000; the test's own default is 10000) and print its summary (frames
 #     sent per kind, replies, errors, the device's counters, wall time). About 2 ms a frame on a
 #     2-core machine (QEMU feeds its UART 10 to 16 KB/s): 100000 frames take 3 to 4 minutes.
-#  2. faults at scale, on the STM32H743's capacity twin (`--features twin-h743`; the F411 build
-#     cannot hold these maps): host/tests/qemu_soak_twin.rs with ROUNDS rounds (default 10; the
+#  2. faults at scale, on the STM32H743's capacity twin (`--features twin-h743`) and on the F411
+#     build (which holds these maps in its arena): host/tests/qemu_soak_twin.rs with ROUNDS rounds (default 10; the
 #     test's own default is 1), each uploading a 512 x 512 and a 604 x 307 map raw and run-length
 #     coded with injected byte drops and corruption, broken uploads redone, plans checked against
-#     the host core. About 20 s a round. ROUNDS = 0 skips it.
+#     the host core. About 25 s a round on each firmware, the two in parallel. ROUNDS = 0 skips it.
 # Both are seeded: set OHACA_SOAK_SEED to try another stream.
 #   scripts/soak.sh [FRAMES [ROUNDS]]
 set -euo pipefail

@@ -1,7 +1,7 @@
 //! Faults at scale (issue 19, item 7): map uploads of 512 x 512 and 604 x 307 cells over QEMU's
-//! UART with injected byte drops and corruption, against the STM32H743's capacity twin (the
-//! F411-capacity firmware holds these maps too since its arena, `qemu_large.rs` plans them
-//! there; `qemu_soak.rs` soaks it with smaller ones).
+//! UART with injected byte drops and corruption, against the STM32H743's capacity twin and
+//! against the F411-capacity firmware (the default QEMU build), which holds these maps in its
+//! arena (`ohaca::planner::arena`); `qemu_soak.rs` soaks the latter with many small frames.
 //!
 //! Each round uploads `NewYork_0_512` (512 x 512, a city) and a generated 604 x 307 depot (the
 //! shape of Nav2's sample depot: walls, racks, aisles, noise), each raw and run-length coded,
@@ -45,7 +45,10 @@ use ohaca::protocol::{
 use ohaca::{Params, Point};
 use ohaca_host::link::Response;
 use ohaca_host::Map;
-use qemu::{assert_core_path, core_plan_steps, have_qemu, maps, twin_firmware, Qemu};
+use qemu::{
+    assert_core_path, core_plan, core_plan_steps, firmware, have_qemu, maps, twin_firmware,
+    CorePath, Qemu,
+};
 
 const DEFAULT_ROUNDS: usize = 1;
 const DEFAULT_SEED: u64 = 0x0ACA_5CA1;
@@ -452,6 +455,26 @@ fn free_near(map: &Map, x: u16, y: u16) -> Point {
 #[test]
 fn uploads_of_512x512_and_604x307_survive_drops_and_corruption() {
     need_qemu!();
+    soak_at_scale(twin_firmware(), |map, start, goal, params| {
+        core_plan_steps(map, start, goal, params, 8191)
+    });
+}
+
+/// The same soak on the STM32F411-capacity firmware (the default QEMU build), which holds these
+/// maps since it plans them in one arena with the map (`ohaca::planner::arena`): every plan is
+/// the host core's in an arena of the same length (`core_plan`).
+#[test]
+fn the_f411_build_survives_the_same_uploads() {
+    need_qemu!();
+    soak_at_scale(firmware(), core_plan);
+}
+
+/// Upload both maps `OHACA_SOAK_SCALE_ROUNDS` times (default 1) to the firmware `elf` through the
+/// faults, and require every plan to be `core`'s.
+fn soak_at_scale(
+    elf: &std::path::Path,
+    core: impl Fn(&Map, Point, Point, &Params) -> Result<CorePath, ErrorReply>,
+) {
     let rounds: usize = std::env::var("OHACA_SOAK_SCALE_ROUNDS")
         .ok()
         .and_then(|v| v.parse().ok())
@@ -461,12 +484,11 @@ fn uploads_of_512x512_and_604x307_survive_drops_and_corruption() {
         .and_then(|v| v.parse().ok())
         .unwrap_or(DEFAULT_SEED);
     let mut rng = Rng(seed);
-    let mut q = Qemu::tcp_with(twin_firmware());
+    let mut q = Qemu::tcp_with(elf);
     let mut dev = Device::new(&q);
     let t0 = Instant::now();
     let new_york = Map::load(maps().join("large/NewYork_0_512.map")).expect("NewYork_0_512");
     let depot = depot(seed);
-    let steps = 8191;
     // Cheap plans: the point is the map, not the colony.
     let params = Params {
         ants: 8,
@@ -551,7 +573,7 @@ fn uploads_of_512x512_and_604x307_survive_drops_and_corruption() {
                     goal,
                     seed: Some(seed),
                 });
-                let core = core_plan_steps(map, start, goal, &Params { seed, ..params }, steps);
+                let core = core(map, start, goal, &Params { seed, ..params });
                 let outcome = match (r, core) {
                     (Response::Path(p), Ok(c)) => {
                         assert_core_path(name, &c, &p);
