@@ -5,7 +5,7 @@
 //!   2,047 steps): one arena of 103,424 bytes in `.bss`, inside `state::MAP`'s lock: the map in
 //!   its first bytes, the planner's buffers after it, laid out per map by
 //!   `ohaca::planner::arena::carve` when a plan starts ([`lend`]). A 256 x 256 map leaves the
-//!   planner every buffer the former fixed `Storage` had; a 512 x 512 one takes 32 KiB and
+//!   planner every buffer a fixed 95,232-byte `Storage` would have; a 512 x 512 one takes 32 KiB and
 //!   leaves the compact layout.
 //! - **STM32H743 and its QEMU twin** (`twin-h743`; maps of up to 2,097,152 cells, paths of up
 //!   to 8,191 steps): the map (256 KiB) and the planner's two per-cell bit sets (256 KiB each)

@@ -142,7 +142,7 @@ impl<'a> Workspace<'a> {
 
     /// The largest map (in cells) this workspace can plan on: as many as its bit sets hold, and
     /// with fewer than [`BLOCKS`] pheromone entries at most that many, except on a workspace
-    /// without pruning marks (`dead` empty, [`Workspace::carve`]'s compact layout), where a map
+    /// without pruning marks (`dead` empty, [`crate::planner::arena::carve`]'s compact layout), where a map
     /// of more cells than `tau` has entries gets blocks of cells
     /// ([`Workspace::pheromone_budget`]).
     pub fn capacity(&self) -> usize {
