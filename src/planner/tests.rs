@@ -775,7 +775,9 @@ fn walking_the_iterations_best_and_worst_again_plans_what_keeping_them_does() {
     // Every algorithm (with and without the wolves rule), both dead-end rules, with and without
     // tightening, short and full runs, on maps with and without blocks and the coarse route,
     // with the local search's move budget (maze) and with ants dropped for their length.
-    let mut cases: Vec<(Vec<u8>, u16, u16, Point, Point, Params, usize)> = Vec::new();
+    // The map's bits and size, start, goal, parameters, step bound.
+    type Case = (Vec<u8>, u16, u16, Point, Point, Params, usize);
+    let mut cases: Vec<Case> = Vec::new();
     for seed in 1..=3u64 {
         let (b, w, h) = large_map(seed);
         for algorithm in [
