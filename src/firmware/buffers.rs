@@ -118,8 +118,9 @@ mod layout {
     use ohaca::bitmap::words;
     use ohaca::grid::{Dir, Point};
     use ohaca::pheromone::BLOCKS;
-    use ohaca::planner::{Buffers, CurvePoint, Workspace};
+    use ohaca::planner::{Buffers, Workspace};
     use ohaca::route::GUIDE_BLOCKS;
+    use ohaca::tighten::hash_words;
 
     use crate::firmware::state::{MAP_BYTES, PLAN_CELLS, PLAN_STEPS};
 
@@ -150,17 +151,18 @@ mod layout {
     const WORDS: usize = words(PLAN_CELLS);
     /// Entries of each tour and of the path cells: paths of up to [`PLAN_STEPS`] steps.
     const STEPS: usize = PLAN_STEPS + 1;
-    /// Links: two per path cell (tightening's positions and its hash table), and at least the
-    /// coarse route's blocks.
-    const LINKS: usize = if 2 * STEPS > GUIDE_BLOCKS {
-        2 * STEPS
+    /// Links: tightening's smallest hash table for the longest path (`ohaca::tighten::hash_words`:
+    /// 32,768 half-word slots for 16,385 cells, a load factor of up to 2/3; one of 1/2 would
+    /// need 65,536), and at least the coarse route's blocks (its heap): 16,384 words, all of
+    /// SRAM4. The host mirrors it (`host/tests/common/qemu.rs`, `core_plan_steps`).
+    const LINKS: usize = if hash_words(STEPS) > GUIDE_BLOCKS {
+        hash_words(STEPS)
     } else {
         GUIDE_BLOCKS
     };
+    const _: () = assert!(4 * LINKS <= 65_536);
     /// The move table for maps of up to this many cells (larger maps compute moves on the fly).
     const MOVES: usize = 1024;
-    /// Iterations of the convergence curve kept.
-    const CURVE: usize = 128;
 
     /// Memory the startup code does not initialise (a NOLOAD section): [`Region::fill`] writes
     /// every element before the memory is lent out, once.
@@ -211,26 +213,22 @@ mod layout {
     /// Links: SRAM4.
     #[link_section = ".sram4.links"]
     static LINKS_BUF: Region<u32, LINKS> = Region::new();
+    /// The coarse route: ITCM (data accesses from the CPU; the section starts 8 bytes in, so no
+    /// static is at address 0).
+    #[link_section = ".itcm.guide"]
+    static GUIDE: Region<u32, GUIDE_BLOCKS> = Region::new();
 
-    /// What stays in the DTCM's `.bss` (zeroed by the startup code): the tours, the path cells,
-    /// the coarse route, the curve and the move table.
+    /// What stays in the DTCM's `.bss` (zeroed by the startup code): the ant's tour and the
+    /// best one (the iteration's best and worst ants are walked again instead of kept), the path
+    /// cells and the move table.
     struct Dtcm {
-        tours: [[Dir; STEPS]; 4],
+        tours: [[Dir; STEPS]; 2],
         points: [Point; STEPS],
-        guide: [u32; GUIDE_BLOCKS],
-        curve: [CurvePoint; CURVE],
         moves: [u8; MOVES],
     }
     static DTCM: ConstStaticCell<Dtcm> = ConstStaticCell::new(Dtcm {
-        tours: [[0; STEPS]; 4],
+        tours: [[0; STEPS]; 2],
         points: [Point::new(0, 0); STEPS],
-        guide: [0; GUIDE_BLOCKS],
-        curve: [CurvePoint {
-            best: 0.0,
-            mean: 0.0,
-            best_so_far: 0.0,
-            arrived: 0,
-        }; CURVE],
         moves: [0; MOVES],
     });
 
@@ -240,6 +238,7 @@ mod layout {
     pub const BYTES: usize = 2 * size_of::<[u32; WORDS]>()
         + 2 * size_of::<[[f32; 4]; BLOCKS]>()
         + size_of::<[u32; LINKS]>()
+        + size_of::<[u32; GUIDE_BLOCKS]>()
         + size_of::<Dtcm>();
 
     /// The planner's buffers, each a `'static` slice of its own static.
@@ -249,27 +248,27 @@ mod layout {
         tabu: &'static mut [u32],
         dead: &'static mut [u32],
         moves: &'static mut [u8],
-        tours: [&'static mut [Dir]; 4],
+        tours: [&'static mut [Dir]; 2],
         points: &'static mut [Point],
         links: &'static mut [u32],
-        curve: &'static mut [CurvePoint],
         guide: &'static mut [u32],
     }
 
     impl PlanStorage {
-        /// Lend the buffers as a workspace for one run.
+        /// Lend the buffers as a workspace for one run (no convergence curve: the device does
+        /// not report one).
         pub fn workspace(&mut self) -> Workspace<'_> {
-            let [t0, t1, t2, t3] = &mut self.tours;
+            let [tour, best] = &mut self.tours;
             Workspace::new(Buffers {
                 tau: self.tau,
                 delta: self.delta,
                 tabu: self.tabu,
                 dead: self.dead,
                 moves: self.moves,
-                tours: [t0, t1, t2, t3],
+                tours: [tour, &mut [], &mut [], best],
                 points: self.points,
                 links: self.links,
-                curve: self.curve,
+                curve: &mut [],
                 guide: self.guide,
             })
         }
@@ -297,7 +296,7 @@ mod layout {
         let taken = TAKEN.swap(true, Ordering::AcqRel);
         defmt::assert!(!taken, "the planner's buffers are taken once");
         // SAFETY: once (`TAKEN`), so each region is filled and lent once.
-        let (map, tabu, dead, tau, delta, links) = unsafe {
+        let (map, tabu, dead, tau, delta, links, guide) = unsafe {
             (
                 MAP.fill(0),
                 TABU.fill(0),
@@ -305,21 +304,21 @@ mod layout {
                 TAU.fill([0.0; 4]),
                 DELTA.fill([0.0; 4]),
                 LINKS_BUF.fill(0),
+                GUIDE.fill(0),
             )
         };
         let dtcm = DTCM.take();
-        let [t0, t1, t2, t3] = &mut dtcm.tours;
+        let [t0, t1] = &mut dtcm.tours;
         let storage = STORAGE.take().insert(PlanStorage {
             tau,
             delta,
             tabu,
             dead,
             moves: &mut dtcm.moves,
-            tours: [t0, t1, t2, t3],
+            tours: [t0, t1],
             points: &mut dtcm.points,
             links,
-            curve: &mut dtcm.curve,
-            guide: &mut dtcm.guide,
+            guide,
         });
         let mut buf = defmt::unwrap!(
             crate::firmware::state::MAP.try_lock().ok(),
