@@ -466,7 +466,7 @@ fn uploads_of_512x512_and_604x307_survive_drops_and_corruption() {
     let t0 = Instant::now();
     let new_york = Map::load(maps().join("large/NewYork_0_512.map")).expect("NewYork_0_512");
     let depot = depot(seed);
-    let steps = 8191;
+    let steps = 16_384;
     // Cheap plans: the point is the map, not the colony.
     let params = Params {
         ants: 8,
