@@ -8,7 +8,7 @@
 //!   planner every buffer the former fixed `Storage` had; a 512 x 512 one takes 32 KiB and
 //!   leaves the compact layout.
 //! - **STM32H743 and its QEMU twin** (`twin-h743`; maps of up to 2,097,152 cells, paths of up
-//!   to 8,191 steps): the map (256 KiB) and the planner's two per-cell bit sets (256 KiB each)
+//!   to 16,384 steps): the map (256 KiB) and the planner's two per-cell bit sets (256 KiB each)
 //!   do not fit one RAM region (the largest, the AXI SRAM, has 512 KiB), so every buffer is a
 //!   static of its own, placed with `#[link_section]` into the board's regions
 //!   (`board/stm32h743-memory.x`, `board/qemu/twin-h743-memory.x`), and the planner's workspace
@@ -18,14 +18,23 @@
 //! | --- | --- | --- | ---: |
 //! | AXI SRAM (512 KiB) | `.axisram` (NOLOAD) | map, `tabu` | 262,144 + 262,144 |
 //! | SRAM1-3 (288 KiB) | `.sram123` (NOLOAD) | `dead`, `tau`, `delta` | 262,144 + 16,384 + 16,384 |
-//! | SRAM4 (64 KiB) | `.sram4` (NOLOAD) | `links` (2 x 8,192) | 65,536 |
-//! | DTCM (128 KiB) | `.bss` | 4 tours (8,192 each), `points` (8,192), `guide`, `curve`, `moves` | 32,768 + 32,768 + 16,384 + 2,048 + 1,024 |
+//! | SRAM4 (64 KiB) | `.sram4` (NOLOAD) | `links` (16,384) | 65,536 |
+//! | ITCM (64 KiB) | `.itcm` (NOLOAD) | 8 bytes left out (no static at address 0), `guide` | 8 + 16,384 |
+//! | DTCM (128 KiB) | `.bss` | 2 tours (16,385 each), `points` (16,385), `moves` | 32,770 + 65,540 + 1,024 |
 //!
-//! Every region but the DTCM is then full to the byte; the DTCM keeps 45 KiB for the rest of the
-//! firmware's statics (about 6 KiB) and the stack (3.4 KiB measured: BENCHMARKS.md, section 5b). An ant path step costs 16 bytes (a byte in each of
-//! the four tours, a 4-byte path cell, two 4-byte links): 8,192 steps take 128 KiB, which is
-//! what the regions have left beside the 768 KiB of per-cell bits (16,384 steps would need
-//! 256 KiB).
+//! Every region but the DTCM and the ITCM is then full to the byte; the DTCM keeps about 22 KiB
+//! for the rest of the firmware's statics (about 6 KiB) and the stack (about 3.4 KiB measured,
+//! BENCHMARKS.md, section 5b), within the budget of 120 KiB. An ant path step costs 6 bytes of
+//! DTCM: a byte in each of the two tours (the iteration's best and worst ants are walked again
+//! rather than kept, as on the STM32F411) and a 4-byte path cell. The links (tightening's
+//! positions, the coarse route's heap, the smoothing's links) are tightening's smallest hash
+//! table for the longest path (`ohaca::tighten::hash_words`): 32,768 half-word slots for 16,385
+//! cells, a load factor of up to 2/3 (one of 1/2 would need 128 KiB), which tightens exactly as
+//! the per-cell index does. The device records no convergence curve (it never reports one), and
+//! the coarse route moved from the DTCM to the ITCM (the CPU reads and writes it as data). Only
+//! a best path of exactly 16,384 steps (16,385 cells, one more than the links) is smoothed
+//! greedily instead of by the shortest-path smoothing; the host plans it alike
+//! (`host/tests/common/qemu.rs`, `core_plan_steps`).
 //!
 //! The NOLOAD sections are not touched by the startup code (cortex-m-rt zeroes `.bss` only), so
 //! their statics are `Region`s, `MaybeUninit` memory that [`take`] fills with zeros element by
