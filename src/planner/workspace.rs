@@ -251,10 +251,10 @@ impl<'a> Workspace<'a> {
             tabu: cut(tabu, w),
             dead: cut(dead, w),
             moves: moves.split_at_mut(moves_len).0,
-            tour: tour.split_at_mut(steps).0,
+            tour: tour.split_at_mut(steps.min(tour.len())).0,
             iter_best: iter_best.split_at_mut(steps.min(iter_best.len())).0,
             iter_worst: iter_worst.split_at_mut(steps.min(iter_worst.len())).0,
-            best: best.split_at_mut(steps).0,
+            best: best.split_at_mut(steps.min(best.len())).0,
             points: points
                 .split_at_mut(steps.saturating_add(1).min(points.len()))
                 .0,
