@@ -155,12 +155,7 @@ pub fn tighten(
 /// that if it still has at least `3n / 2` slots (load factor at most 2/3), else `None` (the path
 /// is left untightened). Two 16-bit slots a word for paths of fewer than 65,535 cells.
 fn hash_slots(n: usize, words: usize) -> Option<usize> {
-    let Some(twice) = n.checked_mul(2) else {
-        return None;
-    };
-    let Some(want) = twice.checked_next_power_of_two() else {
-        return None;
-    };
+    let want = n.checked_mul(2)?.checked_next_power_of_two()?;
     let half = n < u16::MAX as usize;
     let fits = |slots: usize| words >= if half { slots.div_ceil(2) } else { slots };
     if fits(want) {
