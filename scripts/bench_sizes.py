@@ -14,7 +14,7 @@ map's bytes in the device's one map buffer, the bytes a raw upload's frames put 
 their time at 115200 8N1, the iterations, the instructions of the plan
 (from `Run::new` to the smoothed path; `Path.ticks`), its split (with defmt-print), and the raw
 length against the `.scen` optimum. A plan that fails shows its error (a path longer than the
-2,047 steps the device keeps, 8,191 on the twin, is `PathTooLong`). A map beyond the device's
+2,047 steps the device keeps, 16,384 on the twin, is `PathTooLong`). A map beyond the device's
 capacity (Hello's `cells`) is uploaded all the same: its row shows the device's refusal and what
 the map would need.
 The planner's storage does not grow with the map (`BENCHMARKS.md` section 5).

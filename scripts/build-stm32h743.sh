@@ -12,13 +12,23 @@ target_dir=target/stm32h743
 cargo build --release --no-default-features --features board-stm32h743 --target-dir "$target_dir" "$@"
 elf="$target_dir/thumbv7em-none-eabihf/release/ohaca"
 scripts/firmware-size.sh "$elf"
-# The regions beside the DTCM (static RAM above): NOLOAD sections of stm32h743-memory.x.
-readelf -SW "$elf" | sed -n 's/^ *\[ *[0-9]*\] //p' | awk '$1 ~ /^\.(axisram|sram123|sram4)$/ {print $1, $5}' |
-  while read -r name size; do
-    case "$name" in
-      .axisram) region="AXI SRAM, 524288" ;;
-      .sram123) region="SRAM1-3, 294912" ;;
-      *) region="SRAM4, 65536" ;;
-    esac
-    printf '  %-14s %8d  (%s)\n' "$name" "$((16#$size))" "$region"
-  done
+# The regions beside the DTCM (static RAM above): NOLOAD sections of stm32h743-memory.x, each
+# against its region's size (the linker refuses an overflow too); exit 1 if one is over.
+status=0
+while read -r name size; do
+  size=$((16#$size))
+  case "$name" in
+    .axisram) region="AXI SRAM"; limit=524288 ;;
+    .sram123) region="SRAM1-3"; limit=294912 ;;
+    .sram4) region="SRAM4"; limit=65536 ;;
+    *) region="ITCM"; limit=65536 ;;
+  esac
+  verdict=ok
+  if [ "$size" -gt "$limit" ]; then verdict="OVER BUDGET"; status=1; fi
+  printf '  %-14s %8d  (%s, %d: %s)\n' "$name" "$size" "$region" "$limit" "$verdict"
+done < <(readelf -SW "$elf" | sed -n 's/^ *\[ *[0-9]*\] //p' | awk '$1 ~ /^\.(axisram|sram123|sram4|itcm)$/ {print $1, $5}')
+if [ "$(readelf -SW "$elf" | grep -c ' \.itcm ')" != 1 ]; then
+  echo "no .itcm section in $elf" >&2
+  status=1
+fi
+exit "$status"

@@ -17,14 +17,15 @@
 # init and its USART / timer interrupt handlers instead of QEMU's UART / SysTick ones.
 #
 # Then the same for the STM32H743 (Nucleo-H743ZI2: 2 MiB flash; RAM in four regions, DTCM
-# 128 KiB, AXI SRAM 512 KiB, SRAM1-3 288 KiB, SRAM4 64 KiB; maps of up to 2,097,152 cells, paths
-# of up to 8,191 steps), per region:
+# 128 KiB, AXI SRAM 512 KiB, SRAM1-3 288 KiB, SRAM4 64 KiB, ITCM 64 KiB; maps of up to 2,097,152
+# cells, paths of up to 16,384 steps), per region:
 #
 #   flash      = .vector_table + .text + .rodata + .data                    <= H7_FLASH_BUDGET (1 MiB)
 #   DTCM       = .data + .bss + .uninit + measured stack peak + STACK_MARGIN <= H7_DTCM_BUDGET (120 KiB)
 #   AXI SRAM   = .axisram                                                    <= 512 KiB
 #   SRAM1-3    = .sram123                                                    <= 288 KiB
 #   SRAM4      = .sram4                                                      <= 64 KiB
+#   ITCM       = .itcm                                                       <= 64 KiB
 #
 # Its stack peak is measured on its QEMU capacity twin (`--features twin-h743`: the H743's
 # capacity, RAM regions and buffer placement on the mps2-an386), with `selftest`, `stack` and a
@@ -178,8 +179,9 @@ h7_dtcm=$((h7_static + h7_stack + STACK_MARGIN))
 h7_axi=$(section "$h7_elf" .axisram)
 h7_sram123=$(section "$h7_elf" .sram123)
 h7_sram4=$(section "$h7_elf" .sram4)
+h7_itcm=$(section "$h7_elf" .itcm)
 # The twin must place the same buffers in regions of the same sizes.
-for s in .axisram .sram123 .sram4; do
+for s in .axisram .sram123 .sram4 .itcm; do
   if [ "$(section "$twin_elf" "$s")" != "$(section "$h7_elf" "$s")" ]; then
     echo "the twin's $s ($(section "$twin_elf" "$s") bytes) is not the H743's ($(section "$h7_elf" "$s"))" >&2
     status=1
@@ -190,11 +192,12 @@ h7_dtcm_ok=$(verdict "$h7_dtcm" "$H7_DTCM_BUDGET")
 h7_axi_ok=$(verdict "$h7_axi" 524288)
 h7_sram123_ok=$(verdict "$h7_sram123" 294912)
 h7_sram4_ok=$(verdict "$h7_sram4" 65536)
-for v in "$h7_flash_ok" "$h7_dtcm_ok" "$h7_axi_ok" "$h7_sram123_ok" "$h7_sram4_ok"; do
+h7_itcm_ok=$(verdict "$h7_itcm" 65536)
+for v in "$h7_flash_ok" "$h7_dtcm_ok" "$h7_axi_ok" "$h7_sram123_ok" "$h7_sram4_ok" "$h7_itcm_ok"; do
   [ "$v" = ok ] || status=1
 done
 echo
-echo "== budgets: STM32H743 release firmware, maps of up to 2,097,152 cells (any shape) planned at full resolution, paths of up to 8,191 steps, 50 ants"
+echo "== budgets: STM32H743 release firmware, maps of up to 2,097,152 cells (any shape) planned at full resolution, paths of up to 16,384 steps, 50 ants"
 printf '| %-58s | %8s | %8s | %-11s |\n' "item" "bytes" "budget" "verdict"
 printf '| %-58s | %8s | %8s | %-11s |\n' "---" "---" "---" "---"
 printf '| %-58s | %8d | %8d | %-11s |\n' "flash (.vector_table + .text + .rodata + .data)" "$h7_flash" "$H7_FLASH_BUDGET" "$h7_flash_ok"
@@ -205,6 +208,7 @@ printf '| %-58s | %8d | %8d | %-11s |\n' "DTCM (static + stack peak + margin; re
 printf '| %-58s | %8d | %8d | %-11s |\n' "AXI SRAM (.axisram: map, tabu bits)" "$h7_axi" 524288 "$h7_axi_ok"
 printf '| %-58s | %8d | %8d | %-11s |\n' "SRAM1-3 (.sram123: pruned-cell bits, pheromone)" "$h7_sram123" 294912 "$h7_sram123_ok"
 printf '| %-58s | %8d | %8d | %-11s |\n' "SRAM4 (.sram4: links)" "$h7_sram4" 65536 "$h7_sram4_ok"
+printf '| %-58s | %8d | %8d | %-11s |\n' "ITCM (.itcm: 8 bytes off address 0, the coarse route)" "$h7_itcm" 65536 "$h7_itcm_ok"
 echo
 echo "The stack peak is the twin's (DTCM static $twin_static bytes there; its other regions are the"
 echo "H743's, byte for byte), added to the H743 build's DTCM statics."

@@ -136,7 +136,7 @@ def unframe(wire):
 
 # ---- messages --------------------------------------------------------------------------------
 
-PROTOCOL_VERSION = 7
+PROTOCOL_VERSION = 8
 ALGORITHMS = ["aca", "paca", "haca", "ohaca"]
 DEAD_ENDS = ["backtrack", "die"]
 SMOOTHING = ["none", "greedy", "shortest"]

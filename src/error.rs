@@ -64,7 +64,7 @@ pub enum Error {
     NoAntArrived,
     /// The goal is reachable, but no ant reached it and some ants were dropped because their
     /// paths grew longer than the workspace keeps (`Workspace::steps`; 2,047 steps on the
-    /// STM32F411 and the default QEMU board, 8,191 on the STM32H743): the way to the goal is
+    /// STM32F411 and the default QEMU board, 16,384 on the STM32H743): the way to the goal is
     /// longer than that, or the ants wandered that far.
     PathTooLong {
         /// Ants dropped over the run.

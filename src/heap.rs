@@ -126,6 +126,15 @@ impl HeapStorage {
         Ok(s)
     }
 
+    /// The same storage with at most `links` links: for a device that has fewer than
+    /// [`HeapStorage::with_steps`] gives (the STM32H743 keeps paths of 16,384 steps with
+    /// tightening's smallest table, `crate::tighten::hash_words`). [`HeapStorage::ensure`]
+    /// grows them again.
+    pub fn with_links(mut self, links: usize) -> Self {
+        self.buffers.links.truncate(links);
+        self
+    }
+
     /// Drop the buffers of the iteration's best and worst paths, as a device's storage may
     /// ([`crate::Storage`]'s `KEPT` = 0): runs walk those two ants again instead, with the same
     /// paths bit for bit.

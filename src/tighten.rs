@@ -22,8 +22,9 @@ use crate::grid::{is_diagonal, neighbour, opposite, Dir, Moves, Point};
 /// `cells` is scratch of at least `steps + 1` points. `pos` finds a cell's position on the path:
 /// with one entry per map cell it is indexed by cell; shorter, it is an open-addressing hash
 /// table over the path's cells, which needs a power of two of at least twice the path's cells as
-/// slots, two 16-bit slots a word for paths of fewer than 65,535 cells (a longer path is returned
-/// untightened). Both give the same result.
+/// slots, or if that does not fit, of at least one and a half times (load factor 2/3), two 16-bit
+/// slots a word for paths of fewer than 65,535 cells (a longer path is returned untightened:
+/// [`hash_words`]). Every one gives the same result.
 ///
 /// `visited` is the walk's tabu set (every cell of the path is in it): a neighbour outside it is
 /// not on the path and is not looked up. An empty set looks up every neighbour; same result.
@@ -149,6 +150,50 @@ pub fn tighten(
     }
 }
 
+/// Slots of the hash table [`tighten`] builds for a path of `n` cells in `words` words: the
+/// smallest power of two of at least `2n` (load factor at most 1/2) when it fits, else half of
+/// that if it still has at least `3n / 2` slots (load factor at most 2/3), else `None` (the path
+/// is left untightened). Two 16-bit slots a word for paths of fewer than 65,535 cells.
+fn hash_slots(n: usize, words: usize) -> Option<usize> {
+    let want = n.checked_mul(2)?.checked_next_power_of_two()?;
+    let half = n < u16::MAX as usize;
+    let fits = |slots: usize| words >= if half { slots.div_ceil(2) } else { slots };
+    if fits(want) {
+        return Some(want);
+    }
+    // `n + n / 2 <= 2n`, which did not overflow.
+    let fewer = want >> 1;
+    if fewer >= n.wrapping_add(n >> 1) && fits(fewer) {
+        Some(fewer)
+    } else {
+        None
+    }
+}
+
+/// The fewest words of `pos` with which [`tighten`] tightens every path of up to `n` cells
+/// (rather than leaving it unchanged) on a map of more cells: its hash table's, at a load factor
+/// of up to 2/3 (`hash_slots`). `usize::MAX` if no table holds `n` cells.
+pub const fn hash_words(n: usize) -> usize {
+    // Either the smallest table of a load factor <= 1/2, or the one half its size.
+    let Some(twice) = n.checked_mul(2) else {
+        return usize::MAX;
+    };
+    let Some(want) = twice.checked_next_power_of_two() else {
+        return usize::MAX;
+    };
+    let half = n < u16::MAX as usize;
+    let slots = if (want >> 1) >= n.wrapping_add(n >> 1) {
+        want >> 1
+    } else {
+        want
+    };
+    if half {
+        slots.div_ceil(2)
+    } else {
+        slots
+    }
+}
+
 /// Cell -> position on a path: a per-cell array, or a hash table over the path's cells.
 struct PathIndex<'a> {
     slots: &'a mut [u32],
@@ -169,15 +214,16 @@ impl<'a> PathIndex<'a> {
                 half: false,
             });
         }
-        // The smallest power of two of at least 2n slots (load factor <= 1/2); positions + 1
-        // below 2^16 fit a half word, so the same words hold twice the slots.
-        let want = n.checked_mul(2)?.checked_next_power_of_two()?;
+        // The smallest power of two of at least 2n slots (load factor <= 1/2), or when that does
+        // not fit, half of it if that still has at least 3n/2 slots (load factor <= 2/3);
+        // positions + 1 below 2^16 fit a half word, so the same words hold twice the slots.
+        let slots = hash_slots(n, pos.len())?;
         let half = n < usize::from(u16::MAX);
-        let slots = pos.get_mut(..if half { want.div_ceil(2) } else { want })?;
-        slots.fill(0);
+        let table = pos.get_mut(..if half { slots.div_ceil(2) } else { slots })?;
+        table.fill(0);
         Some(PathIndex {
-            slots,
-            hash: Some(want.trailing_zeros()),
+            slots: table,
+            hash: Some(slots.trailing_zeros()),
             half,
         })
     }
@@ -235,7 +281,7 @@ impl<'a> PathIndex<'a> {
         let len = self.len();
         let mask = len.wrapping_sub(1);
         let mut h = Self::home(bits, cell) & mask;
-        // At most n entries in 2n slots: an empty slot is always found.
+        // At most n entries in at least 3n/2 slots: an empty slot is always found.
         for _ in 0..len {
             if self.slot(h) == Some(0) {
                 self.set_slot(h, i.wrapping_add(1)); // i < n <= 2^31 (< 2^16 - 1 in half slots)
@@ -284,7 +330,8 @@ mod tests {
     fn the_hash_tables_tighten_as_the_per_cell_index_does() {
         // Weakly guided walks on a 48 x 40 map with random obstacles wander and bulge; each is
         // tightened with a per-cell index, with the smallest hash table of 16-bit slots (half a
-        // word a slot), and with one word too few (the walk comes back untightened).
+        // word a slot) of a load factor of 1/2, and with one word too few (the walk comes back
+        // untightened, or tightened alike in the table half the size when that holds it).
         let (w, h) = (48u16, 40u16);
         let mut changed = 0;
         for seed in 0..40u64 {
@@ -332,10 +379,109 @@ mod tests {
             let direct = run(g.cells());
             let words = (2 * n).next_power_of_two() / 2;
             assert_eq!(run(words), direct, "seed {seed}");
-            let (short, path) = run(words - 1);
-            assert_eq!((short, path.as_slice()), (walk, &tour[..walk.steps]));
+            // One word too few for a load factor of 1/2: the table half its size if that keeps
+            // the load factor at most 2/3 (the next test), else the walk comes back untightened.
+            if words < n + n / 2 {
+                assert_eq!(hash_words(n), words, "seed {seed}");
+                let (short, path) = run(words - 1);
+                assert_eq!((short, path.as_slice()), (walk, &tour[..walk.steps]));
+            } else {
+                assert_eq!(hash_words(n), words / 2, "seed {seed}");
+                assert_eq!(run(words - 1), direct, "seed {seed}");
+            }
             changed += usize::from(direct.0.steps < walk.steps);
         }
         assert!(changed >= 10, "{changed}");
+    }
+
+    #[test]
+    fn the_two_thirds_table_tightens_as_the_per_cell_index_does() {
+        // The same weakly guided walks, on maps of several sizes so that their lengths fall both
+        // just above a power of two (where half the load-1/2 table still holds 3n/2 slots) and
+        // below: with the words of that smaller table, each walk is tightened exactly as with the
+        // per-cell index; with one word fewer, it comes back untightened.
+        let mut smaller = 0;
+        for (w, h) in [(48u16, 40u16), (64, 24), (30, 30), (80, 60)] {
+            for seed in 0..40u64 {
+                let mut rng = Xoshiro128pp::from_u64(seed);
+                let cells = usize::from(w) * usize::from(h);
+                let mut bits = vec![0u8; cells.div_ceil(8)];
+                for i in 0..cells {
+                    if i > 0 && i + 1 < cells && rng.next_unit() < 0.2 {
+                        bits[i / 8] |= 1 << (i % 8);
+                    }
+                }
+                let g = Grid::new(w, h, &bits).unwrap();
+                let (start, goal) = (Point::new(0, 0), Point::new(w - 1, h - 1));
+                if !g.is_free(goal) {
+                    continue;
+                }
+                let mut tau_buf = vec![[1.0f32; 4]; 1024];
+                let tau = Table::new(Blocks::new(w, h), &mut tau_buf);
+                let heur = Heuristic::new(goal, Some(Attraction { a: 0.3, xi: 1.0 }), 0.5);
+                let moves = Moves::new(g, &[]);
+                let ant = Ant {
+                    moves: &moves,
+                    start,
+                    goal,
+                    tau: &tau,
+                    heuristic: &heur,
+                    alpha: 1.0,
+                    dead_end: DeadEnd::Backtrack,
+                    dead: &[],
+                    route: None,
+                    budget: u32::MAX,
+                };
+                let mut tabu = vec![0u32; crate::bitmap::words(g.cells())];
+                let mut tour = vec![0u8; g.cells()];
+                let Ok(walk) = ant.walk(&mut rng, &mut tabu, &mut tour) else {
+                    continue;
+                };
+                let n = walk.steps + 1;
+                let slots = (2 * n).next_power_of_two() / 2;
+                if slots < n + n / 2 {
+                    continue;
+                }
+                let run = |links: usize| {
+                    let mut t = tour.clone();
+                    let mut cells = vec![Point::default(); n];
+                    let mut pos = vec![0u32; links];
+                    let out = tighten(&moves, start, walk, &mut t, &mut cells, &mut pos, &tabu);
+                    (out, t[..out.steps].to_vec())
+                };
+                let words = slots / 2;
+                assert_eq!(hash_words(n), words);
+                assert_eq!(run(words), run(g.cells()), "{w}x{h} seed {seed}");
+                let (short, path) = run(words - 1);
+                assert_eq!((short, path.as_slice()), (walk, &tour[..walk.steps]));
+                smaller += 1;
+            }
+        }
+        assert!(smaller >= 20, "{smaller}");
+    }
+
+    #[test]
+    fn a_path_of_16385_cells_is_indexed_in_16384_words() {
+        // The STM32H743's longest path (16,384 steps) in its 16,384 links: 32,768 half-word
+        // slots, a load factor of 1/2 would need 65,536. Every cell is found at its position,
+        // and cells not on the path are not.
+        let n = 16_385;
+        assert_eq!(hash_words(n), 16_384);
+        let mut pos = vec![0u32; 16_384];
+        let mut ix = PathIndex::new(&mut pos, 1 << 22, n).expect("a table");
+        assert_eq!(ix.len(), 32_768);
+        let cell = |i: usize| (i * 193 + 7) % (1 << 22);
+        for i in 0..n {
+            ix.insert(cell(i), i as u32);
+        }
+        let at = |j: usize| (j < n).then(|| cell(j));
+        for i in 0..n {
+            assert_eq!(ix.find(cell(i), at), Some(i));
+        }
+        for i in n..n + 1000 {
+            assert_eq!(ix.find(cell(i), at), None);
+        }
+        let mut fewer = vec![0u32; 16_383];
+        assert!(PathIndex::new(&mut fewer, 1 << 22, n).is_none());
     }
 }

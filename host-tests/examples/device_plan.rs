@@ -1,5 +1,5 @@
 //! One plan as the device makes it (ant paths bounded to the STM32F411 firmware's 2,047 steps, or
-//! `--steps N`, e.g. the STM32H743's 8191; no move table on maps of more than 1,024 cells; the
+//! `--steps N`, e.g. the STM32H743's 16384; no move table on maps of more than 1,024 cells; the
 //! iteration's best and worst ants walked again instead of kept), for profiling the core on the
 //! host with callgrind, whose instruction counts follow the device's: the phases are the
 //! functions `Run::new`, `Run::step` and `Run::finish`.

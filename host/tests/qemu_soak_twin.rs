@@ -456,7 +456,7 @@ fn free_near(map: &Map, x: u16, y: u16) -> Point {
 fn uploads_of_512x512_and_604x307_survive_drops_and_corruption() {
     need_qemu!();
     soak_at_scale(twin_firmware(), |map, start, goal, params| {
-        core_plan_steps(map, start, goal, params, 8191)
+        core_plan_steps(map, start, goal, params, 16_384)
     });
 }
 

@@ -8,7 +8,7 @@
 //!   planner every buffer a fixed 95,232-byte `Storage` would have; a 512 x 512 one takes 32 KiB and
 //!   leaves the compact layout.
 //! - **STM32H743 and its QEMU twin** (`twin-h743`; maps of up to 2,097,152 cells, paths of up
-//!   to 8,191 steps): the map (256 KiB) and the planner's two per-cell bit sets (256 KiB each)
+//!   to 16,384 steps): the map (256 KiB) and the planner's two per-cell bit sets (256 KiB each)
 //!   do not fit one RAM region (the largest, the AXI SRAM, has 512 KiB), so every buffer is a
 //!   static of its own, placed with `#[link_section]` into the board's regions
 //!   (`board/stm32h743-memory.x`, `board/qemu/twin-h743-memory.x`), and the planner's workspace
@@ -18,14 +18,23 @@
 //! | --- | --- | --- | ---: |
 //! | AXI SRAM (512 KiB) | `.axisram` (NOLOAD) | map, `tabu` | 262,144 + 262,144 |
 //! | SRAM1-3 (288 KiB) | `.sram123` (NOLOAD) | `dead`, `tau`, `delta` | 262,144 + 16,384 + 16,384 |
-//! | SRAM4 (64 KiB) | `.sram4` (NOLOAD) | `links` (2 x 8,192) | 65,536 |
-//! | DTCM (128 KiB) | `.bss` | 4 tours (8,192 each), `points` (8,192), `guide`, `curve`, `moves` | 32,768 + 32,768 + 16,384 + 2,048 + 1,024 |
+//! | SRAM4 (64 KiB) | `.sram4` (NOLOAD) | `links` (16,384) | 65,536 |
+//! | ITCM (64 KiB) | `.itcm` (NOLOAD) | 8 bytes left out (no static at address 0), `guide` | 8 + 16,384 |
+//! | DTCM (128 KiB) | `.bss` | 2 tours (16,385 each), `points` (16,385), `moves` | 32,770 + 65,540 + 1,024 |
 //!
-//! Every region but the DTCM is then full to the byte; the DTCM keeps 45 KiB for the rest of the
-//! firmware's statics (about 6 KiB) and the stack (3.4 KiB measured: BENCHMARKS.md, section 5b). An ant path step costs 16 bytes (a byte in each of
-//! the four tours, a 4-byte path cell, two 4-byte links): 8,192 steps take 128 KiB, which is
-//! what the regions have left beside the 768 KiB of per-cell bits (16,384 steps would need
-//! 256 KiB).
+//! Every region but the DTCM and the ITCM is then full to the byte; the DTCM keeps about 22 KiB
+//! for the rest of the firmware's statics (about 6 KiB) and the stack (about 3.4 KiB measured,
+//! BENCHMARKS.md, section 5b), within the budget of 120 KiB. An ant path step costs 6 bytes of
+//! DTCM: a byte in each of the two tours (the iteration's best and worst ants are walked again
+//! rather than kept, as on the STM32F411) and a 4-byte path cell. The links (tightening's
+//! positions, the coarse route's heap, the smoothing's links) are tightening's smallest hash
+//! table for the longest path (`ohaca::tighten::hash_words`): 32,768 half-word slots for 16,385
+//! cells, a load factor of up to 2/3 (one of 1/2 would need 128 KiB), which tightens exactly as
+//! the per-cell index does. The device records no convergence curve (it never reports one), and
+//! the coarse route moved from the DTCM to the ITCM (the CPU reads and writes it as data). Only
+//! a best path of exactly 16,384 steps (16,385 cells, one more than the links) is smoothed
+//! greedily instead of by the shortest-path smoothing; the host plans it alike
+//! (`host/tests/common/qemu.rs`, `core_plan_steps`).
 //!
 //! The NOLOAD sections are not touched by the startup code (cortex-m-rt zeroes `.bss` only), so
 //! their statics are `Region`s, `MaybeUninit` memory that [`take`] fills with zeros element by
@@ -118,8 +127,9 @@ mod layout {
     use ohaca::bitmap::words;
     use ohaca::grid::{Dir, Point};
     use ohaca::pheromone::BLOCKS;
-    use ohaca::planner::{Buffers, CurvePoint, Workspace};
+    use ohaca::planner::{Buffers, Workspace};
     use ohaca::route::GUIDE_BLOCKS;
+    use ohaca::tighten::hash_words;
 
     use crate::firmware::state::{MAP_BYTES, PLAN_CELLS, PLAN_STEPS};
 
@@ -150,17 +160,18 @@ mod layout {
     const WORDS: usize = words(PLAN_CELLS);
     /// Entries of each tour and of the path cells: paths of up to [`PLAN_STEPS`] steps.
     const STEPS: usize = PLAN_STEPS + 1;
-    /// Links: two per path cell (tightening's positions and its hash table), and at least the
-    /// coarse route's blocks.
-    const LINKS: usize = if 2 * STEPS > GUIDE_BLOCKS {
-        2 * STEPS
+    /// Links: tightening's smallest hash table for the longest path (`ohaca::tighten::hash_words`:
+    /// 32,768 half-word slots for 16,385 cells, a load factor of up to 2/3; one of 1/2 would
+    /// need 65,536), and at least the coarse route's blocks (its heap): 16,384 words, all of
+    /// SRAM4. The host mirrors it (`host/tests/common/qemu.rs`, `core_plan_steps`).
+    const LINKS: usize = if hash_words(STEPS) > GUIDE_BLOCKS {
+        hash_words(STEPS)
     } else {
         GUIDE_BLOCKS
     };
+    const _: () = assert!(4 * LINKS <= 65_536);
     /// The move table for maps of up to this many cells (larger maps compute moves on the fly).
     const MOVES: usize = 1024;
-    /// Iterations of the convergence curve kept.
-    const CURVE: usize = 128;
 
     /// Memory the startup code does not initialise (a NOLOAD section): [`Region::fill`] writes
     /// every element before the memory is lent out, once.
@@ -211,26 +222,22 @@ mod layout {
     /// Links: SRAM4.
     #[link_section = ".sram4.links"]
     static LINKS_BUF: Region<u32, LINKS> = Region::new();
+    /// The coarse route: ITCM (data accesses from the CPU; the section starts 8 bytes in, so no
+    /// static is at address 0).
+    #[link_section = ".itcm.guide"]
+    static GUIDE: Region<u32, GUIDE_BLOCKS> = Region::new();
 
-    /// What stays in the DTCM's `.bss` (zeroed by the startup code): the tours, the path cells,
-    /// the coarse route, the curve and the move table.
+    /// What stays in the DTCM's `.bss` (zeroed by the startup code): the ant's tour and the
+    /// best one (the iteration's best and worst ants are walked again instead of kept), the path
+    /// cells and the move table.
     struct Dtcm {
-        tours: [[Dir; STEPS]; 4],
+        tours: [[Dir; STEPS]; 2],
         points: [Point; STEPS],
-        guide: [u32; GUIDE_BLOCKS],
-        curve: [CurvePoint; CURVE],
         moves: [u8; MOVES],
     }
     static DTCM: ConstStaticCell<Dtcm> = ConstStaticCell::new(Dtcm {
-        tours: [[0; STEPS]; 4],
+        tours: [[0; STEPS]; 2],
         points: [Point::new(0, 0); STEPS],
-        guide: [0; GUIDE_BLOCKS],
-        curve: [CurvePoint {
-            best: 0.0,
-            mean: 0.0,
-            best_so_far: 0.0,
-            arrived: 0,
-        }; CURVE],
         moves: [0; MOVES],
     });
 
@@ -240,6 +247,7 @@ mod layout {
     pub const BYTES: usize = 2 * size_of::<[u32; WORDS]>()
         + 2 * size_of::<[[f32; 4]; BLOCKS]>()
         + size_of::<[u32; LINKS]>()
+        + size_of::<[u32; GUIDE_BLOCKS]>()
         + size_of::<Dtcm>();
 
     /// The planner's buffers, each a `'static` slice of its own static.
@@ -249,27 +257,27 @@ mod layout {
         tabu: &'static mut [u32],
         dead: &'static mut [u32],
         moves: &'static mut [u8],
-        tours: [&'static mut [Dir]; 4],
+        tours: [&'static mut [Dir]; 2],
         points: &'static mut [Point],
         links: &'static mut [u32],
-        curve: &'static mut [CurvePoint],
         guide: &'static mut [u32],
     }
 
     impl PlanStorage {
-        /// Lend the buffers as a workspace for one run.
+        /// Lend the buffers as a workspace for one run (no convergence curve: the device does
+        /// not report one).
         pub fn workspace(&mut self) -> Workspace<'_> {
-            let [t0, t1, t2, t3] = &mut self.tours;
+            let [tour, best] = &mut self.tours;
             Workspace::new(Buffers {
                 tau: self.tau,
                 delta: self.delta,
                 tabu: self.tabu,
                 dead: self.dead,
                 moves: self.moves,
-                tours: [t0, t1, t2, t3],
+                tours: [tour, &mut [], &mut [], best],
                 points: self.points,
                 links: self.links,
-                curve: self.curve,
+                curve: &mut [],
                 guide: self.guide,
             })
         }
@@ -297,7 +305,7 @@ mod layout {
         let taken = TAKEN.swap(true, Ordering::AcqRel);
         defmt::assert!(!taken, "the planner's buffers are taken once");
         // SAFETY: once (`TAKEN`), so each region is filled and lent once.
-        let (map, tabu, dead, tau, delta, links) = unsafe {
+        let (map, tabu, dead, tau, delta, links, guide) = unsafe {
             (
                 MAP.fill(0),
                 TABU.fill(0),
@@ -305,21 +313,21 @@ mod layout {
                 TAU.fill([0.0; 4]),
                 DELTA.fill([0.0; 4]),
                 LINKS_BUF.fill(0),
+                GUIDE.fill(0),
             )
         };
         let dtcm = DTCM.take();
-        let [t0, t1, t2, t3] = &mut dtcm.tours;
+        let [t0, t1] = &mut dtcm.tours;
         let storage = STORAGE.take().insert(PlanStorage {
             tau,
             delta,
             tabu,
             dead,
             moves: &mut dtcm.moves,
-            tours: [t0, t1, t2, t3],
+            tours: [t0, t1],
             points: &mut dtcm.points,
             links,
-            curve: &mut dtcm.curve,
-            guide: &mut dtcm.guide,
+            guide,
         });
         let mut buf = defmt::unwrap!(
             crate::firmware::state::MAP.try_lock().ok(),

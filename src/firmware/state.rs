@@ -41,7 +41,7 @@ pub const PLAN_CELLS: usize = MAX_CELLS;
 /// straight path across a 256 x 256 map has at most 255 steps, but a maze's or a long corridor's
 /// (4096 x 16) can be far longer: the longest scenario of `maps/large/maze-128-128-2` has 1,379
 /// steps (BENCHMARKS.md, section 4), within the 2,047 of the STM32F411 and the default QEMU
-/// board (the STM32H743 and its twin keep 8,191). On the small boards' maps of more than 68,256
+/// board (the STM32H743 and its twin keep 16,384). On the small boards' maps of more than 68,256
 /// cells the arena leaves fewer (`ohaca::planner::arena::steps_for`: 1,876 at 512 x 512).
 pub const PLAN_STEPS: usize = board::CAPACITY.steps;
 /// The planner's storage (`super::buffers`): nothing of its own on the small boards (its

@@ -65,8 +65,9 @@ pub use wire::{Waypoints, WAYPOINT_BYTES};
 /// bytes or meaning of a message (2: [`StatsReply::stack_peak`]; 3: run-length uploads, cell
 /// updates, warm plans, [`Capacity`]'s sides are the largest map held; 4: warm replies and
 /// `warm_patience`; 5: `refine_patience` and `refine`; 6: [`Capacity`] by cells, `max_side` and
-/// `max_steps`; 7: [`MAX_REPLY`] carries every path of [`MAX_STEPS`] steps).
-pub const VERSION: u16 = 7;
+/// `max_steps`; 7: [`MAX_REPLY`] carries every path of [`MAX_STEPS`] steps; 8: [`MAX_STEPS`]
+/// 16,384).
+pub const VERSION: u16 = 8;
 
 /// The id of replies to frames whose request id could not be read. Hosts should not use it.
 pub const UNKNOWN_ID: u32 = 0;
@@ -75,8 +76,8 @@ pub const UNKNOWN_ID: u32 = 0;
 pub const MAX_CHUNK: usize = 128;
 
 /// Longest path, in steps, a device may plan ([`Capacity::max_steps`] is at most this): the
-/// STM32H743's 8,191, the largest of the boards. Every such path fits one [`PathReply`].
-pub const MAX_STEPS: usize = 8191;
+/// STM32H743's 16,384, the largest of the boards. Every such path fits one [`PathReply`].
+pub const MAX_STEPS: usize = 16_384;
 
 /// Most waypoints in a [`PathReply`]: every cell of a path of [`MAX_STEPS`] steps.
 pub const MAX_WAYPOINTS: usize = MAX_STEPS + 1;
@@ -116,14 +117,14 @@ pub const fn path_payload(waypoints: usize, directions: usize) -> usize {
 
 /// Largest reply payload (postcard bytes plus CRC) a host must accept: a [`PathReply`] with
 /// [`MAX_WAYPOINTS`] waypoints and [`MAX_DIRECTIONS`] directions, every path of [`MAX_STEPS`]
-/// steps, fits (41,019 bytes). A device need not hold one: [`PathStream`] encodes a path frame
+/// steps, fits (81,985 bytes). A device need not hold one: [`PathStream`] encodes a path frame
 /// piece by piece.
 pub const MAX_REPLY: usize = path_payload(MAX_WAYPOINTS, MAX_DIRECTIONS);
 
 // The figure docs/PROTOCOL.md gives (`host-tests/tests/documents.rs` reads it there and encodes
 // the widest path reply): a change to `MAX_STEPS` or to `PathReply` is a new protocol version.
 // Each board checks its `max_steps` against `MAX_STEPS` (`firmware::board`).
-const _: () = assert!(MAX_REPLY == 41_019);
+const _: () = assert!(MAX_REPLY == 81_985);
 
 /// Largest request frame on the wire, delimiter included.
 pub const MAX_REQUEST_WIRE: usize = wire_len(MAX_REQUEST);

@@ -400,8 +400,10 @@ pub fn core_plan(
 }
 
 /// [`core_plan`] for a device that keeps ant paths of up to `steps` steps (Hello's
-/// `capacity.max_steps`), with the device's workspace shape: links for `steps`, the move table
-/// only on maps of up to 1024 cells, as the firmware has it (`firmware::buffers`). The host keeps
+/// `capacity.max_steps`), with the device's workspace shape: links for `steps` (at most
+/// tightening's smallest table for them, at least the coarse route's blocks: the STM32H743's
+/// 16,384), the move table only on maps of up to 1024 cells, as the firmware has it
+/// (`firmware::buffers`). The host keeps
 /// the iteration's best and worst paths where the STM32F411 build walks those ants again, so a
 /// match also checks that both ways plan alike.
 pub fn core_plan_steps(
@@ -424,9 +426,11 @@ fn core_plan_with(
 ) -> Result<CorePath, ErrorReply> {
     let grid = map.grid().map_err(ErrorReply::from)?;
     params.validate().map_err(ErrorReply::from)?;
+    let links = ohaca::tighten::hash_words(steps + 1).max(ohaca::route::GUIDE_BLOCKS);
     let mut storage =
         HeapStorage::with_steps(map.cells(), steps, moves, usize::from(params.iterations))
-            .expect("host storage");
+            .expect("host storage")
+            .with_links(links);
     let plan = ohaca::plan(&grid, start, goal, params, storage.workspace())?;
     Ok(core_path(&plan))
 }

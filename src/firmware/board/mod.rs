@@ -74,13 +74,15 @@ pub const SMALL: Capacity = Capacity {
 };
 
 /// The STM32H743's capacity, and its QEMU twin's: 2,097,152 cells (2048 x 1024, or Nav2's
-/// 1006 x 1674 warehouse at 3 cm; a 256 KiB map), paths of 8,191 steps. The map and the planner's
-/// two per-cell bit sets take 768 KiB of the chip's 992 KiB of RAM; what is left holds ant paths
-/// of 8,191 steps at 16 bytes a step (`super::buffers` has the arithmetic).
+/// 1006 x 1674 warehouse at 3 cm; a 256 KiB map), paths of 16,384 steps (820 m at 5 cm). The map
+/// and the planner's two per-cell bit sets take 768 KiB of the chip's 1,056 KiB of RAM (ITCM
+/// included); the ant paths take 6 bytes a step in the DTCM (two tours, the path cells: the
+/// iteration's best and worst ants are walked again) and tightening's hash table fills SRAM4 at
+/// a load factor of up to 2/3 (`super::buffers` has the arithmetic).
 #[cfg(any(feature = "twin-h743", feature = "board-stm32h743"))]
 pub const LARGE: Capacity = Capacity {
     cells: 2_097_152,
-    steps: 8191,
+    steps: 16_384,
 };
 
 // A path the board plans always fits one path reply (`ohaca::protocol::MAX_STEPS`, from which

@@ -16,7 +16,7 @@ use static_cell::ConstStaticCell;
 
 use super::{Board, Capacity};
 
-/// Maps of up to 2,097,152 cells, paths of up to 8,191 steps.
+/// Maps of up to 2,097,152 cells, paths of up to 16,384 steps.
 pub const CAPACITY: Capacity = super::LARGE;
 
 bind_interrupts!(struct Irqs {
