@@ -326,57 +326,86 @@ mod tests {
     use crate::pheromone::{Blocks, Table};
     use crate::rng::Xoshiro128pp;
 
+    /// A weakly guided walk from corner to corner of a `w x h` map with 20 % random obstacles
+    /// (from `seed`): such walks wander and bulge. The map's bits, the walk, its tour and the tabu
+    /// bits it left; `None` when the goal is blocked or the ant is lost.
+    fn wandering_walk(w: u16, h: u16, seed: u64) -> Option<(Vec<u8>, Walk, Vec<Dir>, Vec<u32>)> {
+        let mut rng = Xoshiro128pp::from_u64(seed);
+        let cells = usize::from(w) * usize::from(h);
+        let mut bits = vec![0u8; cells.div_ceil(8)];
+        for i in 0..cells {
+            if i > 0 && i + 1 < cells && rng.next_unit() < 0.2 {
+                bits[i / 8] |= 1 << (i % 8);
+            }
+        }
+        let g = Grid::new(w, h, &bits).ok()?;
+        let (start, goal) = (Point::new(0, 0), Point::new(w - 1, h - 1));
+        if !g.is_free(goal) {
+            return None;
+        }
+        let mut tau_buf = vec![[1.0f32; 4]; 1024];
+        let tau = Table::new(Blocks::new(w, h), &mut tau_buf);
+        let heur = Heuristic::new(goal, Some(Attraction { a: 0.3, xi: 1.0 }), 0.5);
+        let moves = Moves::new(g, &[]);
+        let ant = Ant {
+            moves: &moves,
+            start,
+            goal,
+            tau: &tau,
+            heuristic: &heur,
+            alpha: 1.0,
+            dead_end: DeadEnd::Backtrack,
+            dead: &[],
+            route: None,
+            budget: u32::MAX,
+        };
+        let mut tabu = vec![0u32; crate::bitmap::words(cells)];
+        let mut tour = vec![0u8; cells];
+        let walk = ant.walk(&mut rng, &mut tabu, &mut tour).ok()?;
+        Some((bits, walk, tour, tabu))
+    }
+
+    /// Tighten `walk` (its `tour`) on the map `bits` with `links` words of index: the walk and
+    /// its path.
+    fn tightened(
+        (w, h, bits): (u16, u16, &[u8]),
+        walk: Walk,
+        tour: &[Dir],
+        tabu: &[u32],
+        links: usize,
+    ) -> (Walk, Vec<Dir>) {
+        let g = Grid::new(w, h, bits).unwrap();
+        let moves = Moves::new(g, &[]);
+        let mut t = tour.to_vec();
+        let mut cells = vec![Point::default(); walk.steps + 1];
+        let mut pos = vec![0u32; links];
+        let out = tighten(
+            &moves,
+            Point::new(0, 0),
+            walk,
+            &mut t,
+            &mut cells,
+            &mut pos,
+            tabu,
+        );
+        (out, t[..out.steps].to_vec())
+    }
+
     #[test]
     fn the_hash_tables_tighten_as_the_per_cell_index_does() {
-        // Weakly guided walks on a 48 x 40 map with random obstacles wander and bulge; each is
-        // tightened with a per-cell index, with the smallest hash table of 16-bit slots (half a
-        // word a slot) of a load factor of 1/2, and with one word too few (the walk comes back
-        // untightened, or tightened alike in the table half the size when that holds it).
+        // Wandering walks on a 48 x 40 map; each is tightened with a per-cell index, with the
+        // smallest hash table of 16-bit slots (half a word a slot) of a load factor of 1/2, and
+        // with one word too few (the walk comes back untightened, or tightened alike in the
+        // table half the size when that holds it).
         let (w, h) = (48u16, 40u16);
         let mut changed = 0;
         for seed in 0..40u64 {
-            let mut rng = Xoshiro128pp::from_u64(seed);
-            let mut bits = vec![0u8; (usize::from(w) * usize::from(h)).div_ceil(8)];
-            for i in 0..usize::from(w) * usize::from(h) {
-                if i > 0 && i + 1 < bits.len() * 8 && rng.next_unit() < 0.2 {
-                    bits[i / 8] |= 1 << (i % 8);
-                }
-            }
-            let g = Grid::new(w, h, &bits).unwrap();
-            let (start, goal) = (Point::new(0, 0), Point::new(w - 1, h - 1));
-            if !g.is_free(goal) {
-                continue;
-            }
-            let mut tau_buf = vec![[1.0f32; 4]; 1024];
-            let tau = Table::new(Blocks::new(w, h), &mut tau_buf);
-            let heur = Heuristic::new(goal, Some(Attraction { a: 0.3, xi: 1.0 }), 0.5);
-            let moves = Moves::new(g, &[]);
-            let ant = Ant {
-                moves: &moves,
-                start,
-                goal,
-                tau: &tau,
-                heuristic: &heur,
-                alpha: 1.0,
-                dead_end: DeadEnd::Backtrack,
-                dead: &[],
-                route: None,
-                budget: u32::MAX,
-            };
-            let mut tabu = vec![0u32; crate::bitmap::words(g.cells())];
-            let mut tour = vec![0u8; g.cells()];
-            let Ok(walk) = ant.walk(&mut rng, &mut tabu, &mut tour) else {
+            let Some((bits, walk, tour, tabu)) = wandering_walk(w, h, seed) else {
                 continue;
             };
             let n = walk.steps + 1;
-            let run = |links: usize| {
-                let mut t = tour.clone();
-                let mut cells = vec![Point::default(); n];
-                let mut pos = vec![0u32; links];
-                let out = tighten(&moves, start, walk, &mut t, &mut cells, &mut pos, &tabu);
-                (out, t[..out.steps].to_vec())
-            };
-            let direct = run(g.cells());
+            let run = |links: usize| tightened((w, h, &bits), walk, &tour, &tabu, links);
+            let direct = run(usize::from(w) * usize::from(h));
             let words = (2 * n).next_power_of_two() / 2;
             assert_eq!(run(words), direct, "seed {seed}");
             // One word too few for a load factor of 1/2: the table half its size if that keeps
@@ -396,45 +425,14 @@ mod tests {
 
     #[test]
     fn the_two_thirds_table_tightens_as_the_per_cell_index_does() {
-        // The same weakly guided walks, on maps of several sizes so that their lengths fall both
+        // The same wandering walks, on maps of several sizes so that their lengths fall both
         // just above a power of two (where half the load-1/2 table still holds 3n/2 slots) and
         // below: with the words of that smaller table, each walk is tightened exactly as with the
         // per-cell index; with one word fewer, it comes back untightened.
         let mut smaller = 0;
         for (w, h) in [(48u16, 40u16), (64, 24), (30, 30), (80, 60)] {
             for seed in 0..40u64 {
-                let mut rng = Xoshiro128pp::from_u64(seed);
-                let cells = usize::from(w) * usize::from(h);
-                let mut bits = vec![0u8; cells.div_ceil(8)];
-                for i in 0..cells {
-                    if i > 0 && i + 1 < cells && rng.next_unit() < 0.2 {
-                        bits[i / 8] |= 1 << (i % 8);
-                    }
-                }
-                let g = Grid::new(w, h, &bits).unwrap();
-                let (start, goal) = (Point::new(0, 0), Point::new(w - 1, h - 1));
-                if !g.is_free(goal) {
-                    continue;
-                }
-                let mut tau_buf = vec![[1.0f32; 4]; 1024];
-                let tau = Table::new(Blocks::new(w, h), &mut tau_buf);
-                let heur = Heuristic::new(goal, Some(Attraction { a: 0.3, xi: 1.0 }), 0.5);
-                let moves = Moves::new(g, &[]);
-                let ant = Ant {
-                    moves: &moves,
-                    start,
-                    goal,
-                    tau: &tau,
-                    heuristic: &heur,
-                    alpha: 1.0,
-                    dead_end: DeadEnd::Backtrack,
-                    dead: &[],
-                    route: None,
-                    budget: u32::MAX,
-                };
-                let mut tabu = vec![0u32; crate::bitmap::words(g.cells())];
-                let mut tour = vec![0u8; g.cells()];
-                let Ok(walk) = ant.walk(&mut rng, &mut tabu, &mut tour) else {
+                let Some((bits, walk, tour, tabu)) = wandering_walk(w, h, seed) else {
                     continue;
                 };
                 let n = walk.steps + 1;
@@ -442,16 +440,14 @@ mod tests {
                 if slots < n + n / 2 {
                     continue;
                 }
-                let run = |links: usize| {
-                    let mut t = tour.clone();
-                    let mut cells = vec![Point::default(); n];
-                    let mut pos = vec![0u32; links];
-                    let out = tighten(&moves, start, walk, &mut t, &mut cells, &mut pos, &tabu);
-                    (out, t[..out.steps].to_vec())
-                };
+                let run = |links: usize| tightened((w, h, &bits), walk, &tour, &tabu, links);
                 let words = slots / 2;
                 assert_eq!(hash_words(n), words);
-                assert_eq!(run(words), run(g.cells()), "{w}x{h} seed {seed}");
+                assert_eq!(
+                    run(words),
+                    run(usize::from(w) * usize::from(h)),
+                    "{w}x{h} seed {seed}"
+                );
                 let (short, path) = run(words - 1);
                 assert_eq!((short, path.as_slice()), (walk, &tour[..walk.steps]));
                 smaller += 1;
