@@ -180,7 +180,16 @@ h7_axi=$(section "$h7_elf" .axisram)
 h7_sram123=$(section "$h7_elf" .sram123)
 h7_sram4=$(section "$h7_elf" .sram4)
 h7_itcm=$(section "$h7_elf" .itcm)
-# The twin must place the same buffers in regions of the same sizes.
+# Every region section must be there (`section` prints 0 for a missing one, which would pass the
+# budgets below), and the twin must place the same buffers in regions of the same sizes.
+for elf in "$h7_elf" "$twin_elf"; do
+  for s in .axisram .sram123 .sram4 .itcm; do
+    if [ "$(readelf -SW "$elf" | grep -c " \\$s ")" != 1 ]; then
+      echo "no $s section in $elf" >&2
+      status=1
+    fi
+  done
+done
 for s in .axisram .sram123 .sram4 .itcm; do
   if [ "$(section "$twin_elf" "$s")" != "$(section "$h7_elf" "$s")" ]; then
     echo "the twin's $s ($(section "$twin_elf" "$s") bytes) is not the H743's ($(section "$h7_elf" "$s"))" >&2
