@@ -468,7 +468,10 @@ mod tests {
         assert_eq!((hash_words(10), hash_slots(10, 8)), (8, Some(16)));
         assert_eq!((hash_words(11), hash_slots(11, 15)), (16, None));
         assert_eq!(hash_words(10_922), 8_192);
-        assert_eq!((hash_words(10_923), hash_slots(10_923, 8_192)), (16_384, None));
+        assert_eq!(
+            (hash_words(10_923), hash_slots(10_923, 8_192)),
+            (16_384, None)
+        );
     }
 
     #[test]

@@ -2,7 +2,7 @@
 //! piece of the setup, each iteration, each piece of the local search and the smoothing),
 //! yielding to the executor after every piece so frames keep arriving and `Cancel` works.
 //! A path is streamed into the UART as it is encoded ([`PathStream`]), a piece at a time: no
-//! buffer for a whole frame (up to 40 KiB). The planner reads the map in place: it holds
+//! buffer for a whole frame (up to 80 KiB). The planner reads the map in place: it holds
 //! [`MAP`]'s lock from `Run::new` until its path is sent (on the small boards the planner's
 //! buffers share the map's arena), and a writer (a map upload, a cell update) cancels the plan
 //! first, so it gives the lock up at its next yield, or once its path is out.

@@ -11,7 +11,7 @@
 //! | 2 tours | `steps` each | 1 | the ant's path, the best so far |
 //! | 2 more tours, or none | `steps` each | 1 | the iteration's best and worst paths |
 //! | `points` | `steps + 1` | 4 | the best path as cells, tightening scratch |
-//! | `links` | `cells`, or `>= 2 (steps + 1)` and [`GUIDE_BLOCKS`] | 4 | path positions (tightening), flood-fill ring, pruning stack, route heap, smoothing links |
+//! | `links` | `cells`, or at least tightening's table ([`crate::tighten::hash_words`]`(steps + 1)`: `2 (steps + 1)` half-word slots at a load of 1/2, down to `3 (steps + 1) / 2` at 2/3; fewer leave walks untightened), `steps + 1` (the smoothing's shortest-path rule; fewer: its greedy rule) and [`GUIDE_BLOCKS`] | 4 | path positions (tightening), flood-fill ring, pruning stack, route heap, smoothing links |
 //! | `curve` | iterations recorded | 16 | the convergence curve |
 //! | `guide` | [`GUIDE_BLOCKS`] on maps of more than [`BLOCKS`] cells, else none | 4 | the coarse route ([`crate::route`]) |
 //!
@@ -74,7 +74,8 @@ pub struct Buffers<'a> {
     pub tours: [&'a mut [Dir]; 4],
     /// Path cells: `steps + 1`.
     pub points: &'a mut [Point],
-    /// Links: `cells`, or at least `2 (steps + 1)` (see the module docs).
+    /// Links: `cells`, or at least tightening's hash table, `steps + 1` and [`GUIDE_BLOCKS`] (see
+    /// the module docs).
     pub links: &'a mut [u32],
     /// Convergence curve: one entry per iteration recorded.
     pub curve: &'a mut [CurvePoint],

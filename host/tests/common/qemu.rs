@@ -404,7 +404,7 @@ pub fn core_plan(
 /// tightening's smallest table for them, at least the coarse route's blocks: the STM32H743's
 /// 16,384), the move table only on maps of up to 1024 cells, as the firmware has it
 /// (`firmware::buffers`). The host keeps
-/// the iteration's best and worst paths where the STM32F411 build walks those ants again, so a
+/// the iteration's best and worst paths where the firmware (every board) walks those ants again, so a
 /// match also checks that both ways plan alike.
 pub fn core_plan_steps(
     map: &Map,
