@@ -326,10 +326,18 @@ mod tests {
     use crate::pheromone::{Blocks, Table};
     use crate::rng::Xoshiro128pp;
 
+    /// A walk of [`wandering_walk`]: the map's bits, the walk, its tour and the tabu bits it left.
+    struct Wandering {
+        bits: Vec<u8>,
+        walk: Walk,
+        tour: Vec<Dir>,
+        tabu: Vec<u32>,
+    }
+
     /// A weakly guided walk from corner to corner of a `w x h` map with 20 % random obstacles
-    /// (from `seed`): such walks wander and bulge. The map's bits, the walk, its tour and the tabu
-    /// bits it left; `None` when the goal is blocked or the ant is lost.
-    fn wandering_walk(w: u16, h: u16, seed: u64) -> Option<(Vec<u8>, Walk, Vec<Dir>, Vec<u32>)> {
+    /// (from `seed`): such walks wander and bulge. `None` when the goal is blocked or the ant is
+    /// lost.
+    fn wandering_walk(w: u16, h: u16, seed: u64) -> Option<Wandering> {
         let mut rng = Xoshiro128pp::from_u64(seed);
         let cells = usize::from(w) * usize::from(h);
         let mut bits = vec![0u8; cells.div_ceil(8)];
@@ -362,7 +370,12 @@ mod tests {
         let mut tabu = vec![0u32; crate::bitmap::words(cells)];
         let mut tour = vec![0u8; cells];
         let walk = ant.walk(&mut rng, &mut tabu, &mut tour).ok()?;
-        Some((bits, walk, tour, tabu))
+        Some(Wandering {
+            bits,
+            walk,
+            tour,
+            tabu,
+        })
     }
 
     /// Tighten `walk` (its `tour`) on the map `bits` with `links` words of index: the walk and
@@ -400,7 +413,13 @@ mod tests {
         let (w, h) = (48u16, 40u16);
         let mut changed = 0;
         for seed in 0..40u64 {
-            let Some((bits, walk, tour, tabu)) = wandering_walk(w, h, seed) else {
+            let Some(Wandering {
+                bits,
+                walk,
+                tour,
+                tabu,
+            }) = wandering_walk(w, h, seed)
+            else {
                 continue;
             };
             let n = walk.steps + 1;
@@ -437,7 +456,13 @@ mod tests {
         let (mut smaller, mut shortened) = (0, 0);
         for (w, h) in [(48u16, 40u16), (64, 24), (30, 30), (80, 60)] {
             for seed in 0..40u64 {
-                let Some((bits, walk, tour, tabu)) = wandering_walk(w, h, seed) else {
+                let Some(Wandering {
+                    bits,
+                    walk,
+                    tour,
+                    tabu,
+                }) = wandering_walk(w, h, seed)
+                else {
                     continue;
                 };
                 let n = walk.steps + 1;
