@@ -168,17 +168,6 @@ impl Ant<'_, '_, '_> {
         let width = usize::from(grid.width());
         let last_row = usize::from(grid.height()).wrapping_sub(1);
         while ci != goal {
-            let eta = match self.route {
-                None => self.heuristic.row(cur),
-                Some(r) => {
-                    let b = r.block(cur);
-                    if b != block {
-                        block = b;
-                        target = r.target(cur);
-                    }
-                    self.heuristic.row_toward(cur, target)
-                }
-            };
             let allowed = self.moves.at(ci, cur);
             // The allowed moves into visited (or pruned) cells: from a 3 x 3 read of the tabu
             // set away from the border, one test a move on it.
@@ -198,42 +187,71 @@ impl Ant<'_, '_, '_> {
                 }
                 t
             };
-            // A visited neighbour (not a pruned one) may offer a shortcut.
-            let mut seen = 0u32;
-            let mut m = tabu_moves;
-            while m != 0 {
-                let di = m.trailing_zeros() as usize & 7;
-                m &= m.wrapping_sub(1);
-                let ni = ci.wrapping_add_signed(offsets.get(di).copied().unwrap_or(0));
-                // At most 8: one per bit of the mask.
-                seen = seen.wrapping_add(u32::from(!bitmap::marked(self.dead, ni)));
+            // A visited neighbour (not a pruned one) may offer a shortcut: one of them is the
+            // cell we came from, a second one may be a shortcut. Once one walk cell had two, the
+            // answer is known and the test is skipped.
+            if !may_tighten && tabu_moves & tabu_moves.wrapping_sub(1) != 0 {
+                let mut seen = 0u32;
+                let mut m = tabu_moves;
+                while m != 0 {
+                    let di = m.trailing_zeros() as usize & 7;
+                    m &= m.wrapping_sub(1);
+                    let ni = ci.wrapping_add_signed(offsets.get(di).copied().unwrap_or(0));
+                    // At most 8: one per bit of the mask.
+                    seen = seen.wrapping_add(u32::from(!bitmap::marked(self.dead, ni)));
+                }
+                may_tighten = seen > 1;
             }
             let mut mask = allowed & !tabu_moves;
-            let edges = blocks.edges(cur);
             let mut n = 0usize;
             let mut total = 0.0f32;
-            // Visit the open moves only (set bits of the mask, lowest first).
-            while mask != 0 {
-                // `& 7`: the mask is non-zero, so this is the index itself, and the compiler
-                // knows it is in range for the 8-entry tables below.
-                let di = mask.trailing_zeros() as usize & 7;
-                mask &= mask.wrapping_sub(1); // mask != 0: clears the lowest set bit
-                let ti = edges.get(di).copied().unwrap_or(usize::MAX);
-                let t = tau.get(ti).copied().unwrap_or(0.0);
-                let w = pow(t) * eta.get(di);
-                if let (Some(cd), Some(cw)) = (cand_dir.get_mut(n & 7), cand_w.get_mut(n & 7)) {
-                    *cd = di as u8;
-                    *cw = w;
+            if mask & mask.wrapping_sub(1) == 0 {
+                // No open move or exactly one (a corridor, the way back out of a dead end): no
+                // weights to compute. A single candidate is taken without a draw, as the roulette
+                // below would, so the walk is the same as if its weight had been computed.
+                if let Some(cd) = cand_dir.get_mut(0) {
+                    *cd = mask.trailing_zeros() as u8 & 7;
                 }
-                total += w;
-                n = n.wrapping_add(1); // at most 8, like `seen`
+                n = usize::from(mask != 0);
+                mask = 0;
+            }
+            // The potential field's row (and the route's sub-goal) only where there is a choice.
+            if mask != 0 {
+                let eta = match self.route {
+                    None => self.heuristic.row(cur),
+                    Some(r) => {
+                        // The sub-goal depends on the block only: computed when the ant chooses
+                        // in another block than last time.
+                        let b = r.block(cur);
+                        if b != block {
+                            block = b;
+                            target = r.target(cur);
+                        }
+                        self.heuristic.row_toward(cur, target)
+                    }
+                };
+                let edges = blocks.edges(cur);
+                // Visit the open moves only (set bits of the mask, lowest first).
+                while mask != 0 {
+                    // `& 7`: the mask is non-zero, so this is the index itself, and the compiler
+                    // knows it is in range for the 8-entry tables below.
+                    let di = mask.trailing_zeros() as usize & 7;
+                    mask &= mask.wrapping_sub(1); // mask != 0: clears the lowest set bit
+                    let ti = edges.get(di).copied().unwrap_or(usize::MAX);
+                    let t = tau.get(ti).copied().unwrap_or(0.0);
+                    let w = pow(t) * eta.get(di);
+                    if let (Some(cd), Some(cw)) = (cand_dir.get_mut(n & 7), cand_w.get_mut(n & 7)) {
+                        *cd = di as u8;
+                        *cw = w;
+                    }
+                    total += w;
+                    n = n.wrapping_add(1); // at most 8
+                }
             }
             moves = moves.saturating_add(1);
             if moves > self.budget {
                 return Err(Lost::Budget);
             }
-            // One visited neighbour is the cell we came from; a second one may be a shortcut.
-            may_tighten |= seen > 1;
             let d = if n == 0 {
                 match self.dead_end {
                     DeadEnd::Die => return Err(Lost::Died),

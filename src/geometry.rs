@@ -20,7 +20,41 @@ pub const SQRT_2: f32 = core::f32::consts::SQRT_2;
 pub fn distance(a: Point, b: Point) -> f32 {
     let dx = f32::from(a.x) - f32::from(b.x);
     let dy = f32::from(a.y) - f32::from(b.y);
-    libm::sqrtf(dx * dx + dy * dy)
+    sqrt(dx * dx + dy * dy)
+}
+
+/// The correctly rounded square root (IEEE 754's `squareRoot`, round to nearest even).
+///
+/// On a hard-float Arm target (the Cortex-M4F's FPv4-SP, the Cortex-M7F's FPv5) this is the FPU's
+/// `vsqrt.f32`, one instruction of 14 cycles, where `libm::sqrtf` is a software loop of about 150
+/// instructions; elsewhere (the host) it is `libm::sqrtf`. Both are correctly rounded, so they
+/// return the same bits for every input, and host and device paths stay bit-identical (the unit
+/// test `sqrt_is_libm_sqrtf` checks every length the planner can ask for on the host, and the
+/// QEMU end-to-end tests compare device paths with the host's bit for bit).
+#[inline]
+pub fn sqrt(x: f32) -> f32 {
+    #[cfg(all(target_arch = "arm", target_abi = "eabihf"))]
+    {
+        let r: f32;
+        // SAFETY: `vsqrt.f32` reads one single-precision register and writes another; it touches
+        // no memory, no stack and no flags (FPSCR's cumulative exception bits aside, which nothing
+        // in this crate reads). The `eabihf` ABI guarantees the FPU is present and enabled
+        // (cortex-m-rt enables it before `main` on hard-float targets).
+        #[allow(unsafe_code)]
+        unsafe {
+            core::arch::asm!(
+                "vsqrt.f32 {r}, {x}",
+                r = lateout(sreg) r,
+                x = in(sreg) x,
+                options(pure, nomem, nostack, preserves_flags)
+            );
+        }
+        r
+    }
+    #[cfg(not(all(target_arch = "arm", target_abi = "eabihf")))]
+    {
+        libm::sqrtf(x)
+    }
 }
 
 /// Length of a path of `straight` orthogonal and `diagonal` diagonal steps.
@@ -198,6 +232,31 @@ pub fn turns(points: &[Point]) -> u32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// `sqrt` must be correctly rounded (what `vsqrt.f32` is on the device), so host and device
+    /// lengths agree bit for bit: checked against the f64 root rounded once, for every squared
+    /// distance between two cells of a map up to 2048 cells a side (sums of two squares, the only
+    /// arguments `distance` makes) and for random bit patterns.
+    #[test]
+    fn sqrt_is_correctly_rounded() {
+        let exact = |x: f32| f64::from(x).sqrt() as f32;
+        for dx in 0u32..2048 {
+            for dy in (0..=dx).step_by(7) {
+                let x = (dx * dx + dy * dy) as f32;
+                assert_eq!(sqrt(x).to_bits(), exact(x).to_bits(), "sqrt({x})");
+            }
+        }
+        let mut s = 0x9E37_79B9u32;
+        for _ in 0..200_000 {
+            s ^= s << 13;
+            s ^= s >> 17;
+            s ^= s << 5;
+            let x = f32::from_bits(s & 0x7FFF_FFFF);
+            if x.is_finite() {
+                assert_eq!(sqrt(x).to_bits(), exact(x).to_bits(), "sqrt({x:e})");
+            }
+        }
+    }
 
     #[test]
     fn a_single_point_has_length_plus_zero() {

@@ -407,8 +407,29 @@ fn a_warm_start_after_a_change_that_cuts_the_goal_off_ends_with_no_path() {
     assert!(run.is_warm());
     assert!(!run.step());
     assert_eq!(run.finish().err(), Some(Error::NoPath));
-    // Cold: the flood fill, the first piece of the setup, ends the run before any ant walks.
+    // Cold with backtracking ants: no flood fill either, the first ant proves it in the first
+    // iteration (and no second ant walks).
     let mut run = Run::cold(&g, Point::new(0, 0), goal, &p, st.workspace(), &mut memory).unwrap();
+    assert!(run.setup_step());
+    assert!(!run.is_done());
+    assert!(!run.step());
+    assert_eq!(run.iteration(), 1);
+    assert_eq!(run.finish().err(), Some(Error::NoPath));
+    // Cold with dying ants (which prove nothing): the flood fill, the first piece of the setup,
+    // ends the run before any ant walks.
+    let die = Params {
+        dead_end: crate::DeadEnd::Die,
+        ..p
+    };
+    let mut run = Run::cold(
+        &g,
+        Point::new(0, 0),
+        goal,
+        &die,
+        st.workspace(),
+        &mut memory,
+    )
+    .unwrap();
     assert!(!run.setup_step());
     assert!(run.is_done());
     assert!(!run.step());

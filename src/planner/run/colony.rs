@@ -181,7 +181,8 @@ impl Run<'_, '_> {
                 match walk_tightened(&ant, p.tighten, &mut self.rng, tabu, tour, points, links) {
                     Ok(w) => w,
                     Err(Lost::Exhausted) => {
-                        // Only possible when the flood fill could not decide: now it is decided.
+                        // The goal is not reachable: proved by this ant (backtracking ants run without the
+                        // flood fill, and a fill that could not decide leaves it to them).
                         self.no_path = true;
                         break;
                     }

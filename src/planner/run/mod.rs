@@ -88,7 +88,8 @@ pub struct Run<'g, 'a> {
 /// once, so the firmware yields between them ([`Run::setup_step`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Setup {
-    /// The flood fill (is the goal reachable at all?).
+    /// The flood fill (is the goal reachable at all?), for dying ants only: backtracking ants
+    /// prove an unreachable goal themselves (`setup.rs`).
     Reach,
     /// Dead-end pruning ([`Params::prune`]).
     Prune,
@@ -101,10 +102,11 @@ enum Setup {
 impl<'g, 'a> Run<'g, 'a> {
     /// Validate everything and prepare a run: fails at once on bad parameters, a map larger than
     /// the workspace, or a start or goal off the map or on an obstacle; sets every pheromone entry
-    /// to `tau0`. The rest of the setup (a flood fill: is the goal reachable at all?; pruning the
-    /// cells no shortest path needs, [`Params::prune`]; the coarse route of a large map) runs in
-    /// the first [`Run::step`], or piecewise through [`Run::setup_step`]; an unreachable goal
-    /// ends the run there, and [`Run::finish`] fails with [`Error::NoPath`].
+    /// to `tau0`. The rest of the setup (with [`crate::DeadEnd::Die`], a flood fill: is the goal
+    /// reachable at all?; pruning the cells no shortest path needs, [`Params::prune`]; the coarse
+    /// route of a large map) runs in the first [`Run::step`], or piecewise through
+    /// [`Run::setup_step`]; an unreachable goal ends the run there (or, with backtracking ants,
+    /// in the first ant's walk), and [`Run::finish`] fails with [`Error::NoPath`].
     pub fn new(
         grid: &'g Grid<'g>,
         start: Point,

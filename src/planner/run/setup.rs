@@ -21,12 +21,14 @@ impl Run<'_, '_> {
         let ws = &mut self.ws;
         match self.setup {
             Setup::Reach => {
-                // A warm start with backtracking ants skips the flood fill: if a change cut the
-                // goal off, the first ant backs out of every branch and proves it
-                // (`Lost::Exhausted`, the run ends with `NoPath`) for about what the flood fill
-                // would have cost; otherwise the fill is pure overhead on a replan (4.6 M of 75 M
-                // instructions on Boston 256).
-                let proved_by_ants = self.warm && p.dead_end == DeadEnd::Backtrack;
+                // Backtracking ants skip the flood fill, cold or warm: if the goal is cut off,
+                // the first ant backs out of every branch of the start's component and proves it
+                // (`Lost::Exhausted`: the run ends with `NoPath`) for about what the flood fill
+                // would have cost (both visit that component once); otherwise the fill is pure
+                // overhead, a pass over every cell the plan could reach (4.6 M instructions of a
+                // 90 M plan on Boston 256; issue 27). Only the paper's dying ants, which cannot
+                // prove anything, still need it.
+                let proved_by_ants = p.dead_end == DeadEnd::Backtrack;
                 if !proved_by_ants
                     && grid.reachable(self.start, self.goal, ws.tabu, ws.links) == Reach::No
                 {
