@@ -35,21 +35,27 @@ pub fn distance(a: Point, b: Point) -> f32 {
 pub fn sqrt(x: f32) -> f32 {
     #[cfg(all(target_arch = "arm", target_abi = "eabihf"))]
     {
-        let r: f32;
-        // SAFETY: `vsqrt.f32` reads one single-precision register and writes another; it touches
-        // no memory, no stack and no flags (FPSCR's cumulative exception bits aside, which nothing
-        // in this crate reads). The `eabihf` ABI guarantees the FPU is present and enabled
-        // (cortex-m-rt enables it before `main` on hard-float targets).
+        let r: u32;
+        // SAFETY: the FPU is present and enabled: the `eabihf` ABI passes floats in its registers,
+        // and cortex-m-rt enables it before `main` on hard-float targets. Rust does not expose
+        // the FPU's register class to `asm!` on this target (no `vfp2` target feature), so the
+        // value goes through a core register, and `s0` is saved on the stack and restored: the
+        // block touches no register or memory it does not declare or restore, and no flags
+        // (FPSCR's cumulative exception bits aside, which nothing in this crate reads).
         #[allow(unsafe_code)]
         unsafe {
             core::arch::asm!(
-                "vsqrt.f32 {r}, {x}",
-                r = lateout(sreg) r,
-                x = in(sreg) x,
-                options(pure, nomem, nostack, preserves_flags)
+                "vpush {{s0}}",
+                "vmov s0, {x}",
+                "vsqrt.f32 s0, s0",
+                "vmov {r}, s0",
+                "vpop {{s0}}",
+                x = in(reg) x.to_bits(),
+                r = lateout(reg) r,
+                options(pure, nomem, preserves_flags)
             );
         }
-        r
+        f32::from_bits(r)
     }
     #[cfg(not(all(target_arch = "arm", target_abi = "eabihf")))]
     {
