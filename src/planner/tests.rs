@@ -215,6 +215,7 @@ fn paper_preset_differs_from_default_only_where_documented() {
     assert_eq!(
         Params::paper(),
         Params {
+            ants: 50,
             patience: 0,
             dead_end: crate::DeadEnd::Die,
             smoothing: crate::SmoothingKind::Greedy,

@@ -13,7 +13,7 @@ const EXAMPLE_WAYPOINTS: [Point; 4] = [
 ];
 const EXAMPLE_DIRECTIONS: [u8; 4] = [0, 0, 1, 2];
 /// Ticks (µs of virtual time) the QEMU firmware reported for the example plan.
-const EXAMPLE_TICKS: u64 = 316;
+const EXAMPLE_TICKS: u64 = 107;
 
 fn example_path() -> PathReply<'static> {
     PathReply {
@@ -22,7 +22,7 @@ fn example_path() -> PathReply<'static> {
         turns: 2,
         iterations: 3,
         best_iteration: 0,
-        moves: 600,
+        moves: 144,
         ticks: EXAMPLE_TICKS,
         raw_cells: 5,
         warm: false,
