@@ -50,8 +50,10 @@ pub const fn nibble_bytes(cells: usize) -> usize {
 pub const ENTRY_BYTES: usize = core::mem::size_of::<Entry>();
 
 /// One open-list entry: the cell (index `key >> 3`), the direction it was reached by
-/// (`key & 7`), its `g` and `f = g + h`.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+/// (`key & 7`), its `g` and `f = g + h`. Plain old data (`bytemuck::Pod`), so a caller can carve
+/// the open list out of a byte or word buffer.
+#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+#[repr(C)]
 pub struct Entry {
     f: f32,
     g: f32,
