@@ -18,12 +18,22 @@ length against the `.scen` optimum. A plan that fails shows its error (a path lo
 capacity (Hello's `cells`) is uploaded all the same: its row shows the device's refusal and what
 the map would need.
 The planner's storage does not grow with the map (`BENCHMARKS.md` section 5).
+
+Side by side, on the same pair and the same emulated chip: the exact A* baseline
+(`examples/astar_device.rs`, `ohaca::astar`: 8-connected, no corner cutting, octile heuristic,
+4 bits a cell plus a heap of 12-byte entries), booted once per map with `-icount shift=0` and
+counted from the map in RAM to the path's cells written (SysTick, 40 instructions a cycle,
+calibrated by the bench itself). Its columns: instructions, RAM in bytes a cell (the nibbles plus
+the heap at its peak, over the map's cells), expansions, and ohaca's mean instructions over the
+A*'s. Built if missing: `cargo build --release --example astar_device`.
 """
 
 import argparse
 import math
 import os
+import re
 import statistics
+import subprocess
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
@@ -40,13 +50,58 @@ MAPS = [
     ("256 x 256", "maps/large/Boston_0_256.map", "maps/large/Boston_0_256-random-1.scen"),
     ("512 x 512", "maps/large/NewYork_0_512.map", "maps/large/NewYork_0_512.map.scen"),
     ("1024 x 1024", "maps/large/Sydney_0_1024.map", "maps/large/Sydney_0_1024.map.scen"),
+    # Nav2's sample depot (host/assets/ros/, Apache-2.0) at its native 5 cm: a fixed far pair,
+    # just inside the outer walls' top-left and bottom-right corners.
+    ("604 x 307", "maps/depot.map", ((9, 4), (596, 300))),
 ]
+# The shared fixed map of `maps/README.md` with its stated pair and optimum.
+FIXED = [("26 x 26", "maps/complex-26.map", ((0, 0), (25, 25), 41.7990))]
+ASTAR_ELF = os.path.join(ROOT, "target/thumbv7em-none-eabihf/release/examples/astar_device")
 CHUNK = 128
 BAUD_BYTES = 115200 / 10  # 8N1: ten bits a byte
 
 
+def astar_device(path, start, goal, elf=ASTAR_ELF):
+    """The exact A* on the emulated chip: its `key=value` results (or `error`)."""
+    cmd = ["qemu-system-arm", "-M", "mps2-an386", "-display", "none", "-monitor", "none",
+           "-serial", "null", "-semihosting-config", "enable=on,target=native",
+           "-icount", "shift=0", "-kernel", elf, "-append",
+           f"{os.path.join(ROOT, path)} {start[0]} {start[1]} {goal[0]} {goal[1]}"]
+    out = subprocess.run(cmd, capture_output=True, text=True, timeout=3600, check=False).stdout
+    return dict(re.findall(r"(\w+)=(\S+)", out))
+
+
+def octile_opt(path, start, goal):
+    """The exact 8-connected optimum (no corner cutting) for a pair no `.scen` file states."""
+    import heapq
+    w, h, bits, _ = load_map(os.path.join(ROOT, path))
+    blocked = lambda x, y: not (0 <= x < w and 0 <= y < h) or bits[(y * w + x) // 8] >> (
+        (y * w + x) % 8) & 1
+    dist = {start: 0.0}
+    heap = [(0.0, start)]
+    while heap:
+        d, (x, y) = heapq.heappop(heap)
+        if (x, y) == goal:
+            return d
+        if d > dist[(x, y)]:
+            continue
+        for dx in (-1, 0, 1):
+            for dy in (-1, 0, 1):
+                if (dx, dy) == (0, 0) or blocked(x + dx, y + dy):
+                    continue
+                if dx and dy and (blocked(x + dx, y) or blocked(x, y + dy)):
+                    continue
+                nd = d + (math.sqrt(2) if dx and dy else 1.0)
+                if nd < dist.get((x + dx, y + dy), math.inf):
+                    dist[(x + dx, y + dy)] = nd
+                    heapq.heappush(heap, (nd, (x + dx, y + dy)))
+    return math.nan
+
+
 def longest(scen):
     """(start, goal, optimum) of the scenario with the largest optimum."""
+    if isinstance(scen, tuple):  # a fixed pair: (start, goal[, optimum])
+        return scen if len(scen) == 3 else scen + (None,)
     best = None
     for line in open(os.path.join(ROOT, scen)).read().splitlines()[1:]:
         f = line.split("\t")
@@ -79,12 +134,19 @@ def main():
     ap.add_argument("--seeds", type=int, default=3)
     ap.add_argument("--elf", default=ELF,
                     help="the firmware to boot (default: the QEMU board's release build)")
+    ap.add_argument("--astar-elf", default=ASTAR_ELF,
+                    help="the exact A* bench (examples/astar_device.rs) to boot")
+    ap.add_argument("--no-astar", action="store_true", help="leave the exact A* columns out")
     ap.add_argument("--only", default="",
                     help="comma-separated substrings: only the maps whose file name has one")
     args = ap.parse_args()
     seeds = list(range(1, args.seeds + 1))
     only = [o for o in args.only.split(",") if o]
-    maps = [m for m in MAPS if not only or any(o in os.path.basename(m[1]) for o in only)]
+    maps = [m for m in FIXED + MAPS
+            if not only or any(o in os.path.basename(m[1]) for o in only)]
+    if not args.no_astar and not os.path.exists(args.astar_elf):
+        subprocess.run(["cargo", "build", "--release", "--example", "astar_device"], cwd=ROOT,
+                       check=True)
 
     rows = []
     q = Qemu(icount=True, elf=os.path.abspath(args.elf))
@@ -96,10 +158,14 @@ def main():
         for size, path, scen in maps:
             w, h, bits, _ = load_map(os.path.join(ROOT, path))
             start, goal, opt = longest(scen)
+            if opt is None:
+                opt = octile_opt(path, start, goal)
             wire = wire_bytes(w, h, bits)
             up = dev.set_map(w, h, bits, chunk=CHUNK)
             row = {"size": size, "map": os.path.basename(path), "start": start, "goal": goal,
-                   "opt": opt, "bytes": len(bits), "wire": wire}
+                   "opt": opt, "bytes": len(bits), "wire": wire, "cells": w * h}
+            if not args.no_astar:
+                row["astar"] = astar_device(path, start, goal, elf=os.path.abspath(args.astar_elf))
             if up["kind"] != "Ack":
                 row["refused"] = up
                 rows.append(row)
@@ -124,20 +190,21 @@ def main():
           f"`qemu-system-arm -icount shift=0`.\n")
     print("| size | map | longest scenario (opt8) | map in RAM | raw upload on the wire, at 115200 "
           "| iterations | instructions, mean (min-max) | `Run::new` / iterations / `finish` "
-          "| raw/opt8 |")
-    print("| --- | --- | --- | ---: | --- | --- | --- | --- | --- |")
+          "| raw/opt8 | exact A*: instructions | its RAM, B/cell | expansions "
+          "| ohaca / exact A* |")
+    print("| --- | --- | --- | ---: | --- | --- | --- | --- | --- | ---: | ---: | ---: | ---: |")
     for r in rows:
         head = (f"| {r['size']} | `{r['map']}` | {r['start']} -> {r['goal']} ({r['opt']:.2f}) | "
                 f"{r['bytes']:,} B | {r['wire']:,} B, {r['wire'] / BAUD_BYTES:.1f} s | ")
         if "refused" in r:
             e = r["refused"]
             print(head + f"refused: `{e.get('name')}` (detail {e.get('detail'):,}, limit "
-                  f"{e.get('limit'):,}) | | | |")
+                  f"{e.get('limit'):,}) | | | | " + astar_cells(r, None) + " |")
             continue
         if "failed" in r:
             e = r["failed"]
             print(head + f"every plan: `{e.get('name')}` (detail {e.get('detail'):,}, limit "
-                  f"{e.get('limit'):,}) | | | |")
+                  f"{e.get('limit'):,}) | | | | " + astar_cells(r, None) + " |")
             continue
         runs = r["runs"]
         ticks = [p["ticks"] for p in runs]
@@ -150,8 +217,23 @@ def main():
             split += " M"
         print(head + f"{min(its)}-{max(its)} (mean {statistics.mean(its):.1f}) | "
               f"**{mi(statistics.mean(ticks)):.2f} M** ({mi(min(ticks)):.2f}-"
-              f"{mi(max(ticks)):.2f}) | {split} | {ratio:.4f} |")
+              f"{mi(max(ticks)):.2f}) | {split} | {ratio:.4f} | "
+              + astar_cells(r, statistics.mean(ticks) * 1000) + " |")
     return 0
+
+
+def astar_cells(r, ohaca_instructions):
+    """The exact A* columns of a row: instructions, B/cell, expansions, ohaca / A*."""
+    a = r.get("astar")
+    if a is None:
+        return " | | |"
+    if "error" in a or "instructions" not in a:
+        return f"`{a.get('error', 'no output')}` | | |"
+    n = int(a["instructions"])
+    opt_note = "" if abs(float(a["length"]) - r["opt"]) < 1e-3 else f" (length {a['length']}!)"
+    ratio = f"{ohaca_instructions / n:.1f}x" if ohaca_instructions else ""
+    return (f"{n / 1e6:.2f} M{opt_note} | {int(a['ram_bytes']) / r['cells']:.3f} "
+            f"({int(a['ram_bytes']):,} B) | {int(a['expansions']):,} | {ratio}")
 
 
 if __name__ == "__main__":

@@ -25,6 +25,7 @@
 //! | [`smoothing`] | line-of-sight smoothing of the raw ant path |
 //! | [`taut`] | the smoothed path pulled taut over the cell centres around it |
 //! | [`refine`] | local search: the exact shortest path in a window sliding along a raw path |
+//! | [`astar`] | the exact A* baseline: a whole-map search in 4 bits a cell plus a heap (not used by the planner) |
 //! | [`planner`] | parameters, caller-provided storage, the iteration loop and the result |
 //! | `heap` | (feature `alloc`) the planner's storage on the heap, sized at run time |
 //! | `protocol` | (feature `protocol`) the wire protocol between a host and the firmware |
@@ -98,6 +99,7 @@ pub(crate) mod fmt;
 mod named;
 
 pub mod ant;
+pub mod astar;
 pub mod bitmap;
 pub mod corridor;
 pub mod dir;
