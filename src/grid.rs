@@ -290,6 +290,29 @@ impl<'a> Grid<'a> {
         word >> (i & 7)
     }
 
+    /// The blocked bits of cells `i..i + 57` (bit `k` = cell `i + k`; beyond the map's buffer:
+    /// blocked; the top bits above 57 are 0), from one unaligned 8-byte read: the rows of the
+    /// route's links ([`crate::route`]) 32 cells at a time.
+    #[inline]
+    pub(crate) fn blocked_window(&self, i: usize) -> u64 {
+        let b = i >> 3;
+        let word = match self.bits.get(b..b.wrapping_add(8)) {
+            Some(&[b0, b1, b2, b3, b4, b5, b6, b7]) => {
+                u64::from_le_bytes([b0, b1, b2, b3, b4, b5, b6, b7])
+            }
+            _ => {
+                let mut v = [0xFFu8; 8];
+                for (k, slot) in v.iter_mut().enumerate() {
+                    if let Some(&x) = self.bits.get(b.wrapping_add(k)) {
+                        *slot = x;
+                    }
+                }
+                u64::from_le_bytes(v)
+            }
+        };
+        word >> (i & 7)
+    }
+
     /// The blocked bits of cells `i`, `i + 1`, `i + 2` (bits 0-2; beyond the map: blocked).
     #[inline]
     fn three(&self, i: usize) -> usize {

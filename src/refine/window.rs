@@ -30,7 +30,7 @@ pub(super) fn pred(
         return None;
     }
     // Moves are symmetric (no corner cutting either way), so the mask of `p` gives the moves in.
-    let mask = grid.move_mask(p);
+    let mask = grid.mask_at(p);
     for d in 0..8u8 {
         if mask & (1 << d) == 0 {
             continue;
@@ -262,7 +262,7 @@ pub(super) fn search(
             return Some(gi);
         }
         let p = bbox.point(iu);
-        let mask = grid.move_mask(p);
+        let mask = grid.mask_at(p);
         for d in 0..8u8 {
             if mask & (1 << d) == 0 {
                 continue;
