@@ -3,7 +3,7 @@
 //! ```text
 //! cargo run --release -p ohaca-host-tests --target host-tuple --example quality -- \
 //!     [--algorithm aca|paca|haca|ohaca] [--a A] [--beta B] [--alpha A] [--rho R] [--xi X] [--q Q]
-//!     [--ants M] [--iterations N] [--patience P] [--seeds N] [--dead-end backtrack|die]
+//!     [--ants M] [--iterations N] [--patience P] [--refine-patience P] [--seeds N] [--dead-end backtrack|die]
 //!     [--smoothing shortest|greedy|none] [--no-tighten]
 //! ```
 //!
@@ -19,7 +19,7 @@ use ohaca_host_tests::maps::scenarios;
 use ohaca_host_tests::quality::{prepare, run_map, summarize};
 
 const USAGE: &str = "usage: quality [--algorithm aca|paca|haca|ohaca] [--a A] [--beta B] \
-[--alpha A] [--rho R] [--xi X] [--q Q] [--ants M] [--iterations N] [--patience P] [--seeds N] \
+[--alpha A] [--rho R] [--xi X] [--q Q] [--ants M] [--iterations N] [--patience P] [--refine-patience P] [--seeds N] \
 [--dead-end backtrack|die] [--smoothing shortest|greedy|none] [--no-tighten]";
 
 fn parse_args(args: &[String]) -> Result<(Params, u64), String> {
@@ -70,6 +70,7 @@ fn parse_args(args: &[String]) -> Result<(Params, u64), String> {
             "--ants" => p.ants = u()?,
             "--iterations" => p.iterations = u()?,
             "--patience" => p.patience = u()?,
+            "--refine-patience" => p.refine_patience = u()?,
             "--seeds" => {
                 seeds = value
                     .parse()

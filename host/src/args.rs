@@ -76,7 +76,7 @@ pub fn parse_bool(s: &str) -> Result<bool, String> {
 /// A named set of planner parameters that the flags start from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum Preset {
-    /// [`Params::default`]: the paper's constants with backtracking ants, path tightening, early
+    /// [`Params::default`]: the paper's constants with 12 backtracking ants, path tightening, early
     /// stopping and shortest smoothing.
     #[default]
     Default,

@@ -159,7 +159,7 @@ fn json_on_complex_26() {
     let params: Params = serde_json::from_value(v["params"].clone()).unwrap();
     assert_eq!(params, Params::default());
     assert_eq!(v["params"]["algorithm"], "ohaca");
-    assert_eq!(v["params"]["ants"], 50);
+    assert_eq!(v["params"]["ants"], 12);
     assert_eq!(v["params"]["iterations"], 100);
     assert_eq!(v["params"]["seed"], 1);
     assert_eq!(v["params"]["dead_end"], "backtrack");
@@ -702,7 +702,7 @@ fn help_and_version() {
     ] {
         assert!(out.contains(flag), "{flag} missing from help");
     }
-    assert!(out.contains("[default: 50]"), "{out}");
+    assert!(out.contains("[default: 12, paper: 50]"), "{out}");
     assert_eq!(ohaca(&["--version"]).status.code(), Some(0));
 }
 

@@ -48,11 +48,11 @@ impl Algorithm {
 /// Every tunable of the planner.
 ///
 /// Two presets: [`Params::default`] is this project's setting (the paper's `alpha`, `beta`, `rho`,
-/// `Q`, `a`, `xi` and `N`, 12 ants instead of the paper's `M = 50`, plus backtracking ants, path tightening, dead-end pruning, early
-/// stopping after 10 stale iterations (2 with the local search of large maps or for a warm
-/// replan), the local search and shortest smoothing); [`Params::paper`] is the paper's algorithm
-/// as written (50 ants that die at dead ends, no tightening, no pruning, always all `N` iterations, no
-/// local search, greedy smoothing).
+/// `Q`, `a`, `xi` and `N`, 12 ants instead of the paper's `M = 50`, plus backtracking ants, path
+/// tightening, dead-end pruning, early stopping after 10 stale iterations (1 with the local
+/// search, 2 for a warm replan), the local search and shortest smoothing); [`Params::paper`] is
+/// the paper's algorithm as written (50 ants that die at dead ends, no tightening, no pruning,
+/// always all `N` iterations, no local search, greedy smoothing).
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
@@ -145,7 +145,7 @@ impl Params {
         tau_max: 100.0,
         patience: 10,
         warm_patience: 2,
-        refine_patience: 2,
+        refine_patience: 1,
         seed: 1,
         dead_end: DeadEnd::Backtrack,
         smoothing: SmoothingKind::Shortest,

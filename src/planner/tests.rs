@@ -719,8 +719,12 @@ fn a_refining_run_counts_gains_of_one_percent_or_less_as_stale() {
     // Replay the rule from the best length after each iteration: the run stops `refine_patience`
     // iterations after the last gain of more than 1 % (against the best at the gain before),
     // whatever smaller gains came after it; and the seeds include such smaller gains, so the rule
-    // is exercised, not just the plain patience.
-    let p = Params::default();
+    // is exercised, not just the plain patience. A patience of 3 (the default's is 1) gives the
+    // small gains iterations to happen in.
+    let p = Params {
+        refine_patience: 3,
+        ..Params::default()
+    };
     let (b, w, h) = maze_10();
     let g = Grid::new(w, h, &b).unwrap();
     let mut st = crate::heap::HeapStorage::for_run(g.cells(), &p).unwrap();

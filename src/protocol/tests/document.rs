@@ -13,16 +13,16 @@ const EXAMPLE_WAYPOINTS: [Point; 4] = [
 ];
 const EXAMPLE_DIRECTIONS: [u8; 4] = [0, 0, 1, 2];
 /// Ticks (µs of virtual time) the QEMU firmware reported for the example plan.
-const EXAMPLE_TICKS: u64 = 107;
+const EXAMPLE_TICKS: u64 = 83;
 
 fn example_path() -> PathReply<'static> {
     PathReply {
         raw_length: 4.414_213_7,
         length: 4.236_068,
         turns: 2,
-        iterations: 3,
+        iterations: 2,
         best_iteration: 0,
-        moves: 144,
+        moves: 96,
         ticks: EXAMPLE_TICKS,
         raw_cells: 5,
         warm: false,
