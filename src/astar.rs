@@ -267,7 +267,7 @@ fn forward(d: u32, m: u32) -> u32 {
         rot(0b1100_0111) // d - 2, d - 1, d, d + 1, d + 2
     } else {
         let forced = rot(0b0010_1000) & !m; // cells d + 3 and d + 5 (= d - 3) not allowed
-        // d + 3 -> d + 2 is a right shift by 1; d + 5 -> d + 6 a left rotation by 1.
+                                            // d + 3 -> d + 2 is a right shift by 1; d + 5 -> d + 6 a left rotation by 1.
         let forced = (forced >> 1 | forced << 7 | forced << 1 | forced >> 7) & 0xFF;
         rot(0b1000_0011) | (forced & rot(0b0100_0100))
     }
@@ -355,7 +355,8 @@ impl Open<'_> {
         let mut h = 0usize;
         let mut c = 3usize;
         while let Some(&[l0, l1, l2, r0, r1, r2]) = w.get(c..c.wrapping_add(6)) {
-            let right = (u64::from(r1) << 32 | u64::from(r0)) < (u64::from(l1) << 32 | u64::from(l0));
+            let right =
+                (u64::from(r1) << 32 | u64::from(r0)) < (u64::from(l1) << 32 | u64::from(l0));
             let (e0, e1, e2, cc) = if right {
                 (r0, r1, r2, c.wrapping_add(3))
             } else {
@@ -851,13 +852,7 @@ pub fn write_path(
     out: &mut [Point],
 ) -> Result<usize, AstarError> {
     let back = path_back(grid, nibbles, goal);
-    write_from(
-        back,
-        |p| nib(nibbles, grid.index(p)) == START,
-        goal,
-        s,
-        out,
-    )
+    write_from(back, |p| nib(nibbles, grid.index(p)) == START, goal, s, out)
 }
 
 /// Write the path [`search_costs`] found, start first and goal last, into `out`; returns how
@@ -870,13 +865,7 @@ pub fn write_path_costs(
     out: &mut [Point],
 ) -> Result<usize, AstarError> {
     let back = path_back_costs(grid, costs, goal);
-    write_from(
-        back,
-        |p| costs.get(grid.index(p)) == Some(&0),
-        goal,
-        s,
-        out,
-    )
+    write_from(back, |p| costs.get(grid.index(p)) == Some(&0), goal, s, out)
 }
 
 #[cfg(test)]
@@ -1077,7 +1066,10 @@ mod tests {
         assert_eq!(write_path(&grid, &nib, g, &r, &mut short), too_long);
         let rc = search_costs(&grid, s, g, &mut costs, &mut heap).unwrap();
         assert_eq!(rc.ram_bytes(), 32 + 12 * rc.peak_heap as usize);
-        assert_eq!(write_path_costs(&grid, &costs, g, &rc, &mut short), too_long);
+        assert_eq!(
+            write_path_costs(&grid, &costs, g, &rc, &mut short),
+            too_long
+        );
         // Storage with no tree.
         let mut out = [Point::default(); 8];
         assert_eq!(
