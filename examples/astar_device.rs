@@ -1,5 +1,7 @@
-//! The exact A* baseline (`ohaca::astar`, 4 bits a cell plus a heap) as a bare-metal bench for
-//! QEMU's mps2-an386 (Cortex-M4F), counted the way the firmware's plans are (issue 27 item 1).
+//! The exact A* baseline (`ohaca::astar`) in both its variants, 4 bits a cell plus a heap
+//! (`astar::search`) and a `u32` cost a cell plus a heap (`astar::search_costs`), as a bare-metal
+//! bench for QEMU's mps2-an386 (Cortex-M4F), counted the way the firmware's plans are (issue 27
+//! item 1).
 //!
 //! ```sh
 //! cargo build --release --example astar_device
@@ -11,10 +13,11 @@
 //!
 //! The command line (semihosting `SYS_GET_CMDLINE`, QEMU's `-append`) names a Moving AI `.map`
 //! file on the host and the start and goal cells. The file is read over semihosting and parsed
-//! into the map's bits (one bit a cell, `ohaca::grid`) before anything is counted. Counted: from
-//! that map in RAM to the path's cells written, i.e. the nibbles filled from the bits, the search
-//! and the path written out. One line of `key=value` results goes to the host's stdout; the exit
-//! status is 0 on a path, 1 otherwise.
+//! into the map's bits (one bit a cell, `ohaca::grid`) before anything is counted. Counted, for
+//! each variant in turn: from that map in RAM to the path's cells written, i.e. the per-cell
+//! storage cleared, the search and the path written out. Two lines of `key=value` results go to
+//! the host's stdout (the 4-bit variant's keys bare, the cost variant's prefixed `c_`); the exit
+//! status is 0 if both found a path, 1 otherwise.
 //!
 //! **Counting.** QEMU's `-icount shift=0` advances virtual time 1 ns per instruction. SysTick runs
 //! from the 25 MHz core clock (`src/firmware/board/qemu/systick.rs`), so one SysTick cycle is
@@ -24,8 +27,9 @@
 //! The SysTick interrupt counts the 2^24-cycle wraps (about 671 M instructions each).
 //!
 //! **Memory.** The QEMU board's `memory.x` keeps to the F411's 128 KiB of RAM; the buffers here
-//! (the file text, the bits, the nibbles, the path and the open list) live in the board's 16 MiB
-//! of PSRAM at 0x2100_0000, which no linker script uses: one audited `unsafe` below.
+//! (the file text, the bits, the nibbles, the costs, the path and the open list) live in the
+//! board's 16 MiB of PSRAM at 0x2100_0000, which no linker script uses: one audited `unsafe`
+//! below.
 //!
 //! On the host this example is an empty `main` (the workspace's `--all-targets` runs build it).
 #![cfg_attr(all(target_arch = "arm", target_os = "none"), no_std, no_main)]
