@@ -1,5 +1,7 @@
-//! The exact A* baseline (`ohaca::astar`, 4 bits a cell plus a heap) as a bare-metal bench for
-//! QEMU's mps2-an386 (Cortex-M4F), counted the way the firmware's plans are (issue 27 item 1).
+//! The exact A* baseline (`ohaca::astar`) in both its variants, 4 bits a cell plus a heap
+//! (`astar::search`) and a `u32` cost a cell plus a heap (`astar::search_costs`), as a bare-metal
+//! bench for QEMU's mps2-an386 (Cortex-M4F), counted the way the firmware's plans are (issue 27
+//! item 1).
 //!
 //! ```sh
 //! cargo build --release --example astar_device
@@ -11,10 +13,11 @@
 //!
 //! The command line (semihosting `SYS_GET_CMDLINE`, QEMU's `-append`) names a Moving AI `.map`
 //! file on the host and the start and goal cells. The file is read over semihosting and parsed
-//! into the map's bits (one bit a cell, `ohaca::grid`) before anything is counted. Counted: from
-//! that map in RAM to the path's cells written, i.e. the nibbles filled from the bits, the search
-//! and the path written out. One line of `key=value` results goes to the host's stdout; the exit
-//! status is 0 on a path, 1 otherwise.
+//! into the map's bits (one bit a cell, `ohaca::grid`) before anything is counted. Counted, for
+//! each variant in turn: from that map in RAM to the path's cells written, i.e. the per-cell
+//! storage cleared, the search and the path written out. Two lines of `key=value` results go to
+//! the host's stdout (the 4-bit variant's keys bare, the cost variant's prefixed `c_`); the exit
+//! status is 0 if both found a path, 1 otherwise.
 //!
 //! **Counting.** QEMU's `-icount shift=0` advances virtual time 1 ns per instruction. SysTick runs
 //! from the 25 MHz core clock (`src/firmware/board/qemu/systick.rs`), so one SysTick cycle is
@@ -24,8 +27,9 @@
 //! The SysTick interrupt counts the 2^24-cycle wraps (about 671 M instructions each).
 //!
 //! **Memory.** The QEMU board's `memory.x` keeps to the F411's 128 KiB of RAM; the buffers here
-//! (the file text, the bits, the nibbles, the path and the open list) live in the board's 16 MiB
-//! of PSRAM at 0x2100_0000, which no linker script uses: one audited `unsafe` below.
+//! (the file text, the bits, the nibbles, the costs, the path and the open list) live in the
+//! board's 16 MiB of PSRAM at 0x2100_0000, which no linker script uses: one audited `unsafe`
+//! below.
 //!
 //! On the host this example is an empty `main` (the workspace's `--all-targets` runs build it).
 #![cfg_attr(all(target_arch = "arm", target_os = "none"), no_std, no_main)]
@@ -237,50 +241,70 @@ mod device {
         let grid = Grid::new(w, h, bits).unwrap_or_else(|_| fail("bad map"));
         let (nibbles, rest) =
             take(rest, astar::nibble_bytes(cells)).unwrap_or_else(|| fail("memory"));
+        let (costs_mem, rest) = take(rest, 4 * cells).unwrap_or_else(|| fail("memory"));
+        let costs: &mut [u32] = bytemuck::cast_slice_mut(costs_mem);
         let (path_mem, rest) = take(rest, 4 * 65_536).unwrap_or_else(|| fail("memory"));
         let path_out: &mut [Point] = bytemuck::cast_slice_mut(path_mem);
         let heap_len = rest.len() / astar::ENTRY_BYTES * astar::ENTRY_BYTES;
         let heap: &mut [Entry] = bytemuck::cast_slice_mut(&mut rest[..heap_len]);
         let (start, goal) = (Point::new(sx, sy), Point::new(gx, gy));
 
-        // Counted: map in RAM -> path cells written.
+        // Counted, each variant: map in RAM -> path cells written.
         let t0 = now();
-        let r = astar::search(&grid, start, goal, nibbles, heap)
+        let r4 = astar::search(&grid, start, goal, nibbles, heap)
             .and_then(|s| astar::write_path(&grid, nibbles, goal, &s, path_out).map(|n| (s, n)));
         let t1 = now();
-        let cycles = (t1 - t0).saturating_sub(overhead);
+        let cycles4 = (t1 - t0).saturating_sub(overhead);
+        let t0 = now();
+        let rc = astar::search_costs(&grid, start, goal, costs, heap).and_then(|s| {
+            astar::write_path_costs(&grid, costs, goal, &s, path_out).map(|n| (s, n))
+        });
+        let t1 = now();
+        let cycles_c = (t1 - t0).saturating_sub(overhead);
 
         let mut o = out().unwrap_or_else(|| fail("no stdout"));
-        let _ = write!(
+        let _ = writeln!(
             o,
-            "astar w={w} h={h} start={sx},{sy} goal={gx},{gy} cycles={cycles} \
-             instructions={} instr_per_cycle={}.{:03} calib_cycles={c1},{c2} overhead_cycles={overhead} ",
-            cycles * INSTR_PER_CYCLE,
+            "astar w={w} h={h} start={sx},{sy} goal={gx},{gy} instr_per_cycle={}.{:03} \
+             calib_cycles={c1},{c2} overhead_cycles={overhead}",
             per_cycle_milli / 1000,
             per_cycle_milli % 1000
         );
-        match r {
-            Ok((s, n)) => {
-                let _ = writeln!(
-                    o,
-                    "length={:.6} steps={} cells_written={n} expansions={} pushes={} \
-                     peak_heap={} nibble_bytes={} heap_bytes={} ram_bytes={}",
-                    s.length,
-                    s.steps(),
-                    s.expansions,
-                    s.pushes,
-                    s.peak_heap,
-                    astar::nibble_bytes(cells),
-                    s.peak_heap as usize * astar::ENTRY_BYTES,
-                    s.ram_bytes(cells)
-                );
-                debug::exit(debug::EXIT_SUCCESS);
-            }
-            Err(e) => {
-                let _ = writeln!(o, "error={e}");
-                debug::exit(debug::EXIT_FAILURE);
+        let mut ok = true;
+        for (prefix, r, cycles) in [("", r4, cycles4), ("c_", rc, cycles_c)] {
+            let _ = write!(
+                o,
+                "{prefix}cycles={cycles} {prefix}instructions={} ",
+                cycles * INSTR_PER_CYCLE
+            );
+            match r {
+                Ok((s, n)) => {
+                    let _ = writeln!(
+                        o,
+                        "{prefix}length={:.6} {prefix}steps={} {prefix}cells_written={n} \
+                         {prefix}expansions={} {prefix}pushes={} {prefix}peak_heap={} \
+                         {prefix}cell_bytes={} {prefix}heap_bytes={} {prefix}ram_bytes={}",
+                        s.length,
+                        s.steps(),
+                        s.expansions,
+                        s.pushes,
+                        s.peak_heap,
+                        s.cell_bytes,
+                        s.peak_heap as usize * astar::ENTRY_BYTES,
+                        s.ram_bytes()
+                    );
+                }
+                Err(e) => {
+                    ok = false;
+                    let _ = writeln!(o, "{prefix}error={e}");
+                }
             }
         }
+        debug::exit(if ok {
+            debug::EXIT_SUCCESS
+        } else {
+            debug::EXIT_FAILURE
+        });
         loop {
             cortex_m::asm::bkpt();
         }

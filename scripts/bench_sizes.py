@@ -21,11 +21,14 @@ The planner's storage does not grow with the map (`BENCHMARKS.md` section 5).
 
 Side by side, on the same pair and the same emulated chip: the exact A* baseline
 (`examples/astar_device.rs`, `ohaca::astar`: 8-connected, no corner cutting, octile heuristic,
-4 bits a cell plus a heap of 12-byte entries), booted once per map with `-icount shift=0` and
-counted from the map in RAM to the path's cells written (SysTick, 40 instructions a cycle,
-calibrated by the bench itself). Its columns: instructions, RAM in bytes a cell (the nibbles plus
-the heap at its peak, over the map's cells), expansions, and ohaca's mean instructions over the
-A*'s. Built if missing: `cargo build --release --example astar_device`.
+exact integer costs), booted once per map with `-icount shift=0` and counted from the map in RAM
+to the path's cells written (SysTick, 40 instructions a cycle, calibrated by the bench itself),
+in both variants: 4 bits a cell (`astar::search`: closed flag and parent in a nibble, `g` only in
+the heap) and a cost a cell (`astar::search_costs`: `g` as u32 a cell, a push only when it
+improves). Its columns: each variant's instructions and RAM in bytes a cell (the per-cell storage
+plus the heap at its peak, over the map's cells), the expansions (the same in both), and ohaca's
+mean instructions over the 4-bit A*'s. Built if missing:
+`cargo build --release --example astar_device`.
 """
 
 import argparse
@@ -190,9 +193,10 @@ def main():
           f"`qemu-system-arm -icount shift=0`.\n")
     print("| size | map | longest scenario (opt8) | map in RAM | raw upload on the wire, at 115200 "
           "| iterations | instructions, mean (min-max) | `Run::new` / iterations / `finish` "
-          "| raw/opt8 | exact A*: instructions | its RAM, B/cell | expansions "
-          "| ohaca / exact A* |")
-    print("| --- | --- | --- | ---: | --- | --- | --- | --- | --- | ---: | ---: | ---: | ---: |")
+          "| raw/opt8 | exact A* 4-bit: instructions | its RAM, B/cell | A* cost a cell: "
+          "instructions | its RAM, B/cell | expansions | ohaca / exact A* 4-bit |")
+    print("| --- | --- | --- | ---: | --- | --- | --- | --- | --- | ---: | ---: | ---: | ---: "
+          "| ---: | ---: |")
     for r in rows:
         head = (f"| {r['size']} | `{r['map']}` | {r['start']} -> {r['goal']} ({r['opt']:.2f}) | "
                 f"{r['bytes']:,} B | {r['wire']:,} B, {r['wire'] / BAUD_BYTES:.1f} s | ")
@@ -223,17 +227,25 @@ def main():
 
 
 def astar_cells(r, ohaca_instructions):
-    """The exact A* columns of a row: instructions, B/cell, expansions, ohaca / A*."""
+    """The exact A* columns of a row: each variant's instructions and B/cell, the expansions,
+    ohaca / the 4-bit A*."""
     a = r.get("astar")
     if a is None:
-        return " | | |"
-    if "error" in a or "instructions" not in a:
-        return f"`{a.get('error', 'no output')}` | | |"
-    n = int(a["instructions"])
-    opt_note = "" if abs(float(a["length"]) - r["opt"]) < 1e-3 else f" (length {a['length']}!)"
-    ratio = f"{ohaca_instructions / n:.1f}x" if ohaca_instructions else ""
-    return (f"{n / 1e6:.2f} M{opt_note} | {int(a['ram_bytes']) / r['cells']:.3f} "
-            f"({int(a['ram_bytes']):,} B) | {int(a['expansions']):,} | {ratio}")
+        return " | | | | |"
+    cols = []
+    for p in ("", "c_"):
+        if p + "error" in a or p + "instructions" not in a:
+            cols += [f"`{a.get(p + 'error', 'no output')}`", ""]
+            continue
+        n = int(a[p + "instructions"])
+        ok = abs(float(a[p + "length"]) - r["opt"]) < 1e-3
+        note = "" if ok else f" (length {a[p + 'length']}!)"
+        ram = int(a[p + "ram_bytes"])
+        cols += [f"{n / 1e6:.2f} M{note}", f"{ram / r['cells']:.3f} ({ram:,} B)"]
+    cols.append(f"{int(a['expansions']):,}" if "expansions" in a else "")
+    n4 = int(a.get("instructions", 0)) if "length" in a else 0
+    cols.append(f"{ohaca_instructions / n4:.1f}x" if ohaca_instructions and n4 else "")
+    return " | ".join(cols)
 
 
 if __name__ == "__main__":

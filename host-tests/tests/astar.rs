@@ -1,4 +1,4 @@
-//! The core's exact A* (`ohaca::astar`, the 4-bit baseline of issue 27) against the independent
+//! The core's exact A* (`ohaca::astar`, both variants of issue 27's baseline) against the independent
 //! references: the `optimal` column of every large map's `.scen` file (8-connected, no corner
 //! cutting: `maps/large/README.md`) and `reference::astar8` on random maps. Its path must be
 //! valid move by move (`reference::step_allowed`, written without the core's move code) and its
@@ -12,15 +12,44 @@ use ohaca_host_tests::maps::{load_scen, maps_dir, Map};
 use ohaca_host_tests::reference::{astar8, step_allowed};
 use proptest::prelude::*;
 
-/// Run the core's A* on `map`, check the path it writes, return the result and the path's exact
-/// length (`straight + diagonal * sqrt 2` in f64).
+/// Run both variants of the core's A* on `map` (the 4-bit [`astar::search`] and the cost-a-cell
+/// [`astar::search_costs`]), check the paths they write and that they agree on the optimum and
+/// the expansions; return the 4-bit result and the path's exact length.
 fn solve(map: &Map, s: Point, g: Point) -> Result<(Search, f64), AstarError> {
+    let a = solve_one(map, s, g, false);
+    let b = solve_one(map, s, g, true);
+    match (&a, &b) {
+        (Ok((ra, la)), Ok((rb, lb))) => {
+            assert_eq!(la, lb, "the variants' lengths differ");
+            assert_eq!(
+                ra.expansions, rb.expansions,
+                "the variants expand differently"
+            );
+        }
+        (Err(ea), Err(eb)) => assert_eq!(ea, eb),
+        _ => panic!("4-bit {a:?}, costs {b:?}"),
+    }
+    a
+}
+
+/// One variant: check the path it writes, return the result and the path's exact length
+/// (`straight + diagonal * sqrt 2` in f64).
+fn solve_one(map: &Map, s: Point, g: Point, costs: bool) -> Result<(Search, f64), AstarError> {
     let grid: Grid<'_> = map.grid();
     let mut nib = vec![0u8; astar::nibble_bytes(map.cells())];
+    let mut cost = vec![0u32; map.cells()];
     let mut heap = vec![Entry::EMPTY; 8 * map.cells() + 8];
-    let r = astar::search(&grid, s, g, &mut nib, &mut heap)?;
+    let r = if costs {
+        astar::search_costs(&grid, s, g, &mut cost, &mut heap)?
+    } else {
+        astar::search(&grid, s, g, &mut nib, &mut heap)?
+    };
     let mut path = vec![Point::default(); r.steps() as usize + 1];
-    let n = astar::write_path(&grid, &nib, g, &r, &mut path)?;
+    let n = if costs {
+        astar::write_path_costs(&grid, &cost, g, &r, &mut path)?
+    } else {
+        astar::write_path(&grid, &nib, g, &r, &mut path)?
+    };
     assert_eq!(n, path.len());
     assert_eq!((path[0], path[n - 1]), (s, g));
     let (mut st, mut di) = (0u32, 0u32);
