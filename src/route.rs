@@ -337,6 +337,8 @@ fn links(moves: &Moves<'_>, blocks: Blocks, dead: &[u32], words: &mut [u32]) {
         let free = !blocked;
         (free, free & !pruned)
     };
+    // Blocks of at most 32 columns start at multiples of 32 in every run: the same bits in all.
+    let columns = block_columns(0, last);
     for y in 0..h {
         let below = y.wrapping_add(1) < h;
         let y_crosses = below && y & last == last;
@@ -362,36 +364,63 @@ fn links(moves: &Moves<'_>, blocks: Blocks, dead: &[u32], words: &mut [u32]) {
             };
             // The cell of bit j: x0 - 1 + j (j >= 1).
             let cell = |j: usize| x0.wrapping_add(j).wrapping_sub(1);
-            for x in Ones(east & run).map(cell) {
-                if x & last == last {
-                    link(x, y, 0);
-                }
+            // The bits of the run's cells in a block's last column (x & last == last) and in its
+            // first (x & last == 0).
+            let (ends, starts) = if last < 32 {
+                columns
+            } else {
+                block_columns(x0, last)
+            };
+            // Moves across a block's east side: east, and south-east from its last column when
+            // they stay in the block row.
+            let across_east = (east | if y_crosses { 0 } else { south_east }) & ends & run;
+            for x in Ones(across_east).map(cell) {
+                link(x, y, 0);
             }
-            if y_crosses {
-                for x in Ones(south & run).map(cell) {
+            // South-west from a block's first column within the block row: the west link, i.e.
+            // the east link of the block to the left, from its last column.
+            if !y_crosses {
+                for x in Ones(south_west & starts & run).map(cell) {
+                    link(x.wrapping_sub(1), y, 0);
+                }
+            } else {
+                // The block row's last row: south, and the diagonals that stay in the block
+                // column, give the south link; one bit a block is enough, so each block's bits
+                // are folded onto its first column before the loop.
+                let mut down = (south | south_east & !ends | south_west & !starts) & run;
+                if last < 32 {
+                    let mut k = 1usize;
+                    while k <= last {
+                        down |= down >> k;
+                        k = k.wrapping_mul(2);
+                    }
+                    down &= starts;
+                }
+                for x in Ones(down).map(cell) {
                     link(x, y, 2);
                 }
-            }
-            for x in Ones(south_east & run).map(cell) {
-                match (x & last == last, y_crosses) {
-                    (true, true) => link(x, y, 1),
-                    (true, false) => link(x, y, 0),
-                    (false, true) => link(x, y, 2),
-                    (false, false) => {}
+                for x in Ones(south_east & ends & run).map(cell) {
+                    link(x, y, 1);
                 }
-            }
-            for x in Ones(south_west & run).map(cell) {
-                match (x & last == 0, y_crosses) {
-                    (true, true) => link(x, y, 3),
-                    // West: the east link of the block to the left, from its last column.
-                    (true, false) => link(x.wrapping_sub(1), y, 0),
-                    (false, true) => link(x, y, 2),
-                    (false, false) => {}
+                for x in Ones(south_west & starts & run).map(cell) {
+                    link(x, y, 3);
                 }
             }
             x0 = x0.wrapping_add(32);
         }
     }
+}
+
+/// For the run of cells starting at column `x0` (bit j = column x0 - 1 + j, j in 1..=32): the bits
+/// of the columns that end a block (`x & last == last`) and of those that start one.
+fn block_columns(x0: usize, last: usize) -> (u64, u64) {
+    let (mut ends, mut starts) = (0u64, 0u64);
+    for j in 1..=32usize {
+        let x = x0.wrapping_add(j).wrapping_sub(1);
+        ends |= u64::from(x & last == last) << j;
+        starts |= u64::from(x & last == 0) << j;
+    }
+    (ends, starts)
 }
 
 /// The positions of the set bits of a word, lowest first.
@@ -603,9 +632,10 @@ mod tests {
             (64, 5),
             (70, 40),
             (97, 66),
+            (200, 70),
         ];
         for &(w, h) in &shapes {
-            for s in 0..=4u8 {
+            for s in 0..=6u8 {
                 for pruned in [false, true] {
                     let cells = usize::from(w) * usize::from(h);
                     let mut b = vec![0u8; cells.div_ceil(8)];
