@@ -313,6 +313,28 @@ impl<'a> Grid<'a> {
         word >> (i & 7)
     }
 
+    /// The free cells of row `y` around the run of 32 columns from `x0` as bits: bit `j` (0..=33)
+    /// is column `x0 - 1 + j`; columns off the map (left of 0, right of the last) read as not
+    /// free. For passes over the map 32 cells at a time ([`crate::route`], [`crate::prune`]).
+    #[inline]
+    pub(crate) fn free_window(&self, y: usize, x0: usize) -> u64 {
+        let w = usize::from(self.width);
+        let row = y.wrapping_mul(w);
+        let blocked = if x0 == 0 {
+            self.blocked_window(row) << 1 | 1
+        } else {
+            self.blocked_window(row.wrapping_add(x0).wrapping_sub(1))
+        };
+        // The first bit past the row: column w, bit w - x0 + 1 (>= 2 for x0 < w).
+        let end = w.wrapping_add(1).wrapping_sub(x0);
+        let on_row = if end < 64 {
+            !(u64::MAX << end)
+        } else {
+            u64::MAX
+        };
+        !blocked & on_row
+    }
+
     /// The blocked bits of cells `i`, `i + 1`, `i + 2` (bits 0-2; beyond the map: blocked).
     #[inline]
     fn three(&self, i: usize) -> usize {

@@ -315,26 +315,15 @@ fn links(moves: &Moves<'_>, blocks: Blocks, dead: &[u32], words: &mut [u32]) {
     };
     // Bit j of a window is cell x0 - 1 + j of its row; cells off the row read as blocked.
     let window = |y: usize, x0: usize| -> (u64, u64) {
+        let free = grid.free_window(y, x0);
         let row = y.wrapping_mul(w);
-        let mut blocked = if x0 == 0 {
-            grid.blocked_window(row) << 1 | 1
-        } else {
-            grid.blocked_window(row.wrapping_add(x0).wrapping_sub(1))
-        };
-        let mut pruned = if dead.is_empty() {
+        let pruned = if dead.is_empty() {
             0
         } else if x0 == 0 {
             crate::bitmap::window(dead, row) << 1
         } else {
             crate::bitmap::window(dead, row.wrapping_add(x0).wrapping_sub(1))
         };
-        // Cells x0 - 1 + j for j up to 33 matter; those at or past the row's end are blocked.
-        let end = w.wrapping_add(1).wrapping_sub(x0); // first j past the row: w - x0 + 1 >= 2
-        if end < 64 {
-            blocked |= u64::MAX << end;
-            pruned &= !(u64::MAX << end);
-        }
-        let free = !blocked;
         (free, free & !pruned)
     };
     // Blocks of at most 32 columns start at multiples of 32 in every run: the same bits in all.

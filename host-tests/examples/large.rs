@@ -4,6 +4,7 @@
 //! ```text
 //! cargo run --release -p ohaca-host-tests --target host-tuple --example large -- \
 //!     [--maps NAME,NAME,...] [--scen N] [--seeds N] [--ants M] [--iterations N] [--patience P]
+//!     [--alpha A] [--beta B]
 //!     [--refine-patience P] [--steps N] [--arena WORDS]
 //!
 //! `--steps N` bounds the ant paths as a device does; `--arena WORDS` plans in an arena of that
@@ -42,6 +43,8 @@ fn main() {
             "--seeds" => seeds = v.parse().expect("--seeds N"),
             "--ants" => params.ants = v.parse().expect("--ants M"),
             "--iterations" => params.iterations = v.parse().expect("--iterations N"),
+            "--alpha" => params.alpha = v.parse().expect("--alpha A"),
+            "--beta" => params.beta = v.parse().expect("--beta B"),
             "--patience" => params.patience = v.parse().expect("--patience P"),
             "--refine-patience" => params.refine_patience = v.parse().expect("--refine-patience P"),
             "--steps" => steps = Some(v.parse().expect("--steps N")),
