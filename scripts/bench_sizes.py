@@ -42,7 +42,7 @@ import sys
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from bench_device import ELF, ROOT, Qemu, mi, split_log  # noqa: E402
 from ohaca_client import (Device, expect, frame, load_map, raw_cells,  # noqa: E402
-                          req_hello, req_plan, req_set_map, varint)
+                          req_hello, req_plan, req_set_map, req_set_params, varint)
 
 # One map per size: (size class, map, scenario file), all in the repository.
 MAPS = [
@@ -142,6 +142,10 @@ def main():
     ap.add_argument("--no-astar", action="store_true", help="leave the exact A* columns out")
     ap.add_argument("--only", default="",
                     help="comma-separated substrings: only the maps whose file name has one")
+    ap.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
+                    help="plan with this parameter changed from the device's defaults "
+                         "(repeatable; e.g. the ablation: --param ants=1 --param iterations=1 "
+                         "--param alpha=0.0 --param beta=16.0)")
     args = ap.parse_args()
     seeds = list(range(1, args.seeds + 1))
     only = [o for o in args.only.split(",") if o]
@@ -158,6 +162,12 @@ def main():
         dev = Device("127.0.0.1", q.port)
         hello = expect(dev.call(req_hello()), "Hello")
         cap = hello["capacity"]
+        if args.param:
+            params = dict(hello["defaults"])
+            for kv in args.param:
+                k, v = kv.split("=")
+                params[k] = float(v) if "." in v else int(v)
+            expect(dev.call(req_set_params(params)), "Ack")
         for size, path, scen in maps:
             w, h, bits, _ = load_map(os.path.join(ROOT, path))
             start, goal, opt = longest(scen)

@@ -36,6 +36,7 @@ fn main() {
     let grid = map.grid();
     let mut st = ohaca_host_tests::heap::storage(map.cells());
     let full = Params {
+        ants: 50,
         patience: 0,
         refine_patience: 0,
         ..Params::default()
