@@ -92,6 +92,12 @@ pub fn shortest(
     };
     *slot = s as u32;
     let mut open_len = 1usize;
+    // `list[..live]` holds the corridor's cells not closed yet, plus `closed` cells closed since
+    // the last compaction, in their original order: the scan below skips closed cells, so
+    // dropping them (in order) changes nothing but the scan's length. Compacted when a quarter
+    // of the entries are closed: each cell is moved O(1) times on average.
+    let mut live = list.len();
+    let mut closed = 0usize;
     // A*: expand the open cell of least g + h (the first one on ties) until the goal closes.
     while open_len > 0 {
         let mut best: Option<(usize, f32)> = None;
@@ -116,9 +122,26 @@ pub fn shortest(
         if i == t {
             break;
         }
+        closed = closed.wrapping_add(1); // <= live
+        if closed.wrapping_mul(4) >= live {
+            let mut k = 0usize;
+            for r in 0..live {
+                let Some(&c) = list.get(r) else { break };
+                let shut = cell
+                    .get(grid.index(unpack(c)))
+                    .is_none_or(|e| e[2].to_bits() & CLOSED != 0);
+                if !shut {
+                    if let Some(slot) = list.get_mut(k) {
+                        *slot = c;
+                    }
+                    k = k.wrapping_add(1); // <= r
+                }
+            }
+            (live, closed) = (k, 0);
+        }
         let p = grid.point(i);
         let limit = cell.get(t).map_or(bound, |e| e[0].min(bound));
-        for &c in list.iter() {
+        for &c in list.iter().take(live) {
             let q = unpack(c);
             let j = grid.index(q);
             let Some(e) = cell.get(j) else { continue };
