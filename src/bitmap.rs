@@ -38,7 +38,7 @@ pub fn window(bits: &[u32], i: usize) -> u64 {
     if r == 0 {
         low
     } else {
-        low | word(2) << (64 - r)
+        low | word(2) << (64u32.wrapping_sub(r) & 63)
     }
 }
 

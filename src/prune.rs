@@ -121,7 +121,7 @@ pub fn prune(
             };
             // Bit j is column x0 - 1 + j: the run's cells are bits 1..=n.
             let n = w.wrapping_sub(x0).min(32);
-            let run = ((1u64 << n) - 1) << 1;
+            let run = (1u64 << n).wrapping_sub(1) << 1;
             let mut m = free & !((free << 1) & (free >> 1)) & !(north & south) & run;
             while m != 0 {
                 let j = m.trailing_zeros() as usize;

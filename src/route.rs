@@ -310,7 +310,7 @@ fn links(moves: &Moves<'_>, blocks: Blocks, dead: &[u32], words: &mut [u32]) {
             *wd |= 1 << d;
         }
         if let Some(wd) = words.get_mut(nb) {
-            *wd |= 1 << ((d + 4) & 7);
+            *wd |= 1 << (d.wrapping_add(4) & 7);
         }
     };
     // Bit j of a window is cell x0 - 1 + j of its row; cells off the row read as blocked.
@@ -349,7 +349,7 @@ fn links(moves: &Moves<'_>, blocks: Blocks, dead: &[u32], words: &mut [u32]) {
             let run = if n >= 64 {
                 u64::MAX
             } else {
-                ((1u64 << n) - 1) << 1
+                (1u64 << n).wrapping_sub(1) << 1
             };
             // The cell of bit j: x0 - 1 + j (j >= 1).
             let cell = |j: usize| x0.wrapping_add(j).wrapping_sub(1);
