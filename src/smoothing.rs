@@ -359,10 +359,16 @@ fn dp_cells(
             _ => break,
         };
         let lo = j.saturating_sub(lookback);
+        // The ring slot of `i`, stepped along with it: one division a cell, not one a candidate.
+        let mut at = slot(lo);
         for i in lo..before {
-            let (Some(&di), Some(&pi)) = (dist.get(slot(i)), pts.get(i)) else {
+            let (Some(&di), Some(&pi)) = (dist.get(at), pts.get(i)) else {
                 break;
             };
+            at = at.wrapping_add(1); // < ring
+            if at == ring {
+                at = 0;
+            }
             let cand = di + distance(pi, pj);
             // Strictly shorter only, so a tie keeps the earlier choice found first.
             if cand < best && segment_clear(grid, pi, pj) {
