@@ -38,7 +38,10 @@
 //! `a + b sqrt 2` compare the same way in these units as long as the diagonal counts differ by
 //! less than about 9800, far beyond any window; equal integer cost means equal step mix. So the
 //! search is exact, not just close. The heap orders by `f = g + h`, then larger `g`, then the
-//! lower box index.
+//! lower box index. The open list is an indexed binary heap (decrease-key in place); since that
+//! order is total, which cell leaves next depends only on the open cells and their keys, so the
+//! expansion order, the costs left in the scratch and the path read back are fixed by the rule
+//! above, not by how the heap is laid out or sifted.
 //!
 //! **Cost.** Linear in the path length for a fixed window: about one window per half piece of
 //! path per pass, each expanding at most `side * side` cells (A* expands far fewer on open

@@ -139,22 +139,15 @@ impl Box2 {
     }
 }
 
-/// Directions whose move changes `x` by `dx` (bit `d` set iff `DX[d] == dx`), likewise for `y`.
-const fn along(table: &[i32; 8], v: i32) -> u8 {
-    let mut m = 0u8;
-    let mut d = 0;
-    while d < 8 {
-        if table[d] == v {
-            m |= 1 << d;
-        }
-        d += 1;
-    }
-    m
-}
-const WEST: u8 = along(&DX, -1);
-const EAST: u8 = along(&DX, 1);
-const NORTH: u8 = along(&DY, -1);
-const SOUTH: u8 = along(&DY, 1);
+/// The moves leaving a box by its west side (bit `d` set iff [`DX`]`[d] == -1`; unit test
+/// `side_masks_are_the_directions`).
+const WEST: u8 = 0b0011_1000;
+/// The moves with [`DX`]`[d] == 1`.
+const EAST: u8 = 0b1000_0011;
+/// The moves with [`DY`]`[d] == -1`.
+const NORTH: u8 = 0b1110_0000;
+/// The moves with [`DY`]`[d] == 1`.
+const SOUTH: u8 = 0b0000_1110;
 
 /// True if box cell `a` comes before `b` in the open list's order: smaller `f`, then larger `g`,
 /// then the smaller index (a total order: indices differ).
@@ -386,4 +379,78 @@ pub(super) fn search(
     }
     budget.expanded = budget.expanded.saturating_add(expanded);
     result
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A small xorshift.
+    fn next(x: &mut u32) -> u32 {
+        *x ^= *x << 13;
+        *x ^= *x >> 17;
+        *x ^= *x << 5;
+        *x
+    }
+
+    #[test]
+    fn side_masks_are_the_directions() {
+        let along =
+            |t: &[i32; 8], v: i32| (0..8).filter(|&d| t[d] == v).fold(0u8, |m, d| m | 1 << d);
+        assert_eq!(WEST, along(&DX, -1));
+        assert_eq!(EAST, along(&DX, 1));
+        assert_eq!(NORTH, along(&DY, -1));
+        assert_eq!(SOUTH, along(&DY, 1));
+    }
+
+    #[test]
+    fn open_list_pops_in_key_order() {
+        // Random keys with many ties in f and in g, pushes, decreases and pops interleaved: every
+        // pop is the smallest open cell by (f, larger g, index), as a plain scan finds it.
+        let mut x = 0x2545_F491u32;
+        for round in 0..200 {
+            let n = 1 + (next(&mut x) as usize % 300);
+            let mut g = vec![0u32; n];
+            let mut f = vec![0u32; n];
+            let (mut heap, mut pos) = (vec![0u16; n + 1], vec![0u16; n]);
+            let mut open = Open {
+                heap: &mut heap,
+                pos: &mut pos,
+                len: 0,
+            };
+            let mut live = vec![false; n];
+            let mut pushed = 0usize;
+            let mut popped = 0usize;
+            while popped < n {
+                let r = next(&mut x) % 4;
+                if r < 2 && pushed < n {
+                    let i = pushed;
+                    g[i] = next(&mut x) % 4;
+                    f[i] = g[i] + next(&mut x) % (3 + round % 5) as u32;
+                    open.push(&g, &f, i as u16);
+                    live[i] = true;
+                    pushed += 1;
+                } else if r == 2 && popped < pushed {
+                    // Lower the key of a live cell, keeping f - g (as the search does).
+                    let i = next(&mut x) as usize % pushed;
+                    if live[i] && g[i] > 0 {
+                        let h = f[i] - g[i];
+                        g[i] -= 1 + next(&mut x) % g[i];
+                        f[i] = g[i] + h;
+                        open.decreased(&g, &f, i as u16);
+                    }
+                } else if popped < pushed {
+                    let want = (0..n)
+                        .filter(|&i| live[i])
+                        .min_by_key(|&i| (f[i], u32::MAX - g[i], i))
+                        .unwrap();
+                    let got = open.pop(&g, &f).expect("open cells left");
+                    assert_eq!(usize::from(got), want, "round {round}");
+                    live[want] = false;
+                    popped += 1;
+                }
+            }
+            assert_eq!(open.pop(&g, &f), None);
+        }
+    }
 }
