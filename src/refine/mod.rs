@@ -38,7 +38,10 @@
 //! `a + b sqrt 2` compare the same way in these units as long as the diagonal counts differ by
 //! less than about 9800, far beyond any window; equal integer cost means equal step mix. So the
 //! search is exact, not just close. The heap orders by `f = g + h`, then larger `g`, then the
-//! lower box index.
+//! lower box index. The open list is an indexed binary heap (decrease-key in place); since that
+//! order is total, which cell leaves next depends only on the open cells and their keys, so the
+//! expansion order, the costs left in the scratch and the path read back are fixed by the rule
+//! above, not by how the heap is laid out or sifted.
 //!
 //! **Cost.** Linear in the path length for a fixed window: about one window per half piece of
 //! path per pass, each expanding at most `side * side` cells (A* expands far fewer on open
@@ -86,16 +89,22 @@ pub struct Scratch<'a> {
     g: &'a mut [u32],
     /// `g` plus the octile heuristic, per box cell.
     f: &'a mut [u32],
-    /// The open list: a binary heap of box cell indices, two `u16` a word.
-    heap: &'a mut [u32],
-    /// Position of each box cell in `heap` ([`CLOSED`] once expanded), two `u16` a word.
-    pos: &'a mut [u32],
+    /// The open list: a binary heap of box cell indices, root at slot 1 (the tail of the first
+    /// word slice seen as `u16`s).
+    heap: &'a mut [u16],
+    /// Position of each box cell in `heap` ([`CLOSED`] once expanded; the tail of the second).
+    pos: &'a mut [u16],
 }
 
 /// `g` of a cell not reached yet.
 const UNREACHED: u32 = u32::MAX;
 /// `pos` of an expanded cell (heap slots are below [`MAX_SIDE`]`^2 < 0xFFFF`).
 const CLOSED: u16 = u16::MAX;
+
+/// The words as `u16`s (two a word; empty if the cast were impossible, which it never is).
+fn halves(words: &mut [u32]) -> &mut [u16] {
+    bytemuck::try_cast_slice_mut(words).unwrap_or_default()
+}
 
 impl<'a> Scratch<'a> {
     /// Bytes of scratch per window cell.
@@ -122,8 +131,8 @@ impl<'a> Scratch<'a> {
         Scratch {
             g,
             f,
-            heap: a.split_at_mut(half.min(a.len())).0,
-            pos: b.split_at_mut(half.min(b.len())).0,
+            heap: halves(a.split_at_mut(half.min(a.len())).0),
+            pos: halves(b.split_at_mut(half.min(b.len())).0),
         }
     }
 
@@ -132,8 +141,8 @@ impl<'a> Scratch<'a> {
         self.g
             .len()
             .min(self.f.len())
-            .min(self.heap.len().saturating_mul(2))
-            .min(self.pos.len().saturating_mul(2))
+            .min(self.heap.len())
+            .min(self.pos.len())
     }
 
     /// The window side: the largest `s <= MAX_SIDE` with `s * s <= self.cells()`.
@@ -145,24 +154,6 @@ impl<'a> Scratch<'a> {
             s = s.wrapping_add(1);
         }
         s
-    }
-}
-
-/// Read the `i`-th `u16` of a slice of words holding two each (0 out of range).
-fn half(words: &[u32], i: usize) -> u16 {
-    let w = words.get(i / 2).copied().unwrap_or(0);
-    // Truncation keeps the wanted half.
-    (if i % 2 == 0 { w } else { w >> 16 }) as u16
-}
-
-/// Write the `i`-th `u16` of a slice of words holding two each (nothing out of range).
-fn set_half(words: &mut [u32], i: usize, v: u16) {
-    if let Some(w) = words.get_mut(i / 2) {
-        *w = if i % 2 == 0 {
-            (*w & 0xFFFF_0000) | u32::from(v)
-        } else {
-            (*w & 0x0000_FFFF) | (u32::from(v) << 16)
-        };
     }
 }
 

@@ -3,9 +3,7 @@
 
 use crate::grid::{Grid, Point, DX, DY};
 
-use super::{
-    half, octile, set_half, Budget, Scratch, CLOSED, DIAGONAL, MAX_SIDE, STRAIGHT, UNREACHED,
-};
+use super::{octile, Budget, Scratch, CLOSED, DIAGONAL, MAX_SIDE, STRAIGHT, UNREACHED};
 
 /// The cell before `p` (box index `i`) on a shortest path of the last [`search`]: its first
 /// neighbour, in direction order, inside the box and reached, one allowed move away, with
@@ -141,63 +139,63 @@ impl Box2 {
     }
 }
 
-/// The open list: a binary heap of box indices ordered by `(f, larger g, index)`.
-struct Heap<'s, 'a> {
-    s: &'s mut Scratch<'a>,
+/// The moves leaving a box by its west side (bit `d` set iff [`DX`]`[d] == -1`; unit test
+/// `side_masks_are_the_directions`).
+const WEST: u8 = 0b0011_1000;
+/// The moves with [`DX`]`[d] == 1`.
+const EAST: u8 = 0b1000_0011;
+/// The moves with [`DY`]`[d] == -1`.
+const NORTH: u8 = 0b1110_0000;
+/// The moves with [`DY`]`[d] == 1`.
+const SOUTH: u8 = 0b0000_1110;
+
+/// True if box cell `a` comes before `b` in the open list's order: smaller `f`, then larger `g`,
+/// then the smaller index (a total order: indices differ).
+#[inline(always)]
+fn before(g: &[u32], f: &[u32], a: u16, b: u16) -> bool {
+    let (au, bu) = (usize::from(a), usize::from(b));
+    let fa = f.get(au).copied().unwrap_or(u32::MAX);
+    let fb = f.get(bu).copied().unwrap_or(u32::MAX);
+    if fa != fb {
+        return fa < fb;
+    }
+    let ga = g.get(au).copied().unwrap_or(0);
+    let gb = g.get(bu).copied().unwrap_or(0);
+    if ga != gb {
+        return ga > gb;
+    }
+    a < b
+}
+
+/// The open list: a binary min-heap of box indices in [`before`] order, root at slot 1, with
+/// each open cell's slot in `pos`. Which cell leaves next depends only on the set of open cells
+/// and their keys (the order is total), not on how the heap is laid out.
+struct Open<'s> {
+    heap: &'s mut [u16],
+    pos: &'s mut [u16],
     len: usize,
 }
 
-impl Heap<'_, '_> {
-    fn key(&self, i: u16) -> (u32, u32, u16) {
-        let k = usize::from(i);
-        let f = self.s.f.get(k).copied().unwrap_or(u32::MAX);
-        let g = self.s.g.get(k).copied().unwrap_or(0);
-        (f, u32::MAX.wrapping_sub(g), i)
-    }
-
-    fn at(&self, slot: usize) -> u16 {
-        half(self.s.heap, slot)
-    }
-
+impl Open<'_> {
+    /// Put cell `i` in slot `slot`.
+    #[inline(always)]
     fn put(&mut self, slot: usize, i: u16) {
-        set_half(self.s.heap, slot, i);
-        // slot < heap length <= MAX_SIDE^2 < 0xFFFF.
-        set_half(self.s.pos, usize::from(i), slot as u16);
-    }
-
-    fn push(&mut self, i: u16) {
-        let slot = self.len;
-        self.len = self.len.saturating_add(1);
-        self.put(slot, i);
-        self.up(slot);
-    }
-
-    fn decreased(&mut self, i: u16) {
-        let slot = usize::from(half(self.s.pos, usize::from(i)));
-        self.up(slot);
-    }
-
-    fn pop(&mut self) -> Option<u16> {
-        if self.len == 0 {
-            return None;
+        if let Some(s) = self.heap.get_mut(slot) {
+            *s = i;
         }
-        let top = self.at(0);
-        self.len = self.len.wrapping_sub(1);
-        if self.len > 0 {
-            let last = self.at(self.len);
-            self.put(0, last);
-            self.down(0);
+        // slot <= len < cells <= MAX_SIDE^2 < 0xFFFF.
+        if let Some(p) = self.pos.get_mut(usize::from(i)) {
+            *p = slot as u16;
         }
-        Some(top)
     }
 
-    fn up(&mut self, mut slot: usize) {
-        let i = self.at(slot);
-        let key = self.key(i);
-        while slot > 0 {
-            let parent = slot.wrapping_sub(1) / 2;
-            let pi = self.at(parent);
-            if self.key(pi) <= key {
+    /// Sift cell `i` up from the hole at `slot`.
+    #[inline(always)]
+    fn up(&mut self, g: &[u32], f: &[u32], mut slot: usize, i: u16) {
+        while slot > 1 {
+            let parent = slot >> 1;
+            let pi = self.heap.get(parent).copied().unwrap_or(0);
+            if !before(g, f, i, pi) {
                 break;
             }
             self.put(slot, pi);
@@ -206,33 +204,76 @@ impl Heap<'_, '_> {
         self.put(slot, i);
     }
 
-    fn down(&mut self, mut slot: usize) {
-        let i = self.at(slot);
-        let key = self.key(i);
-        loop {
-            // slot < len <= 65536: no overflow.
-            let l = slot.wrapping_mul(2).wrapping_add(1);
-            if l >= self.len {
-                break;
-            }
-            let r = l.wrapping_add(1);
-            let mut c = l;
-            if r < self.len && self.key(self.at(r)) < self.key(self.at(l)) {
-                c = r;
-            }
-            let ci = self.at(c);
-            if key <= self.key(ci) {
-                break;
-            }
-            self.put(slot, ci);
-            slot = c;
+    /// Add the new cell `i`.
+    #[inline(never)]
+    fn push(&mut self, g: &[u32], f: &[u32], i: u16) {
+        self.len = self.len.wrapping_add(1); // len < cells
+        self.up(g, f, self.len, i);
+    }
+
+    /// Cell `i`, open, got a smaller key.
+    #[inline(never)]
+    fn decreased(&mut self, g: &[u32], f: &[u32], i: u16) {
+        let slot = usize::from(self.pos.get(usize::from(i)).copied().unwrap_or(0));
+        if slot >= 1 && slot <= self.len {
+            self.up(g, f, slot, i);
         }
-        self.put(slot, i);
+    }
+
+    /// Take the first cell out.
+    #[inline(always)]
+    fn pop(&mut self, g: &[u32], f: &[u32]) -> Option<u16> {
+        if self.len == 0 {
+            return None;
+        }
+        let top = self.heap.get(1).copied()?;
+        let last = self.heap.get(self.len).copied()?;
+        self.len = self.len.wrapping_sub(1);
+        if self.len > 0 {
+            self.settle(g, f, last);
+        }
+        Some(top)
+    }
+
+    /// Fill the root's hole with `e`: walk the hole down to a leaf along the first child of each
+    /// pair (one comparison a level), then sift `e` up from there (usually a step or none). Out
+    /// of line, so that the search loop keeps its registers.
+    #[inline(never)]
+    fn settle(&mut self, g: &[u32], f: &[u32], e: u16) {
+        let len = self.len;
+        let mut hole = 1usize;
+        // Children `c` and `c + 1`; `hole <= len < 2^16`: no wrap.
+        let mut c = 2usize;
+        while c < len {
+            let (a, b) = match self.heap.get(c..c.wrapping_add(2)) {
+                Some(&[a, b]) => (a, b),
+                _ => break,
+            };
+            let (ci, cs) = if before(g, f, b, a) {
+                (b, c.wrapping_add(1))
+            } else {
+                (a, c)
+            };
+            self.put(hole, ci);
+            hole = cs;
+            c = cs.wrapping_mul(2);
+        }
+        if c == len {
+            // A last, lone child.
+            let ci = self.heap.get(c).copied().unwrap_or(0);
+            self.put(hole, ci);
+            hole = c;
+        }
+        self.up(g, f, hole, e);
     }
 }
 
 /// Exact A* from `from` to `to` inside `bbox`; returns the cost to `to` (costs in `scratch`, read
 /// back by [`pred`]).
+///
+/// Each expansion reads the cell's move mask once, drops the moves leaving the box, and visits
+/// the neighbours by index offsets; a closed neighbour costs one load and a comparison (its `g`
+/// is already optimal: the octile heuristic is consistent).
 pub(super) fn search(
     grid: &Grid<'_>,
     bbox: &Box2,
@@ -242,55 +283,174 @@ pub(super) fn search(
     budget: &mut Budget,
 ) -> Option<u32> {
     let cells = bbox.cells();
-    if cells > scratch.cells() || cells > MAX_SIDE * MAX_SIDE {
+    if cells > scratch.cells() || cells > MAX_SIDE * MAX_SIDE || bbox.w == 0 {
         return None;
     }
     let si = bbox.local(from)?;
     let ti = bbox.local(to)?;
-    scratch.g.get_mut(..cells)?.fill(UNREACHED);
-    *scratch.g.get_mut(si)? = 0;
-    *scratch.f.get_mut(si)? = octile(from, to);
-    let mut heap = Heap { s: scratch, len: 0 };
+    let g = scratch.g.get_mut(..cells)?;
+    let f = scratch.f.get_mut(..cells)?;
+    g.fill(UNREACHED);
+    *g.get_mut(si)? = 0;
+    *f.get_mut(si)? = octile(from, to);
+    let mut open = Open {
+        heap: &mut *scratch.heap,
+        pos: &mut *scratch.pos,
+        len: 0,
+    };
+    // Box-local offsets: w <= MAX_SIDE, so all fit isize.
+    let w = bbox.w as isize;
+    let mut off = [0isize; 8];
+    for (d, o) in off.iter_mut().enumerate() {
+        let dx = DX.get(d).copied().unwrap_or(0) as isize;
+        let dy = DY.get(d).copied().unwrap_or(0) as isize;
+        *o = dy.wrapping_mul(w).wrapping_add(dx);
+    }
+    // The target in box coordinates (for the heuristic).
+    let tx = i32::from(to.x.wrapping_sub(bbox.x0));
+    let ty = i32::from(to.y.wrapping_sub(bbox.y0));
+    let (last_x, last_y) = (bbox.w.wrapping_sub(1), bbox.h.wrapping_sub(1));
     // si < cells <= MAX_SIDE^2 < 0xFFFF.
-    heap.push(si as u16);
-    while let Some(i) = heap.pop() {
+    open.push(g, f, si as u16);
+    let mut expanded = 0u64;
+    let mut result = None;
+    while let Some(i) = open.pop(g, f) {
         let iu = usize::from(i);
-        let gi = heap.s.g.get(iu).copied()?;
-        set_half(heap.s.pos, iu, CLOSED);
-        budget.expanded = budget.expanded.saturating_add(1);
+        let gi = g.get(iu).copied().unwrap_or(UNREACHED);
+        if let Some(p) = open.pos.get_mut(iu) {
+            *p = CLOSED;
+        }
+        expanded = expanded.wrapping_add(1);
         if iu == ti {
-            return Some(gi);
+            result = Some(gi);
+            break;
         }
         let p = bbox.point(iu);
-        let mask = grid.mask_at(p);
-        for d in 0..8u8 {
-            if mask & (1 << d) == 0 {
-                continue;
-            }
-            let du = usize::from(d);
-            let nx = i32::from(p.x).wrapping_add(DX.get(du).copied().unwrap_or(0));
-            let ny = i32::from(p.y).wrapping_add(DY.get(du).copied().unwrap_or(0));
-            // The move is allowed, so the target is inside the map: both fit u16.
-            let q = Point::new(nx as u16, ny as u16);
-            let Some(j) = bbox.local(q) else { continue };
-            let gj = heap.s.g.get(j).copied().unwrap_or(0);
+        let (lx, ly) = (
+            usize::from(p.x.wrapping_sub(bbox.x0)),
+            usize::from(p.y.wrapping_sub(bbox.y0)),
+        );
+        // The allowed moves that stay inside the box.
+        let mut mask = grid.mask_at(p);
+        if lx == 0 {
+            mask &= !WEST;
+        }
+        if lx >= last_x {
+            mask &= !EAST;
+        }
+        if ly == 0 {
+            mask &= !NORTH;
+        }
+        if ly >= last_y {
+            mask &= !SOUTH;
+        }
+        while mask != 0 {
+            let d = mask.trailing_zeros() as usize & 7;
+            mask &= mask.wrapping_sub(1);
+            // The move stays inside the box: j is its box index.
+            let j = iu.wrapping_add_signed(off.get(d).copied().unwrap_or(0));
+            let Some(&gj) = g.get(j) else { continue };
             let ng = gi.saturating_add(if d & 1 == 1 { DIAGONAL } else { STRAIGHT });
             if gj == UNREACHED {
-                if let (Some(g), Some(f)) = (heap.s.g.get_mut(j), heap.s.f.get_mut(j)) {
-                    *g = ng;
-                    *f = ng.saturating_add(octile(q, to));
+                // Box coordinates below MAX_SIDE: no overflow in i32.
+                let qx = (lx as i32).wrapping_add(DX.get(d).copied().unwrap_or(0));
+                let qy = (ly as i32).wrapping_add(DY.get(d).copied().unwrap_or(0));
+                let (dx, dy) = (qx.abs_diff(tx), qy.abs_diff(ty));
+                let (hi, lo) = (dx.max(dy), dx.min(dy));
+                let h = hi
+                    .wrapping_sub(lo)
+                    .wrapping_mul(STRAIGHT)
+                    .wrapping_add(lo.wrapping_mul(DIAGONAL));
+                if let (Some(gs), Some(fs)) = (g.get_mut(j), f.get_mut(j)) {
+                    *gs = ng;
+                    *fs = ng.saturating_add(h);
                 }
                 // j < cells < 0xFFFF.
-                heap.push(j as u16);
-            } else if ng < gj && half(heap.s.pos, j) != CLOSED {
-                if let (Some(g), Some(f)) = (heap.s.g.get_mut(j), heap.s.f.get_mut(j)) {
-                    let h = f.saturating_sub(*g);
-                    *g = ng;
-                    *f = ng.saturating_add(h);
+                open.push(g, f, j as u16);
+            } else if ng < gj && open.pos.get(j).copied() != Some(CLOSED) {
+                if let (Some(gs), Some(fs)) = (g.get_mut(j), f.get_mut(j)) {
+                    let h = fs.saturating_sub(*gs);
+                    *gs = ng;
+                    *fs = ng.saturating_add(h);
                 }
-                heap.decreased(j as u16);
+                open.decreased(g, f, j as u16);
             }
         }
     }
-    None
+    budget.expanded = budget.expanded.saturating_add(expanded);
+    result
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A small xorshift.
+    fn next(x: &mut u32) -> u32 {
+        *x ^= *x << 13;
+        *x ^= *x >> 17;
+        *x ^= *x << 5;
+        *x
+    }
+
+    #[test]
+    fn side_masks_are_the_directions() {
+        let along =
+            |t: &[i32; 8], v: i32| (0..8).filter(|&d| t[d] == v).fold(0u8, |m, d| m | 1 << d);
+        assert_eq!(WEST, along(&DX, -1));
+        assert_eq!(EAST, along(&DX, 1));
+        assert_eq!(NORTH, along(&DY, -1));
+        assert_eq!(SOUTH, along(&DY, 1));
+    }
+
+    #[test]
+    fn open_list_pops_in_key_order() {
+        // Random keys with many ties in f and in g, pushes, decreases and pops interleaved: every
+        // pop is the smallest open cell by (f, larger g, index), as a plain scan finds it.
+        let mut x = 0x2545_F491u32;
+        for round in 0..200 {
+            let n = 1 + (next(&mut x) as usize % 300);
+            let mut g = vec![0u32; n];
+            let mut f = vec![0u32; n];
+            let (mut heap, mut pos) = (vec![0u16; n + 1], vec![0u16; n]);
+            let mut open = Open {
+                heap: &mut heap,
+                pos: &mut pos,
+                len: 0,
+            };
+            let mut live = vec![false; n];
+            let mut pushed = 0usize;
+            let mut popped = 0usize;
+            while popped < n {
+                let r = next(&mut x) % 4;
+                if r < 2 && pushed < n {
+                    let i = pushed;
+                    g[i] = next(&mut x) % 4;
+                    f[i] = g[i] + next(&mut x) % (3 + round % 5) as u32;
+                    open.push(&g, &f, i as u16);
+                    live[i] = true;
+                    pushed += 1;
+                } else if r == 2 && popped < pushed {
+                    // Lower the key of a live cell, keeping f - g (as the search does).
+                    let i = next(&mut x) as usize % pushed;
+                    if live[i] && g[i] > 0 {
+                        let h = f[i] - g[i];
+                        g[i] -= 1 + next(&mut x) % g[i];
+                        f[i] = g[i] + h;
+                        open.decreased(&g, &f, i as u16);
+                    }
+                } else if popped < pushed {
+                    let want = (0..n)
+                        .filter(|&i| live[i])
+                        .min_by_key(|&i| (f[i], u32::MAX - g[i], i))
+                        .unwrap();
+                    let got = open.pop(&g, &f).expect("open cells left");
+                    assert_eq!(usize::from(got), want, "round {round}");
+                    live[want] = false;
+                    popped += 1;
+                }
+            }
+            assert_eq!(open.pop(&g, &f), None);
+        }
+    }
 }
