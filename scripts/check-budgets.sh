@@ -147,7 +147,7 @@ ram_ok=$(verdict "$ram" "$RAM_BUDGET")
 [ "$flash_ok" = ok ] || status=1
 [ "$ram_ok" = ok ] || status=1
 echo
-echo "== budgets: STM32F411 release firmware, maps of up to 262,144 cells (any shape) planned at full resolution in one arena, 50 ants"
+echo "== budgets: STM32F411 release firmware, maps of up to 262,144 cells (any shape) planned at full resolution in one arena, any number of ants (none is stored)"
 printf '| %-58s | %8s | %8s | %-11s |\n' "item" "bytes" "budget" "verdict"
 printf '| %-58s | %8s | %8s | %-11s |\n' "---" "---" "---" "---"
 printf '| %-58s | %8d | %8d | %-11s |\n' "flash (.vector_table + .text + .rodata + .data)" "$flash" "$FLASH_BUDGET" "$flash_ok"
@@ -206,7 +206,7 @@ for v in "$h7_flash_ok" "$h7_dtcm_ok" "$h7_axi_ok" "$h7_sram123_ok" "$h7_sram4_o
   [ "$v" = ok ] || status=1
 done
 echo
-echo "== budgets: STM32H743 release firmware, maps of up to 2,097,152 cells (any shape) planned at full resolution, paths of up to 16,384 steps, 50 ants"
+echo "== budgets: STM32H743 release firmware, maps of up to 2,097,152 cells (any shape) planned at full resolution, paths of up to 16,384 steps, any number of ants (none is stored)"
 printf '| %-58s | %8s | %8s | %-11s |\n' "item" "bytes" "budget" "verdict"
 printf '| %-58s | %8s | %8s | %-11s |\n' "---" "---" "---" "---"
 printf '| %-58s | %8d | %8d | %-11s |\n' "flash (.vector_table + .text + .rodata + .data)" "$h7_flash" "$H7_FLASH_BUDGET" "$h7_flash_ok"
