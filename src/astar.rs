@@ -315,8 +315,15 @@ impl Open<'_> {
         }
         self.pushes = self.pushes.wrapping_add(1);
         // Sift the hole at `len` up.
+        Self::sift_up(a, len, e);
+        Ok(())
+    }
+
+    /// Put `e` into the hole at `hole` of the heap `a`, moving it up past every parent that
+    /// ranks after it.
+    #[inline(always)]
+    fn sift_up(a: &mut [Entry], mut hole: usize, e: Entry) {
         let r = e.rank();
-        let mut hole = len;
         while hole > 0 {
             let parent = hole.wrapping_sub(1) >> 1;
             let Some(&p) = a.get(parent) else { break };
@@ -331,7 +338,6 @@ impl Open<'_> {
         if let Some(slot) = a.get_mut(hole) {
             *slot = e;
         }
-        Ok(())
     }
 
     /// The top entry ([`Entry::NONE`] if the heap is empty).
@@ -380,22 +386,7 @@ impl Open<'_> {
             h = c;
         }
         let a: &mut [Entry] = bytemuck::cast_slice_mut(w);
-        let mut hole = h / 3;
-        let r = e.rank();
-        while hole > 0 {
-            let parent = hole.wrapping_sub(1) >> 1;
-            let Some(&p) = a.get(parent) else { break };
-            if r >= p.rank() {
-                break;
-            }
-            if let Some(slot) = a.get_mut(hole) {
-                *slot = p;
-            }
-            hole = parent;
-        }
-        if let Some(slot) = a.get_mut(hole) {
-            *slot = e;
-        }
+        Self::sift_up(a, h / 3, e);
     }
 
     #[inline(always)]
