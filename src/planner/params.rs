@@ -50,7 +50,7 @@ impl Algorithm {
 /// Two presets: [`Params::default`] is this project's setting (the paper's `alpha`, `beta`, `rho`,
 /// `Q`, `a`, `xi` and `N`, 12 ants instead of the paper's `M = 50`, plus backtracking ants, path
 /// tightening, dead-end pruning, early stopping after 10 stale iterations (1 with the local
-/// search, 2 for a warm replan), the local search and shortest smoothing); [`Params::paper`] is
+/// search and for a warm replan), the local search and shortest smoothing); [`Params::paper`] is
 /// the paper's algorithm as written (50 ants that die at dead ends, no tightening, no pruning,
 /// always all `N` iterations, no local search, greedy smoothing).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -144,7 +144,7 @@ impl Params {
         tau_min: 0.01,
         tau_max: 100.0,
         patience: 10,
-        warm_patience: 2,
+        warm_patience: 1,
         refine_patience: 1,
         seed: 1,
         dead_end: DeadEnd::Backtrack,
