@@ -155,6 +155,45 @@ fn a_path_longer_than_the_workspace_keeps_is_path_too_long() {
 }
 
 #[test]
+fn an_unreachable_goal_is_no_path_even_when_the_ants_outgrow_their_tours() {
+    // Backtracking ants skip the setup's flood fill and prove an unreachable goal by exhausting
+    // the start's side; with tours too short for that side (11 steps, 56 free cells) the first
+    // ant is dropped instead, and the flood fill decides at that moment: `NoPath` after one
+    // iteration, not `PathTooLong` after all of them.
+    let rows = [
+        "........", //
+        "........", //
+        "........", //
+        "........", //
+        "........", //
+        "......##", //
+        "......#.", //
+        "........", //
+    ];
+    let (mut b, w, h) = crate::testutil::bits(&rows);
+    // Close the goal's pocket: (7, 6) is walled in by (6, 5), (7, 5), (6, 6) and (6, 7), (7, 7).
+    for (x, y) in [(6usize, 7usize), (7, 7)] {
+        let i = y * 8 + x;
+        b[i / 8] |= 1 << (i % 8);
+    }
+    let g = Grid::new(w, h, &b).unwrap();
+    let (start, goal) = (Point::new(0, 0), Point::new(7, 6));
+    let p = Params::default();
+    let mut small: Storage<2, 12, 128, 64> = Storage::new();
+    assert!(small.workspace().steps() < 54);
+    let mut run = Run::new(&g, start, goal, &p, small.workspace()).unwrap();
+    while run.step() {}
+    assert_eq!(run.iteration(), 1);
+    assert_eq!(run.finish().err(), Some(Error::NoPath));
+    // With room for the whole side the first ant proves it itself, as before.
+    let mut big: S64 = Storage::new();
+    assert_eq!(
+        plan(&g, start, goal, &p, big.workspace()).err(),
+        Some(Error::NoPath)
+    );
+}
+
+#[test]
 fn start_equals_goal() {
     let (b, w, h) = grid(&ROWS);
     let g = Grid::new(w, h, &b).unwrap();

@@ -5,7 +5,7 @@
 
 use crate::ant::{Ant, DeadEnd, Lost, Walk};
 use crate::geometry::steps_length;
-use crate::grid::{Dir, Moves, Point};
+use crate::grid::{Dir, Moves, Point, Reach};
 use crate::pheromone::Table;
 use crate::rng::Xoshiro128pp;
 use crate::route::Route;
@@ -194,6 +194,19 @@ impl Run<'_, '_> {
                     }
                     Err(Lost::Overflow) => {
                         self.dropped = self.dropped.saturating_add(1);
+                        // An ant that outgrew its tour proves nothing about reachability. Before
+                        // any ant has arrived, the flood fill the setup skipped decides it now,
+                        // once: an unreachable goal ends the run with `NoPath` instead of
+                        // iterations of dropped ants ending in `PathTooLong`. The tabu set and
+                        // the links are scratch between walks.
+                        if self.best.is_none() && it.arrived == 0 && !self.reach_checked {
+                            self.reach_checked = true;
+                            let grid = self.grid;
+                            if grid.reachable(self.start, self.goal, tabu, links) == Reach::No {
+                                self.no_path = true;
+                                break;
+                            }
+                        }
                         continue;
                     }
                 };

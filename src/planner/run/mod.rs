@@ -75,6 +75,10 @@ pub struct Run<'g, 'a> {
     /// The colony's best path length, kept when the local search replaces the best path.
     colony: Option<Best>,
     no_path: bool,
+    /// The flood fill has decided reachability in this run (or could not): it runs in the setup
+    /// for dying ants only, and for backtracking ones once an ant outgrew its tour before any
+    /// arrived (`colony.rs`), the one case where the ants cannot prove an unreachable goal.
+    reach_checked: bool,
     /// Ants dropped so far because their paths outgrew the workspace ([`Error::PathTooLong`]).
     dropped: u32,
     /// Ants abandoned so far for their moves ([`colony::MOVE_BUDGET`]).
@@ -288,6 +292,7 @@ impl<'g, 'a> Run<'g, 'a> {
             polish: Polish::Start,
             colony: None,
             no_path: false,
+            reach_checked: false,
             dropped: 0,
             abandoned: 0,
             cheapest: None,

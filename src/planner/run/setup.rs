@@ -29,6 +29,7 @@ impl Run<'_, '_> {
                 // 90 M plan on Boston 256; issue 27). Only the paper's dying ants, which cannot
                 // prove anything, still need it.
                 let proved_by_ants = p.dead_end == DeadEnd::Backtrack;
+                self.reach_checked = !proved_by_ants;
                 if !proved_by_ants
                     && grid.reachable(self.start, self.goal, ws.tabu, ws.links) == Reach::No
                 {
