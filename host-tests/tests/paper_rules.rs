@@ -187,7 +187,15 @@ fn pheromone_update_is_eq_11_to_13_on_every_edge() {
     let mut tied = 0;
     for (name, p) in cases {
         for seed in 1..=2 {
-            let p = Params { seed, ..p };
+            // No early stop: every one of the STEPS iterations runs (the default's runs that
+            // refine may stop after 2).
+            let p = Params {
+                seed,
+                patience: 0,
+                refine_patience: 0,
+                warm_patience: 0,
+                ..p
+            };
             let mut want = vec![[f64::from(p.tau0); 4]; map.cells()];
             for k in 1..=STEPS {
                 // A fresh run of k iterations walks the same ants as a longer one.
@@ -246,6 +254,8 @@ fn fork_params(algorithm: Algorithm, beta: f32, a: f32, seed: u64) -> Params {
         beta,
         a,
         seed,
+        // The paper's 50 ants (the default has 12): the shares below are over 50 walks.
+        ants: 50,
         iterations: 60,
         patience: 0,
         refine_patience: 0,
