@@ -26,7 +26,7 @@ to the path's cells written (SysTick, 40 instructions a cycle, calibrated by the
 in both variants: 4 bits a cell (`astar::search`: closed flag and parent in a nibble, `g` only in
 the heap) and a cost a cell (`astar::search_costs`: `g` as u32 a cell, a push only when it
 improves). Its columns: each variant's instructions and RAM in bytes a cell (the per-cell storage
-plus the heap at its peak, over the map's cells), the expansions (the same in both), and ohaca's
+plus the heap at its peak, over the map's cells), the 4-bit variant's expansions (the other's may differ slightly, on ties), and ohaca's
 mean instructions over the 4-bit A*'s. Built if missing:
 `cargo build --release --example astar_device`.
 """

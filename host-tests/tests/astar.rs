@@ -13,18 +13,17 @@ use ohaca_host_tests::reference::{astar8, step_allowed};
 use proptest::prelude::*;
 
 /// Run both variants of the core's A* on `map` (the 4-bit [`astar::search`] and the cost-a-cell
-/// [`astar::search_costs`]), check the paths they write and that they agree on the optimum and
-/// the expansions; return the 4-bit result and the path's exact length.
+/// [`astar::search_costs`]), check the paths they write and that they agree on the optimum;
+/// return the 4-bit result and the path's exact length.
 fn solve(map: &Map, s: Point, g: Point) -> Result<(Search, f64), AstarError> {
     let a = solve_one(map, s, g, false);
     let b = solve_one(map, s, g, true);
     match (&a, &b) {
-        (Ok((ra, la)), Ok((rb, lb))) => {
+        // Both are exact: the same optimum. Their expansions may differ by a few cells (on a
+        // tie of f and g the 4-bit variant's held-out neighbour and lazy heap pop in another
+        // order than the cost variant's decrease-key), so they are not compared.
+        (Ok((_, la)), Ok((_, lb))) => {
             assert_eq!(la, lb, "the variants' lengths differ");
-            assert_eq!(
-                ra.expansions, rb.expansions,
-                "the variants expand differently"
-            );
         }
         (Err(ea), Err(eb)) => assert_eq!(ea, eb),
         _ => panic!("4-bit {a:?}, costs {b:?}"),
