@@ -39,9 +39,11 @@ pub fn sqrt(x: f32) -> f32 {
         // SAFETY: the FPU is present and enabled: the `eabihf` ABI passes floats in its registers,
         // and cortex-m-rt enables it before `main` on hard-float targets. Rust does not expose
         // the FPU's register class to `asm!` on this target (no `vfp2` target feature), so the
-        // value goes through a core register, and `s0` is saved on the stack and restored: the
-        // block touches no register or memory it does not declare or restore, and no flags
-        // (FPSCR's cumulative exception bits aside, which nothing in this crate reads).
+        // value goes through a core register, and `s0` is saved on the stack (below the stack
+        // pointer, not memory Rust code sees: `nomem` holds; `nostack` is not claimed) and
+        // restored: the block touches no register or memory it does not declare or restore.
+        // `vsqrt.f32` sets FPSCR's cumulative exception bits (inexact for most lengths), which
+        // the reference counts among the flags, so `preserves_flags` is not claimed either.
         #[allow(unsafe_code)]
         unsafe {
             core::arch::asm!(
@@ -52,7 +54,7 @@ pub fn sqrt(x: f32) -> f32 {
                 "vpop {{s0}}",
                 x = in(reg) x.to_bits(),
                 r = lateout(reg) r,
-                options(pure, nomem, preserves_flags)
+                options(pure, nomem)
             );
         }
         f32::from_bits(r)

@@ -290,6 +290,19 @@ fn links(moves: &Moves<'_>, blocks: Blocks, dead: &[u32], words: &mut [u32]) {
     words.fill(0);
     let grid = *moves.grid();
     let (w, h) = (usize::from(grid.width()), usize::from(grid.height()));
+    // Marks shorter than the map (no workspace gives them: `Workspace::capacity` wants every
+    // word or none) read as pruned beyond their end in the per-cell rule, and as live in the
+    // windows below: keep the per-cell rule's answer for them, block by block.
+    if !dead.is_empty() && dead.len() < crate::bitmap::words(grid.cells()) {
+        let across = blocks.across();
+        for (b, wd) in words.iter_mut().enumerate().take(blocks.count()) {
+            let (bx, by) = (b.checked_rem(across), b.checked_div(across));
+            if let (Some(bx), Some(by)) = (bx, by) {
+                *wd = u32::from(block_links(moves, blocks, dead, bx as u16, by as u16));
+            }
+        }
+        return;
+    }
     let s = u32::from(blocks.shift());
     let last = (1usize << s).wrapping_sub(1);
     let across = blocks.across();
@@ -648,6 +661,20 @@ mod tests {
                     let across = blocks.across();
                     let down = blocks.count() / across;
                     let mut words = vec![0xDEADu32; across * down];
+                    // Marks cut short (a caller's bug, not a workspace's): the per-cell rule's
+                    // answer too, cells beyond them pruned.
+                    let short = if pruned && dead.len() > 1 {
+                        &dead[..dead.len() / 2]
+                    } else {
+                        &dead[..]
+                    };
+                    links(&moves, blocks, short, &mut words);
+                    for by in 0..down {
+                        for bx in 0..across {
+                            let want = block_links(&moves, blocks, short, bx as u16, by as u16);
+                            assert_eq!(words[by * across + bx], u32::from(want), "short marks");
+                        }
+                    }
                     links(&moves, blocks, &dead, &mut words);
                     for by in 0..down {
                         for bx in 0..across {
