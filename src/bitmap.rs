@@ -28,11 +28,12 @@ pub fn marked(bits: &[u32], i: usize) -> bool {
 }
 
 /// Cells `i..i + 33` (at least) of the set as the low bits of a word (bit `k` = cell `i + k`);
-/// words beyond the buffer read as empty. For passes over a map's rows 32 cells at a time.
+/// cells beyond the buffer read as set, as [`get`] reads them. For passes over a map's rows 32
+/// cells at a time.
 #[inline]
 pub fn window(bits: &[u32], i: usize) -> u64 {
     let k = i >> 5;
-    let word = |n: usize| u64::from(bits.get(k.wrapping_add(n)).copied().unwrap_or(0));
+    let word = |n: usize| u64::from(bits.get(k.wrapping_add(n)).copied().unwrap_or(u32::MAX));
     let r = (i & 31) as u32;
     let low = (word(0) | word(1) << 32) >> r;
     if r == 0 {

@@ -29,7 +29,7 @@ pub fn distance(a: Point, b: Point) -> f32 {
 /// `vsqrt.f32`, one instruction of 14 cycles, where `libm::sqrtf` is a software loop of about 150
 /// instructions; elsewhere (the host) it is `libm::sqrtf`. Both are correctly rounded, so they
 /// return the same bits for every input, and host and device paths stay bit-identical (the unit
-/// test `sqrt_is_libm_sqrtf` checks every length the planner can ask for on the host, and the
+/// test `sqrt_is_correctly_rounded` checks the lengths the planner asks for and random inputs, and the
 /// QEMU end-to-end tests compare device paths with the host's bit for bit).
 #[inline]
 pub fn sqrt(x: f32) -> f32 {

@@ -275,24 +275,9 @@ impl<'a> Grid<'a> {
         MASK9.get(nb & 511).copied().unwrap_or(0)
     }
 
-    /// The blocked bits of cells `i..i + 25` (bit `k` = cell `i + k`; beyond the map's buffer:
-    /// blocked), from one unaligned 4-byte read.
-    #[inline]
-    fn bits25(&self, i: usize) -> u32 {
-        let b = i >> 3;
-        let word = match self.bits.get(b..b.wrapping_add(4)) {
-            Some(&[b0, b1, b2, b3]) => u32::from_le_bytes([b0, b1, b2, b3]),
-            _ => {
-                let byte = |k: usize| self.bits.get(b.wrapping_add(k)).copied().unwrap_or(0xFF);
-                u32::from_le_bytes([byte(0), byte(1), byte(2), byte(3)])
-            }
-        };
-        word >> (i & 7)
-    }
-
     /// The blocked bits of cells `i..i + 57` (bit `k` = cell `i + k`; beyond the map's buffer:
-    /// blocked; the top bits above 57 are 0), from one unaligned 8-byte read: the rows of the
-    /// route's links ([`crate::route`]) 32 cells at a time.
+    /// blocked; the top bits above 57 are 0), from one unaligned 8-byte read: the passes over
+    /// the map's rows many cells at a time ([`Moves::fill`], [`Grid::free_window`]).
     #[inline]
     pub(crate) fn blocked_window(&self, i: usize) -> u64 {
         let b = i >> 3;
@@ -333,6 +318,14 @@ impl<'a> Grid<'a> {
             u64::MAX
         };
         !blocked & on_row
+    }
+
+    /// The bits of a [`Grid::free_window`] from column `x0` that are cells of its run: bits
+    /// `1..=n` for the `n = min(32, width - x0)` columns `x0..x0 + n` (`x0 < width`).
+    #[inline]
+    pub(crate) fn run_bits(&self, x0: usize) -> u64 {
+        let n = usize::from(self.width).wrapping_sub(x0).min(32);
+        (1u64 << n).wrapping_sub(1) << 1
     }
 
     /// The blocked bits of cells `i`, `i + 1`, `i + 2` (bits 0-2; beyond the map: blocked).
@@ -494,7 +487,7 @@ impl<'g> Moves<'g> {
             return false;
         };
         // Row by row: the border cells through `move_mask`, the interior sixteen cells at a
-        // time from one 25-bit read of each of the three rows (`Grid::bits25`) and `MASK9`: about
+        // time from one read of each of the three rows (`Grid::blocked_window`) and `MASK9`: about
         // ten instructions a cell on the Cortex-M4 where `mask_at` per cell took about 150 (the
         // table of a 256 x 256 map cost 10 M instructions, a ninth of a plan; issue 27). The
         // values are `mask_at`'s (unit test `fill_is_mask_at`).
@@ -524,15 +517,15 @@ impl<'g> Moves<'g> {
                 let n = last.wrapping_sub(x).min(16);
                 // Interior row: the rows above and below exist, and x - 1 >= 0.
                 let i = row0.wrapping_add(x).wrapping_sub(1);
-                let top = grid.bits25(i.wrapping_sub(w));
-                let mid = grid.bits25(i);
-                let bottom = grid.bits25(i.wrapping_add(w));
+                let top = grid.blocked_window(i.wrapping_sub(w));
+                let mid = grid.blocked_window(i);
+                let bottom = grid.blocked_window(i.wrapping_add(w));
                 if let Some(out) = row.get_mut(x..x.wrapping_add(n)) {
                     for (k, m) in out.iter_mut().enumerate() {
                         // k < 16: shifts below 32.
                         let nb =
                             ((top >> k) & 7) | ((mid >> k) & 7) << 3 | ((bottom >> k) & 7) << 6;
-                        *m = MASK9.get(nb as usize & 511).copied().unwrap_or(0);
+                        *m = MASK9.get((nb & 511) as usize).copied().unwrap_or(0);
                     }
                 }
                 x = x.wrapping_add(n);

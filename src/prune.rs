@@ -74,27 +74,18 @@ pub fn prune(
     }
     let offsets = grid.offsets();
     let (si, gi) = (grid.index(start), grid.index(goal));
-    let mut pruned = 0u32;
     let (w, h) = (usize::from(grid.width()), usize::from(grid.height()));
-    // Try `ci` (at `p`); if it goes, depth-first over the neighbours whose neighbourhood just
-    // shrank. True if the stack was too short for some of them.
-    let mut settle = |dead: &mut [u32], ci: usize, p: Point| -> bool {
-        if !try_prune(moves, &offsets, si, gi, dead, ci, p) {
-            return false;
-        }
-        pruned = pruned.wrapping_add(1); // < cells
-        let mut top = 0usize;
-        let mut overflow = push_neighbours(moves, &offsets, ci, stack, &mut top);
-        while top > 0 {
-            top = top.wrapping_sub(1);
-            let Some(&u) = stack.get(top) else { break };
-            let u = u as usize;
-            if try_prune(moves, &offsets, si, gi, dead, u, grid.point(u)) {
-                pruned = pruned.wrapping_add(1);
-                overflow |= push_neighbours(moves, &offsets, u, stack, &mut top);
-            }
-        }
-        overflow
+    // Each try: the local rule at a cell, then depth-first over the neighbours whose
+    // neighbourhood just shrank (as `repair`'s re-pruning does); `touched` is not needed here.
+    let mut touched = Bounds::default();
+    let mut settle = Settle {
+        moves,
+        offsets: &offsets,
+        si,
+        gi,
+        stack,
+        full: false,
+        touched: &mut touched,
     };
     // The first pass tries only the cells that could be prunable on the map as it is, before any
     // mark: a cell with free cells on two opposite sides (west and east, or north and south) is
@@ -103,7 +94,6 @@ pub fn prune(
     // the cell onto the stack, where it is tried with its neighbourhood as it then is. The test
     // is 32 cells at a time (`Grid::free_window`): on a city map about one free cell in ten is
     // tried (issue 27: the full scan was 5 M instructions of a 256 x 256 plan on the Cortex-M4).
-    let mut overflow = false;
     for y in 0..h {
         let row = y.wrapping_mul(w);
         let mut x0 = 0usize;
@@ -119,33 +109,30 @@ pub fn prune(
             } else {
                 0
             };
-            // Bit j is column x0 - 1 + j: the run's cells are bits 1..=n.
-            let n = w.wrapping_sub(x0).min(32);
-            let run = (1u64 << n).wrapping_sub(1) << 1;
+            // Bit j is column x0 - 1 + j.
+            let run = grid.run_bits(x0);
             let mut m = free & !((free << 1) & (free >> 1)) & !(north & south) & run;
             while m != 0 {
                 let j = m.trailing_zeros() as usize;
                 m &= m.wrapping_sub(1);
-                let x = x0.wrapping_add(j).wrapping_sub(1); // j >= 1
-                let ci = row.wrapping_add(x);
-                overflow |= settle(dead, ci, Point::new(x as u16, y as u16));
+                // j >= 1: column x0 - 1 + j.
+                settle.at(dead, row.wrapping_add(x0).wrapping_add(j).wrapping_sub(1));
             }
             x0 = x0.wrapping_add(32);
         }
     }
     // A full stack dropped some neighbours: a pass over every free cell finds what they would
     // have, as many times as it takes.
-    while overflow {
-        overflow = false;
+    while settle.full {
+        settle.full = false;
         for ci in 0..cells {
             // Blocked cells are never pruned: skip them before computing anything.
-            if grid.blocked_at(ci) {
-                continue;
+            if !grid.blocked_at(ci) {
+                settle.at(dead, ci);
             }
-            overflow |= settle(dead, ci, grid.point(ci));
         }
     }
-    pruned
+    bitmap::count(dead, cells)
 }
 
 /// A rectangle of cells, corners included: `(top-left, bottom-right)`.
@@ -311,8 +298,8 @@ impl Bounds {
     }
 }
 
-/// The re-pruning of [`repair`]: the local rule at a cell, then depth-first over the neighbours
-/// of every cell it prunes.
+/// The pruning of [`prune`] and the re-pruning of [`repair`]: the local rule at a cell, then
+/// depth-first over the neighbours of every cell it prunes.
 struct Settle<'m, 's> {
     moves: &'m Moves<'m>,
     offsets: &'m [isize; 8],

@@ -290,19 +290,6 @@ fn links(moves: &Moves<'_>, blocks: Blocks, dead: &[u32], words: &mut [u32]) {
     words.fill(0);
     let grid = *moves.grid();
     let (w, h) = (usize::from(grid.width()), usize::from(grid.height()));
-    // Marks shorter than the map (no workspace gives them: `Workspace::capacity` wants every
-    // word or none) read as pruned beyond their end in the per-cell rule, and as live in the
-    // windows below: keep the per-cell rule's answer for them, block by block.
-    if !dead.is_empty() && dead.len() < crate::bitmap::words(grid.cells()) {
-        let across = blocks.across();
-        for (b, wd) in words.iter_mut().enumerate().take(blocks.count()) {
-            let (bx, by) = (b.checked_rem(across), b.checked_div(across));
-            if let (Some(bx), Some(by)) = (bx, by) {
-                *wd = u32::from(block_links(moves, blocks, dead, bx as u16, by as u16));
-            }
-        }
-        return;
-    }
     let s = u32::from(blocks.shift());
     let last = (1usize << s).wrapping_sub(1);
     let across = blocks.across();
@@ -357,13 +344,7 @@ fn links(moves: &Moves<'_>, blocks: Blocks, dead: &[u32], words: &mut [u32]) {
             let south = live & live1;
             let south_east = live & (live1 >> 1) & (free >> 1) & free1;
             let south_west = live & (live1 << 1) & (free << 1) & free1;
-            let n = (w.wrapping_sub(x0)).min(32);
-            // The cells of this run: bits 1..=n.
-            let run = if n >= 64 {
-                u64::MAX
-            } else {
-                (1u64 << n).wrapping_sub(1) << 1
-            };
+            let run = grid.run_bits(x0);
             // The cell of bit j: x0 - 1 + j (j >= 1).
             let cell = |j: usize| x0.wrapping_add(j).wrapping_sub(1);
             // The bits of the run's cells in a block's last column (x & last == last) and in its

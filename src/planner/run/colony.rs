@@ -181,8 +181,8 @@ impl Run<'_, '_> {
                 match walk_tightened(&ant, p.tighten, &mut self.rng, tabu, tour, points, links) {
                     Ok(w) => w,
                     Err(Lost::Exhausted) => {
-                        // The goal is not reachable: proved by this ant (backtracking ants run without the
-                        // flood fill, and a fill that could not decide leaves it to them).
+                        // The goal is not reachable, proved by this ant: backtracking ants run
+                        // without the setup's flood fill (`setup.rs`).
                         self.no_path = true;
                         break;
                     }
