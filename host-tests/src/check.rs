@@ -282,7 +282,7 @@ pub fn check_plan(
     // plain one.
     // The local search runs for OHACA on every map (its storage here always lends the scratch).
     let refines = p.refine && p.algorithm == Algorithm::Ohaca;
-    let patience = if plan.warm && p.warm_patience > 0 {
+    let patience = if plan.origin == ohaca::planner::Origin::Warm && p.warm_patience > 0 {
         p.warm_patience
     } else if refines && p.refine_patience > 0 {
         p.refine_patience

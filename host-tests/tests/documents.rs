@@ -139,7 +139,7 @@ fn the_reply_size_limits_are_the_documents() {
         moves: u64::MAX,
         ticks: u64::MAX,
         raw_cells: u32::MAX,
-        warm: true,
+        origin: ohaca::planner::Origin::Reused,
         waypoints: Waypoints::Points(&points),
         directions: &dirs,
     });

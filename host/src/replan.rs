@@ -31,7 +31,7 @@ use std::collections::BinaryHeap;
 use serde::Deserialize;
 
 use ohaca::heap::HeapStorage;
-use ohaca::planner::{Area, Memory, Run};
+use ohaca::planner::{reuse, Area, Memory, Origin, Run};
 use ohaca::{Grid, Params, Point};
 
 use crate::link::{DevicePath, Link, LinkError, Transport};
@@ -131,8 +131,24 @@ pub struct Planned {
     pub moves: u64,
     /// Device ticks (`None` on the host).
     pub ticks: Option<u64>,
-    /// The run kept the previous colony.
-    pub warm: bool,
+    /// Cold, warm (the run kept the previous colony) or reused (the rest of the previous answer).
+    pub origin: Origin,
+}
+
+impl Planned {
+    /// A plan of the host core, with the device's ticks if any.
+    pub fn of(plan: &ohaca::Plan<'_>, ticks: Option<u64>) -> Self {
+        Planned {
+            raw: plan.raw().collect(),
+            waypoints: plan.waypoints().to_vec(),
+            raw_length: plan.raw_length,
+            length: plan.length,
+            iterations: plan.iterations,
+            moves: plan.moves,
+            ticks,
+            origin: plan.origin,
+        }
+    }
 }
 
 /// Something that plans: the host core or a device.
@@ -197,21 +213,32 @@ impl Planner for HostPlanner {
 
     fn change(&mut self, cells: &[Point], blocked: bool) -> Result<(), String> {
         for &p in cells {
+            // As the firmware does: a cleared cell counts as freed if it was blocked.
+            let was_blocked = self.map.is_blocked(p);
             set_cell(&mut self.map, p, blocked)?;
-            self.memory.changed(Area::cell(p));
+            let cell = Area::cell(p);
+            self.memory
+                .changed(cell, (!blocked && was_blocked).then_some(cell));
         }
         Ok(())
     }
 
     fn plan(&mut self, start: Point, goal: Point, warm: bool) -> Result<Planned, String> {
         let grid = self.map.grid().map_err(|e| e.to_string())?;
-        let ws = if self.arena.is_empty() {
+        let mut ws = if self.arena.is_empty() {
             self.storage.workspace()
         } else {
             ohaca::planner::arena::carve(&mut self.arena, self.map.cells(), DEVICE_STEPS)
                 .map_err(|e| e.to_string())?
                 .workspace
         };
+        // As the firmware does: a warm replan that no change since can shorten or block is the
+        // rest of the last answer.
+        if warm {
+            if let Some(plan) = reuse(&grid, start, goal, &self.params, &mut ws, &mut self.memory) {
+                return Ok(Planned::of(&plan, None));
+            }
+        }
         let mut run = if warm {
             Run::warm(&grid, start, goal, &self.params, ws, &mut self.memory)
         } else {
@@ -223,16 +250,7 @@ impl Planner for HostPlanner {
         while run.polish_step() {}
         run.keep(&mut self.memory);
         let plan = run.finish().map_err(|e| e.to_string())?;
-        Ok(Planned {
-            raw: plan.raw().collect(),
-            waypoints: plan.waypoints().to_vec(),
-            raw_length: plan.raw_length,
-            length: plan.length,
-            iterations: plan.iterations,
-            moves: plan.moves,
-            ticks: None,
-            warm: plan.warm,
-        })
+        Ok(Planned::of(&plan, None))
     }
 }
 
@@ -268,7 +286,7 @@ impl<T: Transport> Planner for DevicePlanner<T> {
             iterations: p.iterations,
             moves: p.moves,
             ticks: Some(p.ticks),
-            warm: p.warm,
+            origin: p.origin,
         })
     }
 }
@@ -549,7 +567,7 @@ mod tests {
             assert!(s.changed.iter().all(|&c| s.map.is_blocked(c)));
             // The replan saw the wall: it is valid on the changed map and no ant crossed it.
             check(&s.map, s.robot, Point::new(22, 12), &s.plan.raw).unwrap();
-            assert_eq!(s.plan.warm, warm);
+            assert_eq!(s.plan.origin.is_warm(), warm);
             assert!(s.optimum.unwrap() > f64::from(22 - s.robot.x));
             assert!(d.steps.iter().all(|s| d.trail[s.at] == s.robot));
             assert_eq!(d.trail.first(), Some(&Point::new(1, 12)));
@@ -570,7 +588,7 @@ mod tests {
         let cold = drive(&sc, &map, ends, &mut host(), false).unwrap();
         let warm = drive(&sc, &map, ends, &mut host(), true).unwrap();
         assert_eq!(cold.steps[0].plan, warm.steps[0].plan);
-        assert!(!cold.steps[1].plan.warm && warm.steps[1].plan.warm);
+        assert!(!cold.steps[1].plan.origin.is_warm() && warm.steps[1].plan.origin.is_warm());
         assert_eq!(cold.steps[1].changed.len(), 36);
         assert!(!cold.steps[1].blocked);
     }

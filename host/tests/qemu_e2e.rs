@@ -1577,7 +1577,10 @@ fn cell_updates_between_plans_change_the_answer() {
     // The cold plan through the gap recorded its colony: this one keeps it (the host's warm
     // replans are checked against the device's in `qemu_replan.rs`).
     let warm = link.plan_warm(s, g, None).expect("warm");
-    assert!(warm.warm, "PlanWarm after a plan to the same goal");
+    assert!(
+        warm.origin.is_warm(),
+        "PlanWarm after a plan to the same goal"
+    );
     assert!(warm.raw(s).expect("raw").contains(&Point::new(10, 3)));
     let st = link.stats().expect("stats");
     assert_eq!(

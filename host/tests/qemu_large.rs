@@ -157,7 +157,7 @@ fn a_warm_replan_on_a_512x512_map_is_the_host_cores() {
         p.change(&wall, true).expect("cells");
         p.plan(robot, goal, true).expect("warm plan")
     });
-    assert!(warm.warm, "the colony was kept");
+    assert!(warm.origin.is_warm(), "the colony was kept");
     assert!(warm.raw.iter().all(|c| !wall.contains(c)));
     println!(
         "NewYork_0_512: cold {} iterations, {} moves; warm {} iterations, {} moves",

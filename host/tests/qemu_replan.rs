@@ -63,10 +63,10 @@ fn warm_and_cold_replans_on_the_device_are_the_host_cores() {
             let d = drive(&sc, &map, ends, &mut dev, warm).expect("device");
             assert_same_drive(&what, &host, &d);
             assert!(
-                !d.steps[0].plan.warm,
+                !d.steps[0].plan.origin.is_warm(),
                 "{what}: the first plan after an upload is cold"
             );
-            assert_eq!(d.steps[1].plan.warm, warm, "{what}");
+            assert_eq!(d.steps[1].plan.origin.is_warm(), warm, "{what}");
             assert!(!d.steps[1].changed.is_empty(), "{what}");
         }
     }
@@ -98,7 +98,7 @@ fn a_warm_replan_on_the_lab_map_is_the_host_cores() {
     let host = drive(&sc, &map, ends, &mut HostPlanner::new(p), true).expect("host");
     let d = drive(&sc, &map, ends, &mut dev, true).expect("device");
     assert_same_drive("lab", &host, &d);
-    assert!(d.steps[1].plan.warm);
+    assert!(d.steps[1].plan.origin.is_warm());
 }
 
 /// When `PlanWarm` keeps the colony: after a plan to the same goal on this map (cold or warm,
@@ -112,7 +112,12 @@ fn plan_warm_keeps_the_colony_only_for_the_same_goal_and_map() {
     let map = Map::load(maps().join("complex-26.map")).expect("map");
     link.set_map(&map).expect("map");
     let (s, g, other) = (Point::new(0, 0), Point::new(25, 25), Point::new(25, 0));
-    let warm = |link: &mut Link<_>, goal: Point| link.plan_warm(s, goal, None).expect("plan").warm;
+    let warm = |link: &mut Link<_>, goal: Point| {
+        link.plan_warm(s, goal, None)
+            .expect("plan")
+            .origin
+            .is_warm()
+    };
     assert!(!warm(&mut link, g), "no colony yet");
     assert!(warm(&mut link, g), "same goal");
     assert!(!warm(&mut link, other), "another goal");
@@ -128,7 +133,7 @@ fn plan_warm_keeps_the_colony_only_for_the_same_goal_and_map() {
     assert!(link.plan_warm(blocked, g, None).is_err());
     assert!(warm(&mut link, g), "after a refused plan");
     // A cold plan records its colony too.
-    assert!(!link.plan(s, g, None).expect("cold").warm);
+    assert!(!link.plan(s, g, None).expect("cold").origin.is_warm());
     assert!(warm(&mut link, g), "after a cold plan");
     link.set_cells(&[Point::new(12, 12)], true).expect("update");
     assert!(warm(&mut link, g), "a cell update keeps the colony");

@@ -13,7 +13,7 @@ use embassy_futures::yield_now;
 use embassy_time::Instant;
 use embedded_io_async::Write;
 
-use ohaca::planner::Run;
+use ohaca::planner::{reuse, Plan, Run};
 use ohaca::protocol::{ErrorCode, ErrorReply, PathReply, PathStream, Reply, Waypoints};
 
 use super::buffers;
@@ -67,13 +67,30 @@ async fn plan(
         return Err(cancelled());
     }
     let (width, height) = state::map_size().ok_or(ErrorReply::new(ErrorCode::NoMap))?;
-    let (grid, ws) = buffers::lend(&mut map, storage, width, height)?;
+    let (grid, mut ws) = buffers::lend(&mut map, storage, width, height)?;
     let t0 = Instant::now();
     // A warm plan keeps the colony if it is for this map and goal; both kinds record theirs for
     // the next `PlanWarm` once the run started (a refused plan leaves the pheromone as it was).
     // The memory is read and written under the map's lock.
     let mut memory = state::colony();
     let (start, goal, params) = (job.start, job.goal, &job.params);
+    // First, a warm plan that no change since can shorten or block is the rest of the last
+    // answer: no run at all.
+    if job.warm {
+        if let Some(plan) = reuse(&grid, start, goal, params, &mut ws, &mut memory) {
+            state::set_colony(memory);
+            let ticks = Instant::now().saturating_duration_since(t0).as_ticks();
+            defmt::info!(
+                "plan {}: reused, length {}, {} waypoints, {} ticks",
+                job.id,
+                plan.length,
+                plan.waypoints().len(),
+                ticks
+            );
+            send(job, &plan, ticks, port).await?;
+            return Ok(ticks);
+        }
+    }
     let mut run = if job.warm {
         Run::warm(&grid, start, goal, params, ws, &mut memory)
     } else {
@@ -140,6 +157,17 @@ async fn plan(
         in_steps,
         t_end.saturating_duration_since(t_finish).as_ticks()
     );
+    send(job, &plan, ticks, port).await?;
+    Ok(ticks)
+}
+
+/// Send `plan` as the path reply to `job`, a piece at a time.
+async fn send(
+    job: &Job,
+    plan: &Plan<'_>,
+    ticks: u64,
+    port: &'static TxPort,
+) -> Result<(), ErrorReply> {
     let reply = PathReply {
         raw_length: plan.raw_length,
         length: plan.length,
@@ -149,7 +177,7 @@ async fn plan(
         moves: plan.moves,
         ticks,
         raw_cells: u32::try_from(plan.raw_len()).unwrap_or(u32::MAX),
-        warm: plan.warm,
+        origin: plan.origin,
         waypoints: Waypoints::Points(plan.waypoints()),
         directions: plan.directions(),
     };
@@ -176,5 +204,5 @@ async fn plan(
     }
     drop(tx);
     sent_one(sent);
-    Ok(ticks)
+    Ok(())
 }

@@ -249,20 +249,39 @@ async fn update(u: Update<'_>, blocked: bool) -> Reply<'static> {
     }
     state::cancel_all();
     let mut map = MAP.lock().await;
+    // The colony memory learns what changes, and which cells a clear frees (blocked before:
+    // read from the map before it is written), for the next `PlanWarm` (`ohaca::planner::reuse`).
+    let mut memory = state::colony();
+    let was_blocked = |p: Point| {
+        let i = usize::from(p.y) * usize::from(size.0) + usize::from(p.x);
+        map.get(i / 8).is_some_and(|b| b >> (i % 8) & 1 == 1)
+    };
     let done = match u {
         Update::Rect(x, y, w, h) => {
             if let Some(a) = Area::rect(x, y, w, h) {
-                state::colony_changed(a);
+                let cleared = if blocked {
+                    None
+                } else {
+                    let (lo, hi) = a.corners();
+                    (lo.y..=hi.y)
+                        .flat_map(|y| (lo.x..=hi.x).map(move |x| Point::new(x, y)))
+                        .filter(|&p| was_blocked(p))
+                        .map(Area::cell)
+                        .reduce(Area::union)
+                };
+                memory.changed(a, cleared);
             }
             set_rect(size, &mut map[..], (x, y, w, h), blocked)
         }
         Update::Cells(c) => {
-            if let Some(a) = c.iter().map(Area::cell).reduce(Area::union) {
-                state::colony_changed(a);
+            for p in c.iter() {
+                let cleared = !blocked && was_blocked(p);
+                memory.changed(Area::cell(p), cleared.then_some(Area::cell(p)));
             }
             set_cells(size, &mut map[..], &c, blocked)
         }
     };
+    state::set_colony(memory);
     match done {
         Ok(()) => Reply::Ack,
         Err(e) => Reply::Error(e),

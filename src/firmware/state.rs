@@ -18,7 +18,7 @@ use embassy_sync::channel::Channel;
 use embassy_sync::mutex::Mutex;
 
 use ohaca::grid::Point;
-use ohaca::planner::{Area, Memory, Params};
+use ohaca::planner::{Memory, Params};
 use ohaca::protocol::{MapLimits, Reply, StatsReply};
 
 use super::board::{self, Board};
@@ -162,15 +162,6 @@ pub fn colony() -> Memory {
 /// Replace the colony memory (call with [`MAP`]'s lock held).
 pub fn set_colony(m: Memory) {
     COLONY.lock(|c| c.set(m));
-}
-
-/// Record a change of the cells in `area` for the next warm start (call with [`MAP`]'s lock held).
-pub fn colony_changed(area: Area) {
-    COLONY.lock(|c| {
-        let mut m = c.get();
-        m.changed(area);
-        c.set(m);
-    });
 }
 
 /// True if plans received under `generation` are cancelled.

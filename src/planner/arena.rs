@@ -378,8 +378,8 @@ mod tests {
                     let c = (100 + 20 * round + i) * usize::from(w) + 90 + 7 * i;
                     bits[c / 8] |= 1 << (c % 8);
                     let p = Point::new((c % usize::from(w)) as u16, (c / usize::from(w)) as u16);
-                    m1.changed(crate::planner::Area::cell(p));
-                    m2.changed(crate::planner::Area::cell(p));
+                    m1.changed(crate::planner::Area::cell(p), None);
+                    m2.changed(crate::planner::Area::cell(p), None);
                 }
             }
             let g = Grid::new(w, h, &bits).unwrap();
@@ -399,7 +399,7 @@ mod tests {
                         pl.directions().to_vec(),
                         pl.waypoints().to_vec(),
                         pl.moves,
-                        pl.warm,
+                        pl.origin,
                     )
                 })
             };

@@ -21,6 +21,7 @@
 //! | `run` | [`Run`]: the loop as a state machine (setup, walk + update + record, polish) |
 //! | `plan` | [`Plan`], [`RawPath`], [`CurvePoint`]: the result |
 //! | `warm` | [`Memory`], [`Area`]: warm starts after map changes, and the pheromone repair |
+//! | `reuse` | [`reuse`]: a replan answered with the rest of the last answer, when no change can block or shorten it |
 //! | [`arena`] | [`arena::carve`]: a map and a workspace laid out in one arena, per map size |
 //!
 //! [`Run::step`] does one iteration, so the firmware can yield to its executor between iterations
@@ -29,14 +30,16 @@
 pub mod arena;
 mod params;
 mod plan;
+mod reuse;
 mod run;
 mod warm;
 mod workspace;
 
 pub use params::{Algorithm, Params};
-pub use plan::{CurvePoint, Plan, RawPath};
+pub use plan::{CurvePoint, Origin, Plan, RawPath};
+pub use reuse::reuse;
 pub use run::{Run, REFINE_GAIN};
-pub use warm::{Area, Memory, REPAIR_RADIUS};
+pub use warm::{Area, Memory, FREED, REPAIR_RADIUS};
 #[cfg(any(feature = "alloc", test))]
 pub(crate) use workspace::OwnedBuffers;
 pub use workspace::{Buffers, Storage, Workspace};

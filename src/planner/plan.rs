@@ -19,6 +19,44 @@ pub struct CurvePoint {
     pub arrived: u16,
 }
 
+/// Where a [`Plan`] comes from. On the wire it is [`crate::protocol::PathReply::origin`], one
+/// byte: the variant's index.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub enum Origin {
+    /// `0`: a colony run from scratch (`Plan`, or a `PlanWarm` with no colony to keep).
+    #[default]
+    Cold,
+    /// `1`: a colony run that kept the previous run's pheromone ([`super::Run::warm`]).
+    Warm,
+    /// `2`: no run: the rest of the previous answer from the robot's cell, checked on the map as
+    /// it is now, because no change since can shorten it or blocks it ([`super::reuse`]).
+    Reused,
+}
+
+impl Origin {
+    /// True unless the path was planned from scratch.
+    pub fn is_warm(self) -> bool {
+        self != Origin::Cold
+    }
+
+    /// The name used in logs and tables: `cold`, `warm`, `reused`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Origin::Cold => "cold",
+            Origin::Warm => "warm",
+            Origin::Reused => "reused",
+        }
+    }
+}
+
+impl core::fmt::Display for Origin {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
 /// The result of a run. Borrows the workspace it was computed in.
 #[derive(Clone, Copy, Debug)]
 pub struct Plan<'a> {
@@ -43,8 +81,9 @@ pub struct Plan<'a> {
     pub moves: u64,
     /// Cells pruned before the ants ran ([`crate::prune`]).
     pub pruned: u32,
-    /// True if the run kept the previous run's colony ([`super::Run::warm`]).
-    pub warm: bool,
+    /// Where the path comes from: a cold run, a warm one ([`super::Run::warm`]), or the rest of
+    /// the previous answer ([`super::reuse`]).
+    pub origin: Origin,
     pub(super) curve: &'a [CurvePoint],
     /// Parameters used.
     pub params: Params,

@@ -299,7 +299,7 @@ fn run_to_end(run: Run<'_, '_>) -> (Vec<Point>, bool, u16) {
     let mut run = run;
     while run.step() {}
     let p = run.finish().unwrap();
-    (p.raw().collect(), p.warm, p.iterations)
+    (p.raw().collect(), p.origin.is_warm(), p.iterations)
 }
 
 #[test]
@@ -344,7 +344,7 @@ fn a_warm_start_keeps_the_pheromone_away_from_changes_and_resets_it_near_them() 
     let c = Point::new(20, 3);
     let i = usize::from(c.y) * 32 + usize::from(c.x);
     bits[i / 8] |= 1 << (i % 8);
-    memory.changed(Area::cell(c));
+    memory.changed(Area::cell(c), None);
     let g = Grid::new(w, h, &bits).unwrap();
     let warm = Run::warm(&g, Point::new(5, 5), goal, &p, st.workspace(), &mut memory)
         .unwrap()
@@ -389,7 +389,7 @@ fn warm_runs_stop_after_the_warm_patience_and_stay_valid() {
         while run.step() {}
         let best = run.best_iteration().unwrap();
         let plan = run.finish().unwrap();
-        assert!(plan.warm);
+        assert!(plan.origin.is_warm());
         assert_eq!(plan.iterations, best + warm_patience + 1);
         assert_eq!(plan.raw().last(), Some(goal));
         // Another goal: cold, with the cold patience.
@@ -415,7 +415,7 @@ fn a_refused_warm_start_leaves_the_memory_alone() {
     let mut memory = Memory::new();
     run_to_end(Run::warm(&g, Point::new(0, 0), goal, &p, st.workspace(), &mut memory).unwrap());
     let before = st.workspace().pheromone().to_vec();
-    memory.changed(Area::cell(Point::new(3, 3)));
+    memory.changed(Area::cell(Point::new(3, 3)), None);
     let kept = memory;
     // The start is on an obstacle.
     let e = Run::warm(&g, Point::new(1, 1), goal, &p, st.workspace(), &mut memory);
@@ -439,7 +439,7 @@ fn a_warm_start_after_a_change_that_cuts_the_goal_off_ends_with_no_path() {
     for (x, y) in [(6usize, 4usize), (7, 4), (6, 5)] {
         let i = y * 8 + x;
         b[i / 8] |= 1 << (i % 8);
-        memory.changed(Area::cell(Point::new(x as u16, y as u16)));
+        memory.changed(Area::cell(Point::new(x as u16, y as u16)), None);
     }
     let g = Grid::new(w, h, &b).unwrap();
     // Warm with backtracking ants: no flood fill, the first ant proves it.
@@ -727,8 +727,8 @@ fn warm_starts_that_repair_the_marks_and_the_route_plan_what_rebuilding_ones_do(
                 } else {
                     b[i / 8] &= !(1 << (i % 8));
                 }
-                mem_keep.changed(Area::cell(c));
-                mem_plain.changed(Area::cell(c));
+                mem_keep.changed(Area::cell(c), (leg != 0).then_some(Area::cell(c)));
+                mem_plain.changed(Area::cell(c), (leg != 0).then_some(Area::cell(c)));
             }
         }
     }

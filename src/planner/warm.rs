@@ -77,6 +77,12 @@ impl Area {
         }
     }
 
+    /// Cells inside.
+    pub fn cells(&self) -> u64 {
+        let side = |a: u16, b: u16| u64::from(b.saturating_sub(a)).saturating_add(1);
+        side(self.min.x, self.max.x).saturating_mul(side(self.min.y, self.max.y))
+    }
+
     /// The corners, as `(min, max)`.
     pub fn corners(self) -> (Point, Point) {
         (self.min, self.max)
@@ -104,14 +110,14 @@ impl Area {
 /// let mut memory = Memory::new();
 /// assert!(!memory.is_warm_for(64, 64, Point::new(60, 60))); // nothing planned yet
 /// memory.planned(64, 64, Point::new(60, 60));
-/// memory.changed(Area::cell(Point::new(10, 12)));
+/// memory.changed(Area::cell(Point::new(10, 12)), None);
 /// assert!(memory.is_warm_for(64, 64, Point::new(60, 60)));
 /// assert!(!memory.is_warm_for(64, 64, Point::new(1, 1))); // another goal: cold
 /// assert_eq!(memory.changes(), Some(Area::cell(Point::new(10, 12))));
 /// memory.forget(); // a new map
 /// assert!(!memory.is_warm_for(64, 64, Point::new(60, 60)));
 /// ```
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Memory {
     /// Map width, height and goal of the last run that set the pheromone.
@@ -121,10 +127,74 @@ pub struct Memory {
     /// What else that run left in the workspace for a warm start to repair instead of rebuild
     /// ([`super::Run::keep`]).
     kept: Option<Kept>,
+    /// The last answer to the owner's goal, kept in the workspace for a replan to reuse
+    /// ([`super::reuse`]).
+    pub(super) answer: Option<Answer>,
+    /// The cells cleared since that answer was planned, as at most [`FREED`] rectangles.
+    pub(super) freed: Freed,
 }
 
-/// What a run left in the workspace besides its pheromone ([`super::Run::keep`]): its pruning
-/// marks, and maybe its coarse route's links.
+/// Rectangles of cleared cells a [`Memory`] tells apart; a further one is merged into the one
+/// it grows least (a larger rectangle: fewer replans proven unnecessary, never a wrong proof).
+pub const FREED: usize = 8;
+
+/// The cells cleared since an answer was planned ([`Memory::changed`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub(super) struct Freed {
+    areas: [Option<Area>; FREED],
+}
+
+impl Freed {
+    /// Add `area`: into a free slot, else merged into the rectangle it grows least.
+    fn add(&mut self, area: Area) {
+        let mut grow: Option<(u64, usize)> = None;
+        for (i, slot) in self.areas.iter_mut().enumerate() {
+            match slot {
+                None => {
+                    *slot = Some(area);
+                    return;
+                }
+                Some(a) => {
+                    let g = a.union(area).cells().saturating_sub(a.cells());
+                    if grow.is_none_or(|(best, _)| g < best) {
+                        grow = Some((g, i));
+                    }
+                }
+            }
+        }
+        if let Some(slot) = grow.and_then(|(_, i)| self.areas.get_mut(i)) {
+            *slot = slot.map(|a| a.union(area));
+        }
+    }
+
+    /// The rectangles.
+    pub(super) fn areas(&self) -> impl Iterator<Item = Area> + '_ {
+        self.areas.iter().flatten().copied()
+    }
+}
+
+/// The last answer a [`Memory`] keeps: its raw path is `best[from..steps]` of the workspace,
+/// starting at `start`, and its waypoints `points[first..end]` ([`super::reuse`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub(super) struct Answer {
+    /// The answer's first cell (`points[first]`, and the raw path's).
+    pub(super) start: Point,
+    /// The raw path's first direction in the best tour.
+    pub(super) from: u32,
+    /// One past its last.
+    pub(super) steps: u32,
+    /// The first waypoint in `points`.
+    pub(super) first: u32,
+    /// One past the last.
+    pub(super) end: u32,
+    /// The parameters that planned it (seed set to 0: a replan with another seed reuses it).
+    pub(super) params: super::Params,
+}
+
+/// What a run left in the workspace besides its pheromone and its answer ([`super::Run::keep`]):
+/// its pruning marks, and maybe its coarse route's links.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub(super) struct Kept {
@@ -143,6 +213,10 @@ impl Memory {
             owner: None,
             changes: None,
             kept: None,
+            answer: None,
+            freed: Freed {
+                areas: [None; FREED],
+            },
         }
     }
 
@@ -151,20 +225,25 @@ impl Memory {
         *self = Memory::new();
     }
 
-    /// Cells in `area` changed (blocked or cleared).
-    pub fn changed(&mut self, area: Area) {
+    /// Cells in `area` changed (blocked or cleared), and those of them that were blocked and are
+    /// free now lie in `cleared` (`None`: none). A caller that does not know passes
+    /// `Some(area)`: a cleared cell is the one kind of change that can make a kept answer longer
+    /// than a new plan ([`super::reuse`]), so a larger `cleared` is always safe.
+    pub fn changed(&mut self, area: Area, cleared: Option<Area>) {
         self.changes = Some(match self.changes {
             Some(a) => a.union(area),
             None => area,
         });
+        if let Some(c) = cleared {
+            self.freed.add(c);
+        }
     }
 
     /// A run on a `width x height` map to `goal` set the pheromone (called by
     /// [`super::Run::warm`]; no changes since).
     pub fn planned(&mut self, width: u16, height: u16, goal: Point) {
+        *self = Memory::new();
         self.owner = Some((width, height, goal));
-        self.changes = None;
-        self.kept = None;
     }
 
     /// What the last run left besides its pheromone, if it said so ([`super::Run::keep`]).
@@ -232,8 +311,11 @@ mod tests {
         assert!(m.is_warm_for(8, 8, g));
         assert!(!m.is_warm_for(8, 9, g));
         assert!(!m.is_warm_for(8, 8, Point::new(4, 4)));
-        m.changed(Area::cell(Point::new(1, 1)));
-        m.changed(Area::cell(Point::new(5, 0)));
+        m.changed(Area::cell(Point::new(1, 1)), None);
+        m.changed(
+            Area::cell(Point::new(5, 0)),
+            Some(Area::cell(Point::new(5, 0))),
+        );
         assert_eq!(m.changes(), Area::rect(1, 0, 5, 2));
         m.planned(8, 8, g);
         assert_eq!(m.changes(), None);

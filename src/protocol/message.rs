@@ -5,7 +5,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::grid::Point;
-use crate::planner::Params;
+use crate::planner::{Origin, Params};
 
 use super::wire::PointDef;
 #[cfg(doc)] // the doc links
@@ -186,8 +186,11 @@ pub struct PathReply<'a> {
     pub ticks: u64,
     /// Cells of the raw path (`directions.len() + 1` unless the directions were cut short).
     pub raw_cells: u32,
-    /// True if the run kept the colony of the previous plan (a `PlanWarm` planned warm).
-    pub warm: bool,
+    /// Where the path comes from, one byte: `0` cold (a colony run from scratch), `1` warm (a
+    /// `PlanWarm` that kept the previous plan's colony), `2` reused (a `PlanWarm` answered with
+    /// the rest of the previous answer, no colony run: [`crate::planner::reuse`]). Protocol 8's
+    /// `warm` flag, as a byte that says more: `0` and `1` are its bytes.
+    pub origin: Origin,
     /// Waypoints, start first, goal last. At most [`MAX_WAYPOINTS`].
     #[serde(borrow)]
     pub waypoints: Waypoints<'a>,

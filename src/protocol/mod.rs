@@ -66,8 +66,9 @@ pub use wire::{Waypoints, WAYPOINT_BYTES};
 /// updates, warm plans, [`Capacity`]'s sides are the largest map held; 4: warm replies and
 /// `warm_patience`; 5: `refine_patience` and `refine`; 6: [`Capacity`] by cells, `max_side` and
 /// `max_steps`; 7: [`MAX_REPLY`] carries every path of [`MAX_STEPS`] steps; 8: [`MAX_STEPS`]
-/// 16,384).
-pub const VERSION: u16 = 8;
+/// 16,384; 9: [`PathReply::origin`] replaces `warm`, a `PlanWarm` may be answered with the rest
+/// of the previous answer).
+pub const VERSION: u16 = 9;
 
 /// The id of replies to frames whose request id could not be read. Hosts should not use it.
 pub const UNKNOWN_ID: u32 = 0;

@@ -57,7 +57,7 @@ enum Stage {
 /// let points = [Point::new(0, 0), Point::new(3, 2)];
 /// let path = PathReply { raw_length: 3.8, length: 3.6, turns: 0, iterations: 21,
 ///     best_iteration: 0, moves: 4200, ticks: 1689, raw_cells: 4,
-///     warm: false, waypoints: Waypoints::Points(&points), directions: &[0, 1, 1] };
+///     origin: ohaca::planner::Origin::Cold, waypoints: Waypoints::Points(&points), directions: &[0, 1, 1] };
 /// let mut stream = PathStream::new(3, &path).unwrap();
 /// let (mut wire, mut piece) = (Vec::new(), [0u8; 16]);
 /// loop {

@@ -68,6 +68,7 @@ struct Row {
     changed_cells: Vec<[u16; 2]>,
     blocked: bool,
     warm: bool,
+    origin: &'static str,
     iterations: u16,
     moves: u64,
     ticks: Option<u64>,
@@ -87,7 +88,8 @@ fn rows(mode: &'static str, d: &Drive) -> Vec<Row> {
             changed: s.changed.len(),
             changed_cells: s.changed.iter().map(|p| [p.x, p.y]).collect(),
             blocked: s.blocked,
-            warm: s.plan.warm,
+            warm: s.plan.origin.is_warm(),
+            origin: s.plan.origin.name(),
             iterations: s.plan.iterations,
             moves: s.plan.moves,
             ticks: s.plan.ticks,
@@ -126,7 +128,7 @@ fn planner(args: &Args) -> Result<Box<dyn Planner>, String> {
 
 fn table(rows: &[Row]) -> String {
     let mut out = String::from(
-        "mode  plan  robot       changed      warm  iterations  moves      instructions  raw     smoothed  optimum  raw/opt\n",
+        "mode  plan  robot       changed      origin  iterations  moves      instructions  raw     smoothed  optimum  raw/opt\n",
     );
     for r in rows {
         let changed = match (r.plan, r.changed) {
@@ -141,12 +143,12 @@ fn table(rows: &[Row]) -> String {
             format!("{:.4}", f64::from(r.raw_length) / o)
         });
         out += &format!(
-            "{:<5} {:<5} {:<11} {:<12} {:<5} {:<11} {:<10} {:<13} {:<7.2} {:<9.2} {:<8} {}\n",
+            "{:<5} {:<5} {:<11} {:<12} {:<7} {:<11} {:<10} {:<13} {:<7.2} {:<9.2} {:<8} {}\n",
             r.mode,
             r.plan,
             format!("({},{})", r.robot[0], r.robot[1]),
             changed,
-            if r.warm { "yes" } else { "no" },
+            r.origin,
             r.iterations,
             r.moves,
             instr,

@@ -42,7 +42,7 @@ mod fake_device {
                     moves: pts.moves,
                     ticks: pts.ticks,
                     raw_cells: pts.raw_cells,
-                    warm: pts.warm,
+                    origin: pts.origin,
                     waypoints: Waypoints::Points(&pts.waypoints),
                     directions: &pts.directions,
                 })
@@ -133,7 +133,7 @@ mod fake_device {
             moves: seed,
             ticks: 5,
             raw_cells: 2,
-            warm: false,
+            origin: ohaca::planner::Origin::Cold,
             waypoints: vec![Point::new(0, 0), Point::new(1, 0)],
             directions: vec![0],
         }

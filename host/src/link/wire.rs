@@ -108,8 +108,9 @@ pub struct DevicePath {
     pub ticks: u64,
     /// Cells of the raw path.
     pub raw_cells: u32,
-    /// The device kept its previous colony (`PlanWarm` planned warm).
-    pub warm: bool,
+    /// Where the path comes from: cold, warm (`PlanWarm` kept the colony), or reused (the rest
+    /// of the previous answer).
+    pub origin: ohaca::planner::Origin,
     /// Waypoints, start first.
     pub waypoints: Vec<Point>,
     /// The raw path as directions from the start (`0..8` = E, SE, S, SW, W, NW, N, NE).
@@ -127,7 +128,7 @@ impl From<&PathReply<'_>> for DevicePath {
             moves: p.moves,
             ticks: p.ticks,
             raw_cells: p.raw_cells,
-            warm: p.warm,
+            origin: p.origin,
             waypoints: p.waypoints.iter().collect(),
             directions: p.directions.to_vec(),
         }

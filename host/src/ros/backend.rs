@@ -255,7 +255,7 @@ impl<T: Transport> Backend for DeviceBackend<T> {
             iterations: p.iterations,
             moves: p.moves,
             ticks: Some(p.ticks),
-            warm: p.warm,
+            origin: p.origin,
         })
     }
 }
@@ -272,10 +272,10 @@ mod tests {
         b.upload(&map).unwrap();
         let (s, g) = (Point::new(0, 5), Point::new(9, 5));
         let first = b.plan(s, g, true).unwrap();
-        assert!(!first.warm);
+        assert!(!first.origin.is_warm());
         b.set_rect((5, 0, 1, 9), true).unwrap();
         let second = b.plan(s, g, true).unwrap();
-        assert!(second.warm);
+        assert!(second.origin.is_warm());
         assert!(second.raw.iter().all(|p| p.x != 5 || p.y == 9));
         b.set_rect((5, 0, 1, 10), true).unwrap();
         assert!(matches!(b.plan(s, g, true), Err(BackendError::NoPath(_))));

@@ -255,7 +255,8 @@ impl State {
         let info = serde_json::json!({
             "seq": self.seq,
             "trigger": trigger,
-            "warm": out.warm,
+            "warm": out.origin.is_warm(),
+            "origin": out.origin.name(),
             "planning_time_s": out.elapsed.as_secs_f64(),
             "device_ticks": out.planned.ticks,
             "iterations": out.planned.iterations,
@@ -275,7 +276,7 @@ impl State {
             path.poses.len(),
             length_m,
             out.planned.iterations,
-            if out.warm { "warm" } else { "cold" },
+            out.origin,
             out.elapsed.as_secs_f64(),
             self.planning.describe()
         );

@@ -20,6 +20,7 @@
 
 use std::time::{Duration, Instant};
 
+use ohaca::planner::Origin;
 use ohaca::Point;
 
 use super::backend::{Backend, BackendError};
@@ -54,8 +55,9 @@ pub struct PlanOut {
     pub cells: Vec<Point>,
     /// The backend's answer (in its cells).
     pub planned: Planned,
-    /// The backend kept its colony.
-    pub warm: bool,
+    /// Where the path comes from: `cold`, `warm` (the backend kept its colony) or `reused`
+    /// (the rest of the previous answer: no change since could shorten or block it).
+    pub origin: Origin,
     /// From the request to the path.
     pub elapsed: Duration,
     /// The map frame's name.
@@ -442,7 +444,7 @@ impl Planning {
         Ok(PlanOut {
             points_m,
             cells,
-            warm: planned.warm,
+            origin: planned.origin,
             planned,
             elapsed: t0.elapsed(),
             frame_id,
@@ -505,7 +507,7 @@ mod tests {
         );
         p.set_grid(&grid()).unwrap();
         let out = p.plan([0.05, 0.55], [1.95, 0.55]).unwrap();
-        assert!(!out.warm);
+        assert!(!out.origin.is_warm());
         assert_eq!(out.points_m.first(), Some(&[0.05, 0.55]));
         assert_eq!(out.points_m.last(), Some(&[1.95, 0.55]));
         assert_eq!(out.frame_id, "map");
@@ -521,7 +523,7 @@ mod tests {
         let note = p.update(&u).unwrap();
         assert!(note.text.contains("SetRect 1x9"), "{}", note.text);
         let again = p.plan([0.05, 0.55], [1.95, 0.55]).unwrap();
-        assert!(again.warm, "the replan keeps the colony");
+        assert!(again.origin.is_warm(), "the replan keeps the colony");
         assert!(again.cells.iter().all(|c| c.x != 10 || c.y == 0));
         for (what, s, g, code) in [
             (

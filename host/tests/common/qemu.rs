@@ -372,7 +372,7 @@ pub struct CorePath {
     pub best_iteration: u16,
     pub moves: u64,
     pub raw_cells: u32,
-    pub warm: bool,
+    pub origin: ohaca::planner::Origin,
     pub waypoints: Vec<Point>,
     pub directions: Vec<u8>,
 }
@@ -445,7 +445,7 @@ fn core_path(plan: &ohaca::Plan<'_>) -> CorePath {
         best_iteration: plan.best_iteration,
         moves: plan.moves,
         raw_cells: u32::try_from(plan.raw_len()).expect("raw cells"),
-        warm: plan.warm,
+        origin: plan.origin,
         waypoints: plan.waypoints().to_vec(),
         directions: plan.directions().to_vec(),
     }
@@ -462,7 +462,7 @@ pub fn assert_core_path(what: &str, core: &CorePath, dev: &DevicePath) {
         best_iteration: dev.best_iteration,
         moves: dev.moves,
         raw_cells: dev.raw_cells,
-        warm: dev.warm,
+        origin: dev.origin,
         waypoints: dev.waypoints.clone(),
         directions: dev.directions.clone(),
     };

@@ -31,8 +31,9 @@ use crate::route;
 use crate::smoothing::SmoothingKind;
 
 use super::params::{Algorithm, Params};
+use super::plan::Origin;
 use super::plan::{CurvePoint, Plan};
-use super::warm::{self, Area, Kept, Memory};
+use super::warm::{self, Answer, Area, Kept, Memory};
 use super::workspace::Workspace;
 use colony::Best;
 use polish::{Polish, SMALL_REFINE_LINKS};
@@ -124,15 +125,36 @@ impl<'g, 'a> Run<'g, 'a> {
     /// Record in `memory` what this run leaves in the workspace for the next [`Run::warm`] to
     /// repair locally instead of rebuilding: its pruning marks (once the setup made them) and
     /// its coarse route's links (once [`Run::polish_step`] started: they are stashed then, before
-    /// the local search takes the route's words as scratch). Call it with the `memory` this run
+    /// the local search takes the route's words as scratch), and its answer once the polish is
+    /// done (for [`super::reuse`]). Call it with the `memory` this run
     /// was started with ([`Run::warm`], [`Run::cold`]), after the run (before [`Run::finish`]),
     /// and before another run uses the workspace; the firmware calls it once the run's polish is
     /// done. Without the call the next warm start rebuilds both, with the same result.
     pub fn keep(&self, memory: &mut Memory) {
-        if self.marks && memory.is_warm_for(self.grid.width(), self.grid.height(), self.goal) {
+        if !memory.is_warm_for(self.grid.width(), self.grid.height(), self.goal) {
+            return;
+        }
+        if self.marks {
             memory.keep(Kept {
                 start: self.start,
                 route: self.stashed,
+            });
+        }
+        // The answer, once the polish laid out its waypoints, for a replan to reuse
+        // ([`super::reuse`]).
+        if let (Some(best), Polish::Done { waypoints }, false) =
+            (self.best, self.polish, self.no_path)
+        {
+            memory.answer = Some(Answer {
+                start: self.start,
+                from: 0,
+                steps: u32::try_from(best.steps).unwrap_or(0),
+                first: 0,
+                end: u32::try_from(waypoints).unwrap_or(0),
+                params: Params {
+                    seed: 0,
+                    ..self.params
+                },
             });
         }
     }
@@ -445,7 +467,7 @@ impl<'g, 'a> Run<'g, 'a> {
             best_iteration,
             moves,
             pruned,
-            warm,
+            origin: if warm { Origin::Warm } else { Origin::Cold },
             curve,
             params,
         })

@@ -25,7 +25,7 @@ fn example_path() -> PathReply<'static> {
         moves: 96,
         ticks: EXAMPLE_TICKS,
         raw_cells: 5,
-        warm: false,
+        origin: crate::planner::Origin::Cold,
         waypoints: Waypoints::Points(&EXAMPLE_WAYPOINTS),
         directions: &EXAMPLE_DIRECTIONS,
     }
@@ -298,7 +298,7 @@ fn reply_fields(id: u32, r: &Reply<'_>) -> Vec<(String, Vec<u8>)> {
             v.push((format!("  moves = {}", p.moves), ser(&p.moves)));
             v.push((format!("  ticks = {}", p.ticks), ser(&p.ticks)));
             v.push((format!("  raw_cells = {}", p.raw_cells), ser(&p.raw_cells)));
-            v.push((format!("  warm = {}", p.warm), ser(&p.warm)));
+            v.push((format!("  origin = {}", p.origin), ser(&p.origin)));
             let pts: Vec<String> = p
                 .waypoints
                 .iter()

@@ -68,7 +68,7 @@ fn largest_messages_fit_their_limits() {
         moves: u64::MAX,
         ticks: u64::MAX,
         raw_cells: u32::MAX,
-        warm: true,
+        origin: crate::planner::Origin::Warm,
         waypoints: Waypoints::Points(&wp),
         directions: &dirs,
     });

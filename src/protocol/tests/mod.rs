@@ -192,7 +192,7 @@ fn path() -> PathReply<'static> {
         moves: 4200,
         ticks: 123_456,
         raw_cells: 5,
-        warm: true,
+        origin: crate::planner::Origin::Warm,
         waypoints: Waypoints::Points(&WPTS),
         directions: &DIRS,
     }

@@ -1,0 +1,351 @@
+//! Replans answered with the rest of the last answer (`ohaca::planner::reuse`): reused only when
+//! the robot is on the answer, nothing blocks it and no cleared cell can shorten it, and then
+//! valid on the map as it is and never beaten by a path the change opened. Checked against the
+//! independent references (`reference::opt8`, `reference::any_angle`, `reference::segment_clear`,
+//! `reference::step_allowed`), on hand-made maps and as a property over random maps and changes.
+
+use ohaca::heap::HeapStorage;
+use ohaca::planner::{reuse, Area, Memory, Origin, Run};
+use ohaca::{Params, Point};
+use ohaca_host_tests::gen;
+use ohaca_host_tests::maps::Map;
+use ohaca_host_tests::reference::{any_angle, opt8, segment_clear, step_allowed};
+use proptest::prelude::*;
+use proptest::strategy::ValueTree;
+
+/// An answer, owned.
+#[derive(Clone, Debug)]
+struct Answer {
+    raw: Vec<Point>,
+    waypoints: Vec<Point>,
+    raw_length: f32,
+    length: f32,
+    origin: Origin,
+    moves: u64,
+}
+
+/// A robot's planner on the host core: the map, one storage for every plan (as the device's),
+/// the colony memory, told every change as the firmware tells it.
+struct Robot {
+    map: Map,
+    storage: HeapStorage,
+    memory: Memory,
+    params: Params,
+    goal: Point,
+}
+
+impl Robot {
+    fn new(map: Map, goal: Point, params: Params) -> Robot {
+        let storage = HeapStorage::for_run(map.cells(), &params).expect("storage");
+        Robot {
+            map,
+            storage,
+            memory: Memory::new(),
+            params,
+            goal,
+        }
+    }
+
+    /// Block or clear `cells`, telling the memory which cleared cells were blocked.
+    fn change(&mut self, cells: &[Point], blocked: bool) {
+        for &p in cells {
+            let was_blocked = !self.map.is_free(p);
+            self.map.set(p, blocked);
+            let cell = Area::cell(p);
+            self.memory
+                .changed(cell, (!blocked && was_blocked).then_some(cell));
+        }
+    }
+
+    /// `PlanWarm` (`warm`) or `Plan` from `start`, as the firmware answers it.
+    fn plan(&mut self, start: Point, warm: bool) -> Option<Answer> {
+        let grid = self.map.grid();
+        let mut ws = self.storage.workspace();
+        let own = |p: &ohaca::Plan<'_>| Answer {
+            raw: p.raw().collect(),
+            waypoints: p.waypoints().to_vec(),
+            raw_length: p.raw_length,
+            length: p.length,
+            origin: p.origin,
+            moves: p.moves,
+        };
+        if warm {
+            if let Some(p) = reuse(
+                &grid,
+                start,
+                self.goal,
+                &self.params,
+                &mut ws,
+                &mut self.memory,
+            ) {
+                return Some(own(&p));
+            }
+        }
+        let mut run = if warm {
+            Run::warm(&grid, start, self.goal, &self.params, ws, &mut self.memory)
+        } else {
+            Run::cold(&grid, start, self.goal, &self.params, ws, &mut self.memory)
+        }
+        .ok()?;
+        while run.step() {}
+        while run.polish_step() {}
+        run.keep(&mut self.memory);
+        run.finish().ok().map(|p| own(&p))
+    }
+}
+
+/// The answer is a path from `start` to the goal on `map`: allowed moves, clear segments, and
+/// lengths that add up.
+fn assert_valid(map: &Map, a: &Answer, start: Point, goal: Point) {
+    assert_eq!(a.raw.first(), Some(&start));
+    assert_eq!(a.raw.last(), Some(&goal));
+    assert_eq!(a.waypoints.first(), Some(&start));
+    assert_eq!(a.waypoints.last(), Some(&goal));
+    let (mut st, mut di) = (0u32, 0u32);
+    for w in a.raw.windows(2) {
+        let (dx, dy) = (
+            i64::from(w[1].x) - i64::from(w[0].x),
+            i64::from(w[1].y) - i64::from(w[0].y),
+        );
+        assert!(step_allowed(map, w[0], dx, dy), "{:?} -> {:?}", w[0], w[1]);
+        if dx != 0 && dy != 0 {
+            di += 1;
+        } else {
+            st += 1;
+        }
+    }
+    let raw = f64::from(st) + f64::from(di) * std::f64::consts::SQRT_2;
+    assert!(
+        (raw - f64::from(a.raw_length)).abs() < 1e-3,
+        "{raw} {}",
+        a.raw_length
+    );
+    let mut poly = 0.0;
+    for w in a.waypoints.windows(2) {
+        assert!(segment_clear(map, w[0], w[1]), "{:?} -> {:?}", w[0], w[1]);
+        poly +=
+            (f64::from(w[0].x) - f64::from(w[1].x)).hypot(f64::from(w[0].y) - f64::from(w[1].y));
+    }
+    assert!(
+        (poly - f64::from(a.length)).abs() < 1e-3,
+        "{poly} {}",
+        a.length
+    );
+}
+
+/// 40 x 24 cells: a wall down the middle with a door at the bottom; the rest open.
+fn door_map() -> Map {
+    let mut rows = vec![String::new(); 24];
+    for (y, row) in rows.iter_mut().enumerate() {
+        for x in 0..40 {
+            row.push(if x == 20 && y < 20 { '#' } else { '.' });
+        }
+    }
+    let rows: Vec<&str> = rows.iter().map(String::as_str).collect();
+    Map::from_rows(&rows)
+}
+
+#[test]
+fn a_far_change_is_answered_with_the_rest_of_the_path() {
+    let (s, g) = (Point::new(2, 2), Point::new(37, 2));
+    let mut robot = Robot::new(door_map(), g, Params::default());
+    let first = robot.plan(s, true).expect("first plan");
+    assert_eq!(first.origin, Origin::Cold, "no colony yet");
+    // The robot drives a third of the way; a 4 x 4 box appears far from the path (top right
+    // is the goal's side; the box sits at the bottom left, behind the robot).
+    let at = first.raw.len() / 3;
+    let here = first.raw[at];
+    let bx: Vec<Point> = (0..4)
+        .flat_map(|y| (0..4).map(move |x| Point::new(1 + x, 19 + y)))
+        .collect();
+    robot.change(&bx, true);
+    let second = robot.plan(here, true).expect("replan");
+    assert_eq!(second.origin, Origin::Reused);
+    assert_eq!(second.moves, 0);
+    assert_eq!(second.raw, first.raw[at..], "the rest of the raw path");
+    assert_valid(&robot.map, &second, here, g);
+    assert!(second.length <= first.length);
+    // The box goes away again: cleared cells, but no path through them can be shorter.
+    let further = first.raw[at + 3];
+    robot.change(&bx, false);
+    let third = robot.plan(further, true).expect("replan");
+    assert_eq!(third.origin, Origin::Reused);
+    assert_eq!(third.raw, first.raw[at + 3..]);
+    assert_valid(&robot.map, &third, further, g);
+    // Another seed reuses too; other parameters do not.
+    robot.params.seed ^= 0x55;
+    assert_eq!(robot.plan(further, true).unwrap().origin, Origin::Reused);
+    robot.params.ants += 1;
+    assert_eq!(robot.plan(further, true).unwrap().origin, Origin::Warm);
+}
+
+#[test]
+fn a_blocked_cell_on_the_path_or_a_segment_is_never_reused() {
+    let (s, g) = (Point::new(2, 2), Point::new(37, 2));
+    let mut robot = Robot::new(door_map(), g, Params::default());
+    let first = robot.plan(s, true).expect("first plan");
+    // A cell of the raw path ahead.
+    let mut r1 = Robot::new(door_map(), g, Params::default());
+    r1.plan(s, true).unwrap();
+    let ahead = first.raw[first.raw.len() / 2];
+    r1.change(&[ahead], true);
+    let a = r1.plan(first.raw[2], true).expect("replan");
+    assert_eq!(a.origin, Origin::Warm);
+    assert_valid(&r1.map, &a, first.raw[2], g);
+    // A cell a smoothed segment touches while every move of the raw path stays allowed: only
+    // the segment test can see it.
+    let k = first.raw.len() / 2;
+    let here = first.raw[k];
+    let raw_ok = |m: &Map| {
+        first.raw[k..].windows(2).all(|w| {
+            let (dx, dy) = (
+                i64::from(w[1].x) - i64::from(w[0].x),
+                i64::from(w[1].y) - i64::from(w[0].y),
+            );
+            step_allowed(m, w[0], dx, dy)
+        })
+    };
+    let seg_only = (0..robot.map.height())
+        .flat_map(|y| (0..robot.map.width()).map(move |x| Point::new(x, y)))
+        .find(|&c| {
+            let mut m = robot.map.clone();
+            m.set(c, true);
+            // Ahead of the robot (the path runs left to right), on a segment that ends ahead.
+            c.x > here.x + 1
+                && robot.map.is_free(c)
+                && raw_ok(&m)
+                && (first.waypoints.windows(2))
+                    .any(|w| w[1].x > here.x + 1 && !segment_clear(&m, w[0], w[1]))
+        })
+        .expect("a cell only a segment touches");
+    robot.change(&[seg_only], true);
+    let a = robot.plan(here, true).expect("replan");
+    assert_ne!(a.origin, Origin::Reused, "{seg_only:?} blocks a segment");
+    assert_valid(&robot.map, &a, here, g);
+    // The robot off its path: planned.
+    let mut r2 = Robot::new(door_map(), g, Params::default());
+    r2.plan(s, true).unwrap();
+    let off = Point::new(2, 12);
+    assert!(!first.raw.contains(&off));
+    assert_eq!(r2.plan(off, true).unwrap().origin, Origin::Warm);
+}
+
+#[test]
+fn a_cleared_shortcut_is_never_reused() {
+    let (s, g) = (Point::new(2, 2), Point::new(37, 2));
+    let mut robot = Robot::new(door_map(), g, Params::default());
+    let first = robot.plan(s, true).expect("first plan");
+    assert!(first.raw.iter().any(|p| p.y >= 20), "through the door");
+    // A gap near the top of the wall: the path through it is far shorter.
+    robot.change(&[Point::new(20, 3)], false);
+    let a = robot.plan(first.raw[1], true).expect("replan");
+    assert_ne!(a.origin, Origin::Reused);
+    assert!(a.raw_length < first.raw_length - 10.0, "{}", a.raw_length);
+    assert_valid(&robot.map, &a, first.raw[1], g);
+    // Clearing a cell that was free changes nothing: still reused after the warm run.
+    let again = a.raw[1];
+    robot.change(&[Point::new(30, 20)], false);
+    assert_eq!(robot.plan(again, true).unwrap().origin, Origin::Reused);
+}
+
+/// Random maps and changes: a reused answer is valid on the map as it is, and no path the change
+/// opened is shorter: the optimum now is at least the smaller of the answer and the optimum
+/// without the cleared cells (8-connected against the raw length, any-angle against the smoothed
+/// one).
+fn reused_answers_are_never_beaten(
+    map: Map,
+    s: Point,
+    g: Point,
+    at: usize,
+    flips: Vec<(usize, i64, i64, bool)>,
+) -> Result<bool, TestCaseError> {
+    let mut robot = Robot::new(map, g, Params::default());
+    let Some(first) = robot.plan(s, true) else {
+        return Ok(false); // unreachable goal
+    };
+    let here = first.raw[at % first.raw.len()];
+    if here == g {
+        return Ok(false);
+    }
+    let mut cleared = Vec::new();
+    for (i, dx, dy, blocked) in flips {
+        // Near the path (the cells that matter): a path cell's neighbourhood, 2 cells around.
+        let c = first.raw[i % first.raw.len()];
+        let (x, y) = (i64::from(c.x) + dx, i64::from(c.y) + dy);
+        if x < 0 || y < 0 || x >= i64::from(robot.map.width()) || y >= i64::from(robot.map.height())
+        {
+            continue;
+        }
+        let p = Point::new(x as u16, y as u16);
+        if p == here || p == g {
+            continue;
+        }
+        if !blocked && !robot.map.is_free(p) {
+            cleared.push(p);
+        }
+        robot.change(&[p], blocked);
+        if blocked {
+            cleared.retain(|&c| c != p);
+        }
+    }
+    let Some(a) = robot.plan(here, true) else {
+        return Ok(false);
+    };
+    if a.origin != Origin::Reused {
+        return Ok(false);
+    }
+    assert_valid(&robot.map, &a, here, g);
+    let now = opt8(&robot.map, here, g).expect("reachable: the answer is a path");
+    let mut without = robot.map.clone();
+    for &c in &cleared {
+        without.set(c, true);
+    }
+    let before = opt8(&without, here, g).unwrap_or(f64::INFINITY);
+    prop_assert!(
+        now >= before.min(f64::from(a.raw_length)) - 1e-3,
+        "opt8 now {now}, without the cleared cells {before}, answer {}",
+        a.raw_length
+    );
+    let now = any_angle(&robot.map, here, g).expect("reachable").0;
+    let before = any_angle(&without, here, g).map_or(f64::INFINITY, |x| x.0);
+    prop_assert!(
+        now >= before.min(f64::from(a.length)) - 1e-3,
+        "any-angle now {now}, without the cleared cells {before}, answer {}",
+        a.length
+    );
+    Ok(true)
+}
+
+proptest! {
+    #![proptest_config(gen::config(256))]
+    #[test]
+    fn reused_answers_are_valid_and_never_beaten(
+        (map, s, g) in gen::case(20),
+        at in 0usize..64,
+        flips in proptest::collection::vec((0usize..64, -3i64..=3, -3i64..=3, any::<bool>()), 0..4),
+    ) {
+        reused_answers_are_never_beaten(map, s, g, at, flips)?;
+    }
+}
+
+#[test]
+fn the_property_sees_reused_answers() {
+    // Fixed cases of the generator's kind, so the count does not depend on the other test.
+    let mut runner = proptest::test_runner::TestRunner::deterministic();
+    let strategy = (
+        gen::case(20),
+        0usize..64,
+        proptest::collection::vec((0usize..64, -3i64..=3, -3i64..=3, any::<bool>()), 0..4),
+    );
+    let (mut cases, mut reused) = (0, 0);
+    for _ in 0..128 {
+        let ((map, s, g), at, flips) = strategy.new_tree(&mut runner).unwrap().current();
+        reused += usize::from(reused_answers_are_never_beaten(map, s, g, at, flips).unwrap());
+        cases += 1;
+    }
+    eprintln!("{reused} of {cases} random replans reused");
+    assert!(
+        reused >= cases / 8,
+        "only {reused} of {cases} replans reused"
+    );
+}

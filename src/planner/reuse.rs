@@ -1,0 +1,272 @@
+//! Replans that cannot improve: the rest of the previous answer from the robot's cell, without a
+//! colony run.
+//!
+//! A robot replans whenever its costmap changes, and most changes are far from its path. After
+//! [`super::Run::keep`] the workspace still holds the last answer (its raw path in the best tour,
+//! its waypoints in `points`) and [`Memory`] knows where, and which cells were cleared since it was
+//! planned. [`reuse`] answers a replan to the same goal with the rest of that answer when it can
+//! prove that no new plan could be shorter:
+//!
+//! 1. **The robot is on the answer**: its cell is a cell of the raw path (the first occurrence).
+//!    The raw answer is the rest of the raw path from there; the waypoints are the robot's cell
+//!    followed by the waypoints after the segment nearest to it (a collinear first one dropped).
+//! 2. **Nothing blocks it**: every move of the raw rest is allowed on the map as it is now
+//!    ([`Grid::step`]: free cells, no corner cut) and every segment of the waypoints is clear
+//!    ([`segment_clear`]). So a cell blocked since the answer was planned is off it, or the
+//!    answer is not reused.
+//! 3. **No cleared cell can shorten it**: for every rectangle `R` of cells cleared since the
+//!    answer was planned, `d(s, R) + d(R, g)` is at least the answer's length, for the octile
+//!    distance against the raw length and the Euclidean distance to `R`'s squares against the
+//!    smoothed length (`s` the robot's cell, `g` the goal).
+//!
+//! **Why that is enough** (the proof, also in `docs/ALGORITHM.md`): take any path `Q` from `s` to
+//! `g` on the map as it is now. If `Q` touches no cleared cell, every cell it touches was free
+//! when the answer was planned (a cell free now and not cleared since was free then), so `Q` was a
+//! candidate then and the change gave nothing new. If `Q` touches a cleared cell `c` in `R`, then
+//! `|Q| >= d(s, c) + d(c, g) >= d(s, R) + d(R, g) >=` the answer's length, for 8-connected paths
+//! through cell centres with the octile distance and for any-angle paths touching `c`'s closed
+//! square with the Euclidean one. So no path the change made possible is shorter than the
+//! answer, and the answer is valid on the map as it is now (step 2). Blocked cells alone can
+//! only lengthen other paths. The reused answer is as good as the rest of the last one was.
+//!
+//! **Cost**: one walk over the raw path and one [`segment_clear`] per waypoint: a few hundred
+//! instructions a path cell, no colony, no pruning, no route; the colony's memory is untouched,
+//! so the next warm run still repairs around every change since the colony last ran.
+//!
+//! Host and device call the same function on the same workspace layout, so a reused answer is
+//! the same bit for bit on both. Panic-free like the rest of the core: indices are checked.
+
+use crate::geometry::{bend, distance, segment_clear, sqrt, steps_length, turns};
+use crate::grid::{is_diagonal, neighbour, Dir, Grid, Point};
+use crate::heuristic::octile;
+use crate::smoothing::SmoothingKind;
+
+use super::params::{Algorithm, Params};
+use super::plan::{Origin, Plan};
+use super::warm::{Answer, Area, Memory};
+use super::workspace::Workspace;
+
+/// A lower bound is lowered by this much before it is compared with a length, so that the
+/// rounding of either (f32, a few ulps) can never turn "a path through the cleared cells could be
+/// shorter" into a reuse.
+const SLACK: f32 = 1.0 / 64.0;
+
+/// The rest of the last answer to `goal` from the robot's cell `start`, when `memory` says the
+/// workspace holds one planned with `params` (any seed) on a map of this size, and no change
+/// since can block or shorten it (see the module docs); `None` otherwise, and the caller plans
+/// (warm). On success the memory's answer becomes the returned one (the next replan starts from
+/// it), and the plan's [`Plan::origin`] is [`Origin::Reused`]: no iterations, no moves.
+///
+/// `ws` must be the workspace the last run planned in, laid out the same way (the firmware's
+/// storage, the host's arena or heap storage for the same map), unchanged since but for the map.
+pub fn reuse<'a>(
+    grid: &Grid<'_>,
+    start: Point,
+    goal: Point,
+    params: &Params,
+    ws: &'a mut Workspace<'_>,
+    memory: &mut Memory,
+) -> Option<Plan<'a>> {
+    if !memory.is_warm_for(grid.width(), grid.height(), goal) || start == goal {
+        return None;
+    }
+    let answer = memory.answer?;
+    if answer.params != (Params { seed: 0, ..*params }) {
+        return None;
+    }
+    let (from, steps) = (idx(answer.from), idx(answer.steps));
+    let (first, end) = (idx(answer.first), idx(answer.end));
+    // 1. The robot's cell on the raw path.
+    let tour: &[Dir] = ws.best.get(from..steps)?;
+    let mut p = answer.start;
+    let mut at = None;
+    for (i, &d) in tour.iter().enumerate() {
+        if p == start {
+            at = Some(i);
+            break;
+        }
+        p = neighbour(p, d);
+    }
+    let at = at?;
+    // 2. The rest of the raw path, move by move on the map as it is now.
+    let rest = tour.get(at..)?;
+    let (mut straight, mut diagonal) = (0u32, 0u32);
+    let mut p = start;
+    for &d in rest {
+        p = grid.step(p, d)?;
+        if is_diagonal(d) {
+            diagonal = diagonal.wrapping_add(1);
+        } else {
+            straight = straight.wrapping_add(1);
+        }
+    }
+    if p != goal {
+        return None;
+    }
+    // The waypoints after the segment nearest the robot.
+    let wps: &[Point] = ws.points.get(first..end)?;
+    let mut entry = nearest_segment(wps, start)?;
+    // Dropped when the robot's cell, it and the next are collinear (straight on).
+    if let (Some(&a), Some(&b)) = (wps.get(entry), wps.get(entry.wrapping_add(1))) {
+        let (cross, dot) = bend(start, a, b);
+        if cross == 0 && dot > 0 {
+            entry = entry.wrapping_add(1);
+        }
+    }
+    // ... every segment clear, the robot's first one included; their length summed as
+    // [`crate::geometry::polyline_length`] sums the answer's waypoints (left to right from 0), so it is the
+    // length a run would report for them.
+    let mut prev = start;
+    let mut polyline = 0.0f32;
+    for &w in wps.get(entry..)? {
+        if !segment_clear(grid, prev, w) {
+            return None;
+        }
+        polyline += distance(prev, w);
+        prev = w;
+    }
+    // 3. The lengths, against every cleared rectangle's lower bounds.
+    let raw_length = steps_length(straight, diagonal);
+    // Without smoothing a run reports the raw length (`Run::finish`).
+    let smoothed = params.algorithm == Algorithm::Ohaca && params.smoothing != SmoothingKind::None;
+    let length = if smoothed { polyline } else { raw_length };
+    for area in memory.freed.areas() {
+        let euclid = box_distance(start, area) + box_distance(goal, area) - SLACK;
+        let oct = box_octile(start, area) + box_octile(goal, area) - SLACK;
+        if oct < raw_length || euclid < length {
+            return None;
+        }
+    }
+    // The robot's cell goes into the slot before the entry: a waypoint it has passed.
+    let k0 = first.wrapping_add(entry).checked_sub(1)?;
+    *ws.points.get_mut(k0)? = start;
+    memory.answer = Some(Answer {
+        start,
+        from: u32::try_from(from.wrapping_add(at)).ok()?,
+        steps: answer.steps,
+        first: u32::try_from(k0).ok()?,
+        end: answer.end,
+        params: answer.params,
+    });
+    let Workspace { best, points, .. } = ws;
+    let tour: &'a [Dir] = best.get(from.wrapping_add(at)..steps)?;
+    let waypoints: &'a [Point] = points.get(k0..end)?;
+    Some(Plan {
+        start,
+        tour,
+        waypoints,
+        raw_length,
+        colony_length: raw_length,
+        length,
+        turns: turns(waypoints),
+        iterations: 0,
+        best_iteration: 0,
+        moves: 0,
+        pruned: 0,
+        origin: Origin::Reused,
+        curve: &[],
+        params: *params,
+    })
+}
+
+fn idx(v: u32) -> usize {
+    usize::try_from(v).unwrap_or(usize::MAX)
+}
+
+/// The index `e >= 1` of the waypoint that ends the segment `wps[e - 1]..wps[e]` nearest to `p`
+/// (the later one on a tie: a robot on a waypoint is past it); `None` for fewer than two.
+fn nearest_segment(wps: &[Point], p: Point) -> Option<usize> {
+    let mut best: Option<(f32, usize)> = None;
+    for (i, pair) in wps.windows(2).enumerate() {
+        let (Some(&a), Some(&b)) = (pair.first(), pair.get(1)) else {
+            continue;
+        };
+        let d = segment_distance2(p, a, b);
+        if best.is_none_or(|(bd, _)| d <= bd) {
+            best = Some((d, i.wrapping_add(1)));
+        }
+    }
+    best.map(|(_, e)| e)
+}
+
+/// Squared distance from `p` to the segment `a..b` (cell centres).
+fn segment_distance2(p: Point, a: Point, b: Point) -> f32 {
+    let f = |v: u16| f32::from(v);
+    let (vx, vy) = (f(b.x) - f(a.x), f(b.y) - f(a.y));
+    let (wx, wy) = (f(p.x) - f(a.x), f(p.y) - f(a.y));
+    let len2 = vx * vx + vy * vy;
+    let t = if len2 > 0.0 {
+        ((wx * vx + wy * vy) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let (dx, dy) = (wx - t * vx, wy - t * vy);
+    dx * dx + dy * dy
+}
+
+/// Cells between `p` and the rectangle on one axis (0 inside).
+fn gap(v: u16, lo: u16, hi: u16) -> u16 {
+    if v < lo {
+        lo.wrapping_sub(v)
+    } else {
+        v.saturating_sub(hi)
+    }
+}
+
+/// Euclidean distance from the centre of `p` to the union of the closed squares of `area`'s
+/// cells (0 inside).
+fn box_distance(p: Point, area: Area) -> f32 {
+    let d = |g: u16| (f32::from(g) - 0.5).max(0.0);
+    let (dx, dy) = (
+        d(gap(p.x, area.min.x, area.max.x)),
+        d(gap(p.y, area.min.y, area.max.y)),
+    );
+    sqrt(dx * dx + dy * dy)
+}
+
+/// Octile distance from `p` to the nearest cell of `area` (0 inside).
+fn box_octile(p: Point, area: Area) -> f32 {
+    let q = Point::new(
+        p.x.clamp(area.min.x, area.max.x),
+        p.y.clamp(area.min.y, area.max.y),
+    );
+    octile(p, q)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn box_distances_are_lower_bounds() {
+        let area = Area::rect(10, 10, 3, 2).unwrap();
+        // Inside: 0.
+        assert_eq!(box_distance(Point::new(11, 11), area), 0.0);
+        assert_eq!(box_octile(Point::new(12, 10), area), 0.0);
+        // Beside: to the square's edge (half a cell short of the centre).
+        assert_eq!(box_distance(Point::new(5, 10), area), 4.5);
+        assert_eq!(box_octile(Point::new(5, 10), area), 5.0);
+        // Every cell of the area is at least as far as the bound, from every cell around.
+        for y in 0..25u16 {
+            for x in 0..25u16 {
+                let p = Point::new(x, y);
+                for cy in 10..12u16 {
+                    for cx in 10..13u16 {
+                        let c = Point::new(cx, cy);
+                        assert!(octile(p, c) >= box_octile(p, area));
+                        assert!(distance(p, c) + 0.7072 >= box_distance(p, area));
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn nearest_segment_prefers_the_later_on_a_tie() {
+        let wps = [Point::new(0, 0), Point::new(10, 0), Point::new(10, 10)];
+        assert_eq!(nearest_segment(&wps, Point::new(3, 1)), Some(1));
+        assert_eq!(nearest_segment(&wps, Point::new(10, 0)), Some(2));
+        assert_eq!(nearest_segment(&wps, Point::new(9, 7)), Some(2));
+        assert_eq!(nearest_segment(&wps[..1], Point::new(9, 7)), None);
+    }
+}
