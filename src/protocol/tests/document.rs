@@ -31,6 +31,29 @@ fn example_path() -> PathReply<'static> {
     }
 }
 
+/// The reused answer to the example's `PlanWarm` from (2, 0), a cell of the example path, after
+/// its `Plan` (no map change since): the rest of that path ([`crate::planner::reuse`]).
+const REUSED_WAYPOINTS: [Point; 3] = [Point::new(2, 0), Point::new(3, 1), Point::new(3, 2)];
+const REUSED_DIRECTIONS: [u8; 2] = [1, 2];
+/// Ticks the QEMU firmware reported for the reused answer.
+const REUSED_TICKS: u64 = 2;
+
+fn example_reused() -> PathReply<'static> {
+    PathReply {
+        raw_length: 2.414_213_7,
+        length: 2.414_213_7,
+        turns: 1,
+        iterations: 0,
+        best_iteration: 0,
+        moves: 0,
+        ticks: REUSED_TICKS,
+        raw_cells: 3,
+        origin: crate::planner::Origin::Reused,
+        waypoints: Waypoints::Points(&REUSED_WAYPOINTS),
+        directions: &REUSED_DIRECTIONS,
+    }
+}
+
 /// What the QEMU firmware answered to `Stats` after the example's first three requests.
 fn example_stats() -> StatsReply {
     StatsReply {
@@ -54,7 +77,8 @@ fn example_stats() -> StatsReply {
     }
 }
 
-/// The exchange of the document: Hello, SetMap (the 4x3 map of the crate docs), Plan, Stats.
+/// The exchange of the document: Hello, SetMap (the 4x3 map of the crate docs), Plan, Stats, and
+/// a `PlanWarm` from a cell of the planned path, answered with the rest of it.
 fn example() -> Vec<(u32, Request<'static>, Reply<'static>)> {
     vec![
         (1, Request::Hello, Reply::Hello(hello())),
@@ -79,6 +103,15 @@ fn example() -> Vec<(u32, Request<'static>, Reply<'static>)> {
             Reply::Path(example_path()),
         ),
         (4, Request::Stats, Reply::Stats(example_stats())),
+        (
+            5,
+            Request::PlanWarm {
+                start: Point::new(2, 0),
+                goal: Point::new(3, 2),
+                seed: None,
+            },
+            Reply::Path(example_reused()),
+        ),
     ]
 }
 
@@ -116,18 +149,18 @@ fn protocol_doc_example_is_exact() {
 #[test]
 fn protocol_doc_example_is_what_the_planner_returns() {
     use crate::grid::Grid;
-    use crate::planner::{plan, Storage};
+    use crate::planner::{reuse, Memory, Run, Storage};
     let g = Grid::new(4, 3, &MAP).unwrap();
     // The device's links (4,096), so the local search runs as on the device.
     let mut s: Box<Storage<1, 16, 4096, 16>> = Box::default();
-    let p = plan(
-        &g,
-        Point::new(0, 0),
-        Point::new(3, 2),
-        &hello().defaults,
-        s.workspace(),
-    )
-    .unwrap();
+    let mut memory = Memory::new();
+    let defaults = hello().defaults;
+    let (start, goal) = (Point::new(0, 0), Point::new(3, 2));
+    let mut run = Run::cold(&g, start, goal, &defaults, s.workspace(), &mut memory).unwrap();
+    while run.step() {}
+    while run.polish_step() {}
+    run.keep(&mut memory);
+    let p = run.finish().unwrap();
     let want = example_path();
     assert_eq!(p.waypoints(), EXAMPLE_WAYPOINTS);
     assert_eq!(p.directions(), EXAMPLE_DIRECTIONS);
@@ -139,6 +172,24 @@ fn protocol_doc_example_is_what_the_planner_returns() {
         (p.best_iteration, p.moves, p.raw_len() as u32),
         (want.best_iteration, want.moves, want.raw_cells)
     );
+    // The PlanWarm: the rest of that path.
+    let mut ws = s.workspace();
+    let r = reuse(&g, Point::new(2, 0), goal, &defaults, &mut ws, &mut memory).unwrap();
+    let want = example_reused();
+    assert_eq!(r.origin, want.origin);
+    assert_eq!(r.waypoints(), REUSED_WAYPOINTS);
+    assert_eq!(r.directions(), REUSED_DIRECTIONS);
+    assert_eq!(
+        (r.raw_length, r.length, r.turns, r.iterations, r.moves),
+        (
+            want.raw_length,
+            want.length,
+            want.turns,
+            want.iterations,
+            want.moves
+        )
+    );
+    assert_eq!(r.raw_len() as u32, want.raw_cells);
 }
 
 fn ser<T: Serialize + ?Sized>(v: &T) -> Vec<u8> {
@@ -216,8 +267,15 @@ fn request_fields(id: u32, r: &Request<'_>) -> Vec<(String, Vec<u8>)> {
                 ser(chunk),
             ));
         }
-        Request::Plan { start, goal, seed } => {
-            v.push(("Request::Plan (variant 3)".into(), vec![3]));
+        Request::Plan { start, goal, seed } | Request::PlanWarm { start, goal, seed } => {
+            let (name, variant) = match r {
+                Request::PlanWarm { .. } => ("PlanWarm", 9),
+                _ => ("Plan", 3),
+            };
+            v.push((
+                format!("Request::{name} (variant {variant})"),
+                vec![variant],
+            ));
             v.push((
                 format!("  start = ({}, {})", start.x, start.y),
                 ser(&(start.x, start.y)),
@@ -313,7 +371,15 @@ fn reply_fields(id: u32, r: &Reply<'_>) -> Vec<(String, Vec<u8>)> {
                 ser(&p.waypoints),
             ));
             v.push((
-                format!("  directions: {:?} (E E SE S)", p.directions),
+                format!("  directions: {:?} ({})", p.directions, {
+                    const NAMES: [&str; 8] = ["E", "SE", "S", "SW", "W", "NW", "N", "NE"];
+                    let names: Vec<&str> = p
+                        .directions
+                        .iter()
+                        .map(|&d| NAMES[usize::from(d & 7)])
+                        .collect();
+                    names.join(" ")
+                }),
                 ser(p.directions),
             ));
         }
