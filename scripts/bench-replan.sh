@@ -51,6 +51,7 @@ run "complex-26, wall" scenarios/wall.json "${c26[@]}"
 run "complex-26, door opens" scenarios/complex-26-gap.json "${c26[@]}"
 run "Boston_0_256, wall" scenarios/wall.json "${boston[@]}"
 run "Boston_0_256, door opens" scenarios/boston-256-gap.json "${boston[@]}"
+run "Boston_0_256, far box set, then cleared" scenarios/far-box.json "${boston[@]}"
 run "Paris_1_256, city wall" scenarios/city-wall.json "${paris[@]}"
 run "lab.yaml 5 cm, wall" scenarios/wall.json "${lab[@]}"
 run "lab.yaml 5 cm, door opens" scenarios/lab-gap.json "${lab[@]}"
@@ -60,22 +61,24 @@ rows = {}
 for line in open(sys.argv[1]):
     name, js = line.split("\t", 1)
     plans = json.loads(js)
-    rep = {p["mode"]: p for p in plans if p["plan"] == 1}
-    rows.setdefault(name, []).append(rep)
+    for k in sorted({p["plan"] for p in plans if p["plan"] > 0}):
+        rep = {p["mode"]: p for p in plans if p["plan"] == k}
+        label = name if k == 1 and not any(p["plan"] > 1 for p in plans) else f"{name}, replan {k}"
+        rows.setdefault(label, []).append(rep)
 host = sys.argv[2] == "1"
 unit = "ant moves" if host else "instructions"
 cost = (lambda p: p["moves"]) if host else (lambda p: p["ticks"] * 1000)
 fmt = (lambda v: f"{v / 1e3:.1f} k") if host else (lambda v: f"{v / 1e6:.2f} M")
-print(f"| scenario | cold: {unit} | iterations | raw/opt | warm: {unit} | iterations | raw/opt | warm/cold |")
-print("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
+print(f"| scenario | cold: {unit} | iterations | raw/opt | warm: {unit} | answer | iterations | raw/opt | warm/cold |")
+print("| --- | ---: | ---: | ---: | ---: | --- | ---: | ---: | ---: |")
 ratios = []
 for name, reps in rows.items():
     c = [r["cold"] for r in reps]; w = [r["warm"] for r in reps]
     cc = st.mean(cost(p) for p in c); wc = st.mean(cost(p) for p in w)
     q = lambda ps: st.mean(p["raw_length"] / p["optimum"] for p in ps)
     it = lambda ps: st.mean(p["iterations"] for p in ps)
-    ratios.append(wc / cc)
-    print(f"| {name} | {fmt(cc)} | {it(c):.1f} | {q(c):.4f} | {fmt(wc)} | {it(w):.1f} | {q(w):.4f} | **{100 * wc / cc:.0f} %** |")
-print(f"\nMean warm/cold: {100 * st.mean(ratios):.0f} % over {len(ratios)} scenarios, {len(next(iter(rows.values())))} seeds each.")
+    kinds = sorted({p.get("origin", "warm") for p in w})
+    ratios.append(wc / cc if cc else 0.0)
+    print(f"| {name} | {fmt(cc)} | {it(c):.1f} | {q(c):.4f} | {fmt(wc)} | {' / '.join(kinds)} | {it(w):.1f} | {q(w):.4f} | **{100 * wc / cc:.{1 if wc < 0.1 * cc else 0}f} %** |")
+print(f"\nMean warm/cold: {100 * st.mean(ratios):.0f} % over {len(ratios)} replans, {len(next(iter(rows.values())))} seeds each.")
 PY
-rm -f "$out"

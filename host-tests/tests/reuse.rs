@@ -5,7 +5,7 @@
 //! `reference::step_allowed`), on hand-made maps and as a property over random maps and changes.
 
 use ohaca::heap::HeapStorage;
-use ohaca::planner::{reuse, Area, Memory, Origin, Run};
+use ohaca::planner::{reuse, Memory, Origin, Run};
 use ohaca::{Params, Point};
 use ohaca_host_tests::gen;
 use ohaca_host_tests::maps::Map;
@@ -51,9 +51,7 @@ impl Robot {
         for &p in cells {
             let was_blocked = !self.map.is_free(p);
             self.map.set(p, blocked);
-            let cell = Area::cell(p);
-            self.memory
-                .changed(cell, (!blocked && was_blocked).then_some(cell));
+            self.memory.cell(p, was_blocked, blocked);
         }
     }
 
@@ -246,6 +244,48 @@ fn a_cleared_shortcut_is_never_reused() {
     let again = a.raw[1];
     robot.change(&[Point::new(30, 20)], false);
     assert_eq!(robot.plan(again, true).unwrap().origin, Origin::Reused);
+    // A cell blocked since and cleared again is as it was: reused, even inside the ellipse.
+    // A free cell near the middle of the path that neither a move nor a segment touches.
+    let mid = a.raw[a.raw.len() / 2];
+    let beside = [
+        (0i32, 2i32),
+        (0, -2),
+        (2, 0),
+        (-2, 0),
+        (0, 3),
+        (0, -3),
+        (3, 0),
+        (-3, 0),
+    ]
+    .iter()
+    .map(|&(dx, dy)| {
+        Point::new(
+            (i32::from(mid.x) + dx) as u16,
+            (i32::from(mid.y) + dy) as u16,
+        )
+    })
+    .find(|&c| {
+        let mut m = robot.map.clone();
+        m.set(c, true);
+        robot.map.contains(c)
+            && robot.map.is_free(c)
+            && a.raw.windows(2).all(|w| {
+                let (dx, dy) = (
+                    i64::from(w[1].x) - i64::from(w[0].x),
+                    i64::from(w[1].y) - i64::from(w[0].y),
+                );
+                step_allowed(&m, w[0], dx, dy)
+            })
+            && a.waypoints
+                .windows(2)
+                .all(|w| segment_clear(&m, w[0], w[1]))
+    })
+    .expect("a free cell beside the path");
+    robot.change(&[beside], true);
+    let b = robot.plan(a.raw[2], true).unwrap();
+    assert_eq!(b.origin, Origin::Reused, "blocked off the path");
+    robot.change(&[beside], false);
+    assert_eq!(robot.plan(a.raw[3], true).unwrap().origin, Origin::Reused);
 }
 
 /// Random maps and changes: a reused answer is valid on the map as it is, and no path the change
@@ -267,9 +307,10 @@ fn reused_answers_are_never_beaten(
     if here == g {
         return Ok(false);
     }
-    let mut cleared = Vec::new();
+    // The map the answer was planned on: a cell free now and blocked then is a cleared cell.
+    let planned_on = robot.map.clone();
     for (i, dx, dy, blocked) in flips {
-        // Near the path (the cells that matter): a path cell's neighbourhood, 2 cells around.
+        // Near the path (the cells that matter): a path cell's neighbourhood, 3 cells around.
         let c = first.raw[i % first.raw.len()];
         let (x, y) = (i64::from(c.x) + dx, i64::from(c.y) + dy);
         if x < 0 || y < 0 || x >= i64::from(robot.map.width()) || y >= i64::from(robot.map.height())
@@ -280,13 +321,7 @@ fn reused_answers_are_never_beaten(
         if p == here || p == g {
             continue;
         }
-        if !blocked && !robot.map.is_free(p) {
-            cleared.push(p);
-        }
         robot.change(&[p], blocked);
-        if blocked {
-            cleared.retain(|&c| c != p);
-        }
     }
     let Some(a) = robot.plan(here, true) else {
         return Ok(false);
@@ -296,9 +331,13 @@ fn reused_answers_are_never_beaten(
     }
     assert_valid(&robot.map, &a, here, g);
     let now = opt8(&robot.map, here, g).expect("reachable: the answer is a path");
+    // Without the cleared cells: free only where it is free now and was then.
     let mut without = robot.map.clone();
-    for &c in &cleared {
-        without.set(c, true);
+    for i in 0..without.cells() {
+        let p = without.point(i);
+        if !planned_on.is_free(p) {
+            without.set(p, true);
+        }
     }
     let before = opt8(&without, here, g).unwrap_or(f64::INFINITY);
     prop_assert!(

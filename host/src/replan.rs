@@ -31,7 +31,7 @@ use std::collections::BinaryHeap;
 use serde::Deserialize;
 
 use ohaca::heap::HeapStorage;
-use ohaca::planner::{reuse, Area, Memory, Origin, Run};
+use ohaca::planner::{reuse, Memory, Origin, Run};
 use ohaca::{Grid, Params, Point};
 
 use crate::link::{DevicePath, Link, LinkError, Transport};
@@ -73,6 +73,12 @@ pub struct Change {
     /// A wall across the robot's path.
     #[serde(default)]
     pub wall_ahead: Option<WallAhead>,
+    /// A square of free cells far from the robot's path.
+    #[serde(default)]
+    pub box_away: Option<BoxAway>,
+    /// The cells of the previous change (set to `blocked`: `false` clears a box again).
+    #[serde(default)]
+    pub undo: bool,
     /// Blocked (default) or cleared.
     #[serde(default = "yes")]
     pub blocked: bool,
@@ -92,6 +98,17 @@ pub struct WallAhead {
     pub ahead: u16,
 }
 
+/// A `size x size` square of free cells, every cell at least `distance` cells (Chebyshev) from
+/// the robot and every cell of the rest of its path: the first such square in row-major order.
+#[derive(Clone, Copy, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BoxAway {
+    /// Cells a side.
+    pub size: u16,
+    /// Cells between the box and the path, at least.
+    pub distance: u16,
+}
+
 impl Scenario {
     /// Parse a scenario file's text.
     pub fn parse(text: &str) -> Result<Scenario, String> {
@@ -102,12 +119,21 @@ impl Scenario {
             }
         }
         for c in s.initial.iter().chain(s.events.iter().map(|e| &e.change)) {
-            let n = [c.rect.is_some(), c.cells.is_some(), c.wall_ahead.is_some()]
-                .iter()
-                .filter(|&&b| b)
-                .count();
+            let n = [
+                c.rect.is_some(),
+                c.cells.is_some(),
+                c.wall_ahead.is_some(),
+                c.box_away.is_some(),
+                c.undo,
+            ]
+            .iter()
+            .filter(|&&b| b)
+            .count();
             if n != 1 {
-                return Err("each change needs exactly one of rect, cells, wall_ahead".into());
+                return Err(
+                    "each change needs exactly one of rect, cells, wall_ahead, box_away, undo"
+                        .into(),
+                );
             }
         }
         Ok(s)
@@ -216,9 +242,7 @@ impl Planner for HostPlanner {
             // As the firmware does: a cleared cell counts as freed if it was blocked.
             let was_blocked = self.map.is_blocked(p);
             set_cell(&mut self.map, p, blocked)?;
-            let cell = Area::cell(p);
-            self.memory
-                .changed(cell, (!blocked && was_blocked).then_some(cell));
+            self.memory.cell(p, was_blocked, blocked);
         }
         Ok(())
     }
@@ -337,7 +361,7 @@ pub fn drive(
     let mut changed = Vec::new();
     let mut blocked = true;
     for c in &scenario.initial {
-        let cells = resolve(c, &map, &[], 0, goal)?;
+        let cells = resolve(c, &map, &[], 0, goal, &changed)?;
         for &p in &cells {
             set_cell(&mut map, p, c.blocked)?;
         }
@@ -364,7 +388,8 @@ pub fn drive(
             .min(path.len().saturating_sub(2));
         trail.extend(path.iter().skip(1).take(to));
         robot = path.get(to).copied().unwrap_or(robot);
-        let cells = resolve(&e.change, &map, &path, to, goal)?;
+        let prev = steps.last().map(|s| s.changed.clone()).unwrap_or_default();
+        let cells = resolve(&e.change, &map, &path, to, goal, &prev)?;
         let cells: Vec<Point> = cells.into_iter().filter(|&p| p != robot).collect();
         for &p in &cells {
             set_cell(&mut map, p, e.change.blocked)?;
@@ -421,7 +446,14 @@ fn resolve(
     path: &[Point],
     at: usize,
     goal: Point,
+    prev: &[Point],
 ) -> Result<Vec<Point>, String> {
+    if c.undo {
+        return Ok(prev.to_vec());
+    }
+    if let Some(b) = c.box_away {
+        return box_away(map, path.get(at..).unwrap_or(path), b);
+    }
     let on_map = |x: i64, y: i64| {
         (x >= 0 && y >= 0 && x < i64::from(map.width) && y < i64::from(map.height))
             .then(|| Point::new(x as u16, y as u16))
@@ -474,6 +506,43 @@ fn resolve(
         }
     }
     Ok(out)
+}
+
+/// The first `size x size` square of free cells at least `distance` cells from every cell of
+/// `path` (row-major order of its top-left corner).
+fn box_away(map: &Map, path: &[Point], b: BoxAway) -> Result<Vec<Point>, String> {
+    let (size, d) = (b.size.max(1), b.distance);
+    if path.is_empty() {
+        return Err("box_away: no path yet".into());
+    }
+    let far = |x: u16, y: u16| {
+        path.iter().all(|p| {
+            let dx = if p.x < x {
+                x - p.x
+            } else {
+                p.x.saturating_sub(x + size - 1)
+            };
+            let dy = if p.y < y {
+                y - p.y
+            } else {
+                p.y.saturating_sub(y + size - 1)
+            };
+            dx.max(dy) >= d
+        })
+    };
+    for y in 0..map.height.saturating_sub(size - 1) {
+        for x in 0..map.width.saturating_sub(size - 1) {
+            let cells: Vec<Point> = (y..y + size)
+                .flat_map(|yy| (x..x + size).map(move |xx| Point::new(xx, yy)))
+                .collect();
+            if cells.iter().all(|&p| !map.is_blocked(p)) && far(x, y) {
+                return Ok(cells);
+            }
+        }
+    }
+    Err(format!(
+        "box_away: no free {size} x {size} square {d} cells from the path"
+    ))
 }
 
 /// Check that `raw` goes from `start` to `goal` by allowed moves on `map`.

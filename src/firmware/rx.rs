@@ -235,6 +235,10 @@ impl Session {
     }
 }
 
+/// `SetRect`s of at most this many cells are told to the colony memory cell by cell
+/// (`Memory::cell`); larger ones as a rectangle.
+const SMALL_RECT: u32 = 64;
+
 /// Block or clear cells of the map in place; cancels the running and queued plans.
 async fn update(u: Update<'_>, blocked: bool) -> Reply<'static> {
     let Some(size) = state::map_size() else {
@@ -258,7 +262,17 @@ async fn update(u: Update<'_>, blocked: bool) -> Reply<'static> {
     };
     let done = match u {
         Update::Rect(x, y, w, h) => {
-            if let Some(a) = Area::rect(x, y, w, h) {
+            let small = u32::from(w) * u32::from(h) <= SMALL_RECT;
+            if let (true, Some(a)) = (small, Area::rect(x, y, w, h)) {
+                // Cell by cell, so a box set and cleared again is no change to the answer.
+                let (lo, hi) = a.corners();
+                for y in lo.y..=hi.y {
+                    for x in lo.x..=hi.x {
+                        let p = Point::new(x, y);
+                        memory.cell(p, was_blocked(p), blocked);
+                    }
+                }
+            } else if let Some(a) = Area::rect(x, y, w, h) {
                 let cleared = if blocked {
                     None
                 } else {
@@ -275,8 +289,7 @@ async fn update(u: Update<'_>, blocked: bool) -> Reply<'static> {
         }
         Update::Cells(c) => {
             for p in c.iter() {
-                let cleared = !blocked && was_blocked(p);
-                memory.changed(Area::cell(p), cleared.then_some(Area::cell(p)));
+                memory.cell(p, was_blocked(p), blocked);
             }
             set_cells(size, &mut map[..], &c, blocked)
         }

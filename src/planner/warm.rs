@@ -132,6 +132,50 @@ pub struct Memory {
     pub(super) answer: Option<Answer>,
     /// The cells cleared since that answer was planned, as at most [`FREED`] rectangles.
     pub(super) freed: Freed,
+    /// Cells that were free when that answer was planned and are blocked since
+    /// ([`Memory::cell`]): clearing one of them again restores the map the answer was planned on
+    /// there, so it is not a cleared cell.
+    blocked: Blocked,
+}
+
+/// Cells a [`Memory`] remembers as blocked since its answer was planned (were free then).
+pub const BLOCKED: usize = 32;
+
+/// See [`Memory::cell`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+struct Blocked {
+    cells: [Option<Point>; BLOCKED],
+    /// A cell did not fit: clearing a cell not listed counts as a cleared cell anyway, so the
+    /// list is only an optimisation; kept for the record.
+    overflowed: bool,
+}
+
+impl Blocked {
+    const fn new() -> Self {
+        Blocked {
+            cells: [None; BLOCKED],
+            overflowed: false,
+        }
+    }
+
+    fn push(&mut self, p: Point) {
+        match self.cells.iter_mut().find(|c| c.is_none()) {
+            Some(slot) => *slot = Some(p),
+            None => self.overflowed = true,
+        }
+    }
+
+    /// Remove `p` if listed; true if it was.
+    fn take(&mut self, p: Point) -> bool {
+        match self.cells.iter_mut().find(|c| **c == Some(p)) {
+            Some(slot) => {
+                *slot = None;
+                true
+            }
+            None => false,
+        }
+    }
 }
 
 /// Rectangles of cleared cells a [`Memory`] tells apart; a further one is merged into the one
@@ -217,6 +261,7 @@ impl Memory {
             freed: Freed {
                 areas: [None; FREED],
             },
+            blocked: Blocked::new(),
         }
     }
 
@@ -236,6 +281,27 @@ impl Memory {
         });
         if let Some(c) = cleared {
             self.freed.add(c);
+        }
+    }
+
+    /// Cell `p` changed from blocked (`was_blocked`) or free to `blocked` or free: the precise
+    /// form of [`Memory::changed`] for one cell. A cell blocked and cleared again since the
+    /// answer was planned is as it was then, so it does not count as cleared (a costmap's
+    /// passing obstacle costs no replan when it leaves); this is remembered for up to
+    /// [`BLOCKED`] cells, beyond which such a cell counts as cleared (never a wrong proof).
+    pub fn cell(&mut self, p: Point, was_blocked: bool, blocked: bool) {
+        let area = Area::cell(p);
+        match (was_blocked, blocked) {
+            (false, true) => {
+                self.changed(area, None);
+                self.blocked.push(p);
+            }
+            (true, false) => {
+                let restored = self.blocked.take(p);
+                self.changed(area, (!restored).then_some(area));
+            }
+            // Written as it was: nothing changed.
+            _ => {}
         }
     }
 
@@ -319,6 +385,51 @@ mod tests {
         assert_eq!(m.changes(), Area::rect(1, 0, 5, 2));
         m.planned(8, 8, g);
         assert_eq!(m.changes(), None);
+    }
+
+    #[test]
+    fn a_cell_blocked_and_cleared_again_is_not_cleared() {
+        let mut m = Memory::new();
+        m.planned(8, 8, Point::new(7, 7));
+        let (p, q) = (Point::new(2, 2), Point::new(3, 3));
+        m.cell(p, false, true); // a passing obstacle
+        m.cell(p, true, false); // gone again: as when planned
+        assert_eq!(m.freed.areas().count(), 0);
+        assert_eq!(m.changes(), Some(Area::cell(p)));
+        m.cell(q, true, false); // blocked when planned: cleared
+        assert_eq!(m.freed.areas().collect::<Vec<_>>(), [Area::cell(q)]);
+        m.cell(Point::new(5, 5), false, false); // written as it was: nothing
+        assert_eq!(m.changes(), Some(Area::cell(p).union(Area::cell(q))));
+        // Beyond BLOCKED listed cells, a cleared one counts as cleared.
+        let mut m = Memory::new();
+        for i in 0..=BLOCKED as u16 {
+            m.cell(Point::new(i, 0), false, true);
+        }
+        m.cell(Point::new(BLOCKED as u16, 0), true, false);
+        assert_eq!(m.freed.areas().count(), 1);
+        m.cell(Point::new(0, 0), true, false);
+        assert_eq!(m.freed.areas().count(), 1, "listed: restored");
+    }
+
+    #[test]
+    fn cleared_rectangles_merge_where_they_grow_least() {
+        let mut m = Memory::new();
+        for i in 0..FREED as u16 {
+            m.changed(
+                Area::cell(Point::new(10 * i, 0)),
+                Some(Area::cell(Point::new(10 * i, 0))),
+            );
+        }
+        m.changed(
+            Area::cell(Point::new(31, 1)),
+            Some(Area::cell(Point::new(31, 1))),
+        );
+        let areas: Vec<Area> = m.freed.areas().collect();
+        assert_eq!(areas.len(), FREED);
+        assert!(
+            areas.contains(&Area::rect(30, 0, 2, 2).unwrap()),
+            "{areas:?}"
+        );
     }
 
     #[test]
