@@ -59,6 +59,7 @@ pub mod output;
 pub mod plan_map;
 pub mod replan;
 pub mod ros;
+pub mod stream;
 pub mod strip;
 pub mod trace;
 

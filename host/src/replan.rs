@@ -417,7 +417,7 @@ pub fn drive(
 }
 
 /// Plan from the robot's cell, check the plan and measure the optimum.
-fn plan_step(
+pub(crate) fn plan_step(
     planner: &mut dyn Planner,
     (robot, at): (Point, usize),
     goal: Point,

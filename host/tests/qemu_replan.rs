@@ -140,3 +140,50 @@ fn plan_warm_keeps_the_colony_only_for_the_same_goal_and_map() {
     link.set_map(&map).expect("the same map again");
     assert!(!warm(&mut link, g), "a new upload drops it");
 }
+
+/// A robot's costmap stream (`ohaca_host::stream`): 100 small random updates at 5 Hz while the
+/// robot drives, one new obstacle in ten on or next to its path, a `PlanWarm` after each, on a
+/// 256 x 256 city and on Nav2's depot at 5 cm. Every answer is valid on the map of its time
+/// (checked by `stream`) and the host core's bit for bit, reused ones included; most are reused.
+/// The share of a 100 MHz core's time spent planning goes to stderr (`BENCHMARKS.md`,
+/// "Replanning", has the figures).
+#[test]
+fn a_costmap_stream_on_the_device_is_the_host_cores() {
+    use ohaca_host::stream::{stream, summary, Stream};
+    need_qemu!();
+    let q = Qemu::tcp();
+    let mut dev = DevicePlanner { link: q.link() };
+    dev.link.hello().expect("hello");
+    let p = Params::default();
+    dev.link.set_params(&p).expect("params");
+    let s = Stream::default();
+    for (name, file, ends) in [
+        (
+            "Boston_0_256",
+            maps().join("large/Boston_0_256.map"),
+            (Point::new(184, 0), Point::new(8, 254)),
+        ),
+        (
+            "depot",
+            maps().join("depot.map"),
+            (Point::new(9, 4), Point::new(596, 300)),
+        ),
+    ] {
+        let map = Map::load(&file).expect("map");
+        let host = stream(&s, &map, ends, &mut HostPlanner::new(p), true).expect("host");
+        let d = stream(&s, &map, ends, &mut dev, true).expect("device");
+        assert_same_drive(name, &host, &d);
+        let sum = summary(&d, s.hz, 100e6);
+        assert_eq!(sum.replans, s.updates, "{name}: the robot is still driving");
+        assert!(sum.reused * 2 > sum.replans, "{name}: {sum:?}");
+        assert!(sum.warm > 0, "{name}: obstacles on the path make runs: {sum:?}");
+        eprintln!(
+            "{name}: {} replans, {} reused, {} warm; {:.1} M instructions, {:.1} % of a 100 MHz core",
+            sum.replans,
+            sum.reused,
+            sum.warm,
+            sum.instructions.unwrap_or(0) as f64 / 1e6,
+            100.0 * sum.busy.unwrap_or(0.0)
+        );
+    }
+}

@@ -14,6 +14,7 @@ use ohaca::Point;
 use ohaca_host::input::MapArgs;
 use ohaca_host::link::{Link, Transport, DEFAULT_BAUD};
 use ohaca_host::replan::{drive, DevicePlanner, Drive, HostPlanner, Planner, Scenario};
+use ohaca_host::stream::{stream, summary as summary_of, Stream, Summary};
 use ohaca_host::{exit, strip, ParamArgs};
 use serde::Serialize;
 
@@ -25,8 +26,25 @@ pub struct Args {
     #[command(flatten)]
     pub input: MapArgs,
     /// The changes: a JSON file (see `docs/HOST.md`, `ohaca replan`)
-    #[arg(long, value_name = "FILE")]
-    pub events: PathBuf,
+    #[arg(long, value_name = "FILE", required_unless_present = "stream")]
+    pub events: Option<PathBuf>,
+    /// Instead of `--events`: a costmap stream of N small random updates, a replan after each
+    /// (`ohaca_host::stream`; one new obstacle in ten on or next to the path)
+    #[arg(long, value_name = "N", conflicts_with = "events")]
+    pub stream: Option<usize>,
+    /// Stream: updates a second
+    #[arg(long, value_name = "HZ", default_value_t = 5.0)]
+    pub hz: f64,
+    /// Stream: the robot's speed, cells a second
+    #[arg(long, value_name = "CELLS", default_value_t = 10.0)]
+    pub speed: f64,
+    /// Stream: share of new obstacles on or next to the path
+    #[arg(long, value_name = "SHARE", default_value_t = 0.1)]
+    pub near: f64,
+    /// Stream: the board's clock for the share of its time spent planning (device instructions
+    /// over the stream's duration)
+    #[arg(long, value_name = "MHZ", default_value_t = 100.0)]
+    pub clock_mhz: f64,
     /// Plan on a device over TCP, e.g. QEMU's UART (default: the host core)
     #[arg(long, value_name = "HOST:PORT", conflicts_with = "serial")]
     pub tcp: Option<String>,
@@ -167,12 +185,22 @@ pub fn run(args: &Args) -> u8 {
         Ok(s) => s,
         Err(e) => return bad_input(e),
     };
-    let events = match std::fs::read_to_string(&args.events)
-        .map_err(|e| e.to_string())
-        .and_then(|t| Scenario::parse(&t))
-    {
-        Ok(e) => e,
-        Err(e) => return bad_input(format_args!("{}: {e}", args.events.display())),
+    let events = match &args.events {
+        Some(path) => match std::fs::read_to_string(path)
+            .map_err(|e| e.to_string())
+            .and_then(|t| Scenario::parse(&t))
+        {
+            Ok(e) => Some(e),
+            Err(e) => return bad_input(format_args!("{}: {e}", path.display())),
+        },
+        None => None,
+    };
+    let costmap = Stream {
+        updates: args.stream.unwrap_or(0),
+        hz: args.hz,
+        speed: args.speed,
+        near: args.near,
+        seed: args.params.params().seed,
     };
     let mut p = match planner(args) {
         Ok(p) => p,
@@ -188,10 +216,18 @@ pub fn run(args: &Args) -> u8 {
     };
     let mut all = Vec::new();
     let mut last = None;
+    let mut streams = Vec::new();
     for &(name, warm) in modes {
-        match drive(&events, &sc.map, ends, p.as_mut(), warm) {
+        let d = match &events {
+            Some(ev) => drive(ev, &sc.map, ends, p.as_mut(), warm),
+            None => stream(&costmap, &sc.map, ends, p.as_mut(), warm),
+        };
+        match d {
             Ok(d) => {
                 all.extend(rows(name, &d));
+                if events.is_none() {
+                    streams.push((name, summary_of(&d, costmap.hz, args.clock_mhz * 1e6)));
+                }
                 last = Some(d);
             }
             Err(e) => {
@@ -207,8 +243,11 @@ pub fn run(args: &Args) -> u8 {
         ));
     } else {
         print(&table(&all));
-        if args.compare {
+        if args.compare && events.is_some() {
             print(&summary(&all));
+        }
+        for (name, s) in &streams {
+            print(&stream_line(name, s, args.clock_mhz));
         }
     }
     if let Some(d) = &last {
@@ -227,6 +266,22 @@ pub fn run(args: &Args) -> u8 {
         }
     }
     exit::FOUND
+}
+
+/// One line on a stream: answers by kind, cost, and the share of the board's time planning.
+fn stream_line(name: &str, s: &Summary, clock_mhz: f64) -> String {
+    let cost = match (s.instructions, s.busy) {
+        (Some(i), Some(b)) => format!(
+            "{:.1} M instructions, {:.1} % of a {clock_mhz} MHz core's time",
+            i as f64 / 1e6,
+            100.0 * b
+        ),
+        _ => format!("{} ant moves", s.moves),
+    };
+    format!(
+        "stream {name}: {} replans in {:.1} s: {} reused, {} warm, {} cold; {cost}\n",
+        s.replans, s.seconds, s.reused, s.warm, s.cold
+    )
 }
 
 /// Warm against cold, replan by replan: cost (instructions on a device, ant moves on the host) and
