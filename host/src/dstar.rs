@@ -154,7 +154,7 @@ pub struct Path {
     pub straight: u32,
     /// Diagonal steps.
     pub diagonal: u32,
-    /// Length in cost units (`straight STRAIGHT + diagonal DIAGONAL`), the robot's `g`.
+    /// Length in cost units (`straight STRAIGHT + diagonal DIAGONAL`), the robot's `rhs`.
     pub cost: u32,
     /// Length in cells ([`steps_length`], the core's formula: comparable bit for bit).
     pub length: f32,
@@ -346,6 +346,12 @@ fn step_cost(d: u8) -> u32 {
     }
 }
 
+/// The moves from `p` (bit `d` set iff [`Grid::step`] allows move `d`; 0 at a blocked cell):
+/// its successors, and as the edges are symmetric, its predecessors.
+fn moves(grid: &Grid<'_>, p: Point) -> u8 {
+    grid.mask_at(p)
+}
+
 /// `a + b`, infinite above [`LIMIT`].
 fn add(a: u32, b: u32) -> u32 {
     match a.checked_add(b) {
@@ -403,7 +409,7 @@ impl State {
         if p == self.goal {
             return 0;
         }
-        let m = grid.mask_at(p);
+        let m = moves(grid, p);
         (0..8u8)
             .filter(|d| m & (1 << d) != 0)
             .map(|d| add(step_cost(d), self.g(grid.index(neighbour(p, d)))))
@@ -451,7 +457,7 @@ impl State {
                 self.stats.expanded += 1;
                 self.set_g(u, rhs_u);
                 self.open.remove(u);
-                let m = grid.mask_at(p);
+                let m = moves(grid, p);
                 for d in (0..8u8).filter(|d| m & (1 << d) != 0) {
                     let q = neighbour(p, d);
                     let qi = grid.index(q);
@@ -467,7 +473,7 @@ impl State {
                 // Underconsistent: forget its g; predecessors that relied on it look again.
                 self.stats.expanded += 1;
                 self.set_g(u, INF);
-                let m = grid.mask_at(p);
+                let m = moves(grid, p);
                 for d in (0..8u8).filter(|d| m & (1 << d) != 0) {
                     let q = neighbour(p, d);
                     let qi = grid.index(q);
@@ -483,9 +489,11 @@ impl State {
         }
     }
 
-    /// Follow the cheapest successor (edge cost plus `g`) from the robot to the goal.
+    /// Follow the cheapest successor (edge cost plus `g`) from the robot to the goal. The
+    /// optimized `ComputeShortestPath` may stop with the robot's vertex overconsistent (its `g`
+    /// not lowered yet): its distance is its `rhs`, as in the paper's main loop.
     fn path(&self, grid: &Grid<'_>) -> Option<Path> {
-        let cost = self.g(grid.index(self.start));
+        let cost = self.rhs(grid.index(self.start));
         if cost == INF {
             return None;
         }
@@ -496,7 +504,7 @@ impl State {
             if cells.len() > grid.cells() {
                 return None;
             }
-            let m = grid.mask_at(p);
+            let m = moves(grid, p);
             let (d, q, c) = (0..8u8)
                 .filter(|d| m & (1 << d) != 0)
                 .map(|d| {
