@@ -184,12 +184,34 @@ impl Key {
     };
 }
 
-/// One queue entry: the key, then the cell index (the tie-break).
+/// One queue entry: the key's two parts, then the cell index (the tie-break), ordered in that
+/// order; flat, so that it packs in 16 bytes (a nested [`Key`] would pad it to 24).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 struct Node {
-    key: Key,
+    k1: u64,
+    k2: u32,
     cell: u32,
 }
+
+impl Node {
+    fn new(cell: usize, key: Key) -> Node {
+        // `cell < cells <= MAX_CELLS < 2^32`.
+        Node {
+            k1: key.k1,
+            k2: key.k2,
+            cell: cell as u32,
+        }
+    }
+
+    fn key(&self) -> Key {
+        Key {
+            k1: self.k1,
+            k2: self.k2,
+        }
+    }
+}
+
+const _: () = assert!(ENTRY_BYTES == 16);
 
 /// The queue: an indexed binary min-heap (a vertex's position in `pos`, [`NOT_OPEN`] if it is
 /// not in the queue).
@@ -267,10 +289,7 @@ impl Open {
 
     fn insert(&mut self, cell: usize, key: Key) {
         let i = self.heap.len();
-        self.heap.push(Node {
-            key,
-            cell: cell as u32,
-        });
+        self.heap.push(Node::new(cell, key));
         self.peak = self.peak.max(self.heap.len());
         self.call_peak = self.call_peak.max(self.heap.len());
         if let Some(p) = self.pos.get_mut(cell) {
@@ -285,8 +304,8 @@ impl Open {
         let Some(slot) = self.heap.get_mut(i) else {
             return;
         };
-        let old = slot.key;
-        slot.key = key;
+        let old = slot.key();
+        *slot = Node::new(cell, key);
         if key < old {
             self.sift_up(i);
         } else {
@@ -442,14 +461,14 @@ impl State {
     fn compute(&mut self, grid: &Grid<'_>) {
         let s = grid.index(self.start);
         while let Some(top) = self.open.top() {
-            if top.key >= self.key(grid, s) && self.rhs(s) <= self.g(s) {
+            if top.key() >= self.key(grid, s) && self.rhs(s) <= self.g(s) {
                 break;
             }
             let u = top.cell as usize;
             let k_new = self.key(grid, u);
             let p = grid.point(u);
             let (g_u, rhs_u) = (self.g(u), self.rhs(u));
-            if top.key < k_new {
+            if top.key() < k_new {
                 self.stats.requeued += 1;
                 self.open.update(u, k_new);
             } else if g_u > rhs_u {

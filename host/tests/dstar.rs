@@ -256,6 +256,13 @@ fn a_far_change_costs_far_less_than_the_initial_search() {
     let initial = first.stats.expanded;
     println!("initial: {:?}", first.stats);
     assert!(initial > 2000, "{initial}");
+    // What it keeps: 12 bytes a cell and 16 an entry of the queue at its most (in the first
+    // plan, this call's peak).
+    assert_eq!((CELL_BYTES, ENTRY_BYTES), (12, 16));
+    assert_eq!(
+        first.stats.memory_bytes,
+        200 * 200 * CELL_BYTES + ENTRY_BYTES * first.stats.open_peak
+    );
     let path = first.path.unwrap();
     // Drive a third of the way: nothing changed, nothing to expand.
     d.move_robot(path.cells[path.cells.len() / 3]).unwrap();
