@@ -43,8 +43,10 @@
 //! counted at the most entries it ever held (it persists between replans). Its own copy of the
 //! map (one bit a cell) is not counted, as `ohaca::astar` does not count the map it reads.
 //!
-//! **Guarantees.** Exact (above) and incremental: after every [`DStarLite::plan`] the `g` values
-//! along the returned path are the true distances to the goal. Errors are values
+//! **Guarantees.** Exact (above) and incremental: every [`DStarLite::plan`] returns a shortest
+//! path on the map as it is then (its cost the robot's `rhs`; the optimized search may stop
+//! before lowering the robot's own `g`), checked against the exact A* by the tests after random
+//! sequences of changes and moves, and by [`replay`] on every plan. Errors are values
 //! ([`DStarError`]): a cell off the map, a blocked start or goal (as [`ohaca::astar`]'s
 //! `BadCell`), a map too large; nothing panics and every table access is checked.
 
