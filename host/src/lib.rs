@@ -21,6 +21,7 @@
 //! | [`experiment`] | the paper's experiments: many seeds per algorithm, CSV, summary, pictures |
 //! | [`link`] | the firmware link: a blocking protocol client over TCP or a serial port |
 //! | [`strip`] | pictures of a replanning drive: a PNG strip, an animated GIF |
+//! | [`dstar`] | D* Lite, the incremental exact baseline of replanning: a persistent search on the core's 8-connected grid, and a drive of `replan` replayed into it |
 //! | [`replan`] | replanning scenarios: a robot driving while cells change, warm or cold replans on the core or a device |
 //! | [`ros`] | `ohaca ros`: a ROS 2 node (map, goal and pose topics, `/plan`, Nav2's `compute_path_to_pose`) |
 //!
@@ -50,6 +51,7 @@
 
 pub mod args;
 pub mod draw;
+pub mod dstar;
 pub mod exit;
 pub mod experiment;
 pub mod input;

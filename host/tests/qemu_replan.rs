@@ -176,7 +176,10 @@ fn a_costmap_stream_on_the_device_is_the_host_cores() {
         let sum = summary(&d, s.hz, 100e6);
         assert_eq!(sum.replans, s.updates, "{name}: the robot is still driving");
         assert!(sum.reused * 2 > sum.replans, "{name}: {sum:?}");
-        assert!(sum.warm > 0, "{name}: obstacles on the path make runs: {sum:?}");
+        assert!(
+            sum.warm > 0,
+            "{name}: obstacles on the path make runs: {sum:?}"
+        );
         eprintln!(
             "{name}: {} replans, {} reused, {} warm; {:.1} M instructions, {:.1} % of a 100 MHz core",
             sum.replans,

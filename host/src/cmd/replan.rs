@@ -1,7 +1,9 @@
 //! `ohaca replan`: drive a robot through a replanning scenario ([`ohaca_host::replan`]) on the
 //! host core or on a device (`--tcp` / `--serial`), warm (`PlanWarm`, the default), cold
 //! (`--cold`) or both side by side (`--compare`), print a table of every plan and draw the drive
-//! (`--png` strip of panels, `--gif` animation).
+//! (`--png` strip of panels, `--gif` animation). `--dstar` replays every drive into D* Lite
+//! ([`ohaca_host::dstar::replay`], one persistent search a drive) and adds its cost and the exact
+//! A*'s from scratch, plan by plan.
 //!
 //! Exit codes: 0 every plan found a valid path; 1 a plan failed (no path, a device error or an
 //! invalid path); 2 bad input.
@@ -11,6 +13,7 @@ use std::time::Duration;
 
 use ohaca::Params;
 use ohaca::Point;
+use ohaca_host::dstar::{self, AstarCost, Stats};
 use ohaca_host::input::MapArgs;
 use ohaca_host::link::{Link, Transport, DEFAULT_BAUD};
 use ohaca_host::replan::{drive, DevicePlanner, Drive, HostPlanner, Planner, Scenario};
@@ -69,6 +72,10 @@ pub struct Args {
     /// Draw the (warm) drive as an animated GIF
     #[arg(long, value_name = "FILE")]
     pub gif: Option<PathBuf>,
+    /// Also replay each drive into D* Lite (one incremental search across the drive's plans) and
+    /// print its expansions and memory, and the exact A*'s from scratch, for every plan
+    #[arg(long)]
+    pub dstar: bool,
     /// Print one JSON object instead of the table
     #[arg(long)]
     pub json: bool,
@@ -93,6 +100,19 @@ struct Row {
     raw_length: f32,
     length: f32,
     optimum: Option<f64>,
+    /// `--dstar`: D* Lite's cost for this plan's problem, and the exact A*'s.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    dstar: Option<DstarCols>,
+}
+
+/// `--dstar`'s columns of a plan.
+#[derive(Serialize)]
+struct DstarCols {
+    /// D* Lite, persisted across the drive (the work since the previous plan).
+    #[serde(flatten)]
+    stats: Stats,
+    /// The exact A* (`ohaca::astar::search`) from scratch on the same problem.
+    astar: AstarCost,
 }
 
 fn rows(mode: &'static str, d: &Drive) -> Vec<Row> {
@@ -114,8 +134,21 @@ fn rows(mode: &'static str, d: &Drive) -> Vec<Row> {
             raw_length: s.plan.raw_length,
             length: s.plan.length,
             optimum: s.optimum,
+            dstar: None,
         })
         .collect()
+}
+
+/// Replay `d` into D* Lite and attach its columns to `rows` (the drive's rows, in order).
+fn add_dstar(rows: &mut [Row], d: &Drive, goal: Point) -> Result<(), String> {
+    let replayed = dstar::replay(d, goal).map_err(|e| format!("D* Lite: {e}"))?;
+    for (row, r) in rows.iter_mut().zip(replayed) {
+        row.dstar = Some(DstarCols {
+            stats: r.dstar,
+            astar: r.astar,
+        });
+    }
+    Ok(())
 }
 
 /// A device over `link`, told the parameters.
@@ -144,10 +177,19 @@ fn planner(args: &Args) -> Result<Box<dyn Planner>, String> {
     Ok(Box::new(HostPlanner::new(params)))
 }
 
+/// Bytes in KiB, one decimal.
+fn kib(bytes: usize) -> String {
+    format!("{:.1} K", bytes as f64 / 1024.0)
+}
+
 fn table(rows: &[Row]) -> String {
     let mut out = String::from(
-        "mode  plan  robot       changed      origin  iterations  moves      instructions  raw     smoothed  optimum  raw/opt\n",
+        "mode  plan  robot       changed      origin  iterations  moves      instructions  raw     smoothed  optimum  raw/opt",
     );
+    if rows.iter().any(|r| r.dstar.is_some()) {
+        out += "  D* exp     D* mem     A* exp     A* mem";
+    }
+    out += "\n";
     for r in rows {
         let changed = match (r.plan, r.changed) {
             (0, 0) => "-".to_string(),
@@ -160,8 +202,17 @@ fn table(rows: &[Row]) -> String {
         let ratio = r.optimum.map_or("-".into(), |o| {
             format!("{:.4}", f64::from(r.raw_length) / o)
         });
+        let dstar = r.dstar.as_ref().map_or(String::new(), |d| {
+            format!(
+                "  {:<10} {:<10} {:<10} {}",
+                d.stats.expanded,
+                kib(d.stats.memory_bytes),
+                d.astar.expanded,
+                kib(d.astar.memory_bytes)
+            )
+        });
         out += &format!(
-            "{:<5} {:<5} {:<11} {:<12} {:<7} {:<11} {:<10} {:<13} {:<7.2} {:<9.2} {:<8} {}\n",
+            "{:<5} {:<5} {:<11} {:<12} {:<7} {:<11} {:<10} {:<13} {:<7.2} {:<9.2} {:<8} {:<7}{dstar}\n",
             r.mode,
             r.plan,
             format!("({},{})", r.robot[0], r.robot[1]),
@@ -224,7 +275,14 @@ pub fn run(args: &Args) -> u8 {
         };
         match d {
             Ok(d) => {
-                all.extend(rows(name, &d));
+                let mut r = rows(name, &d);
+                if args.dstar {
+                    if let Err(e) = add_dstar(&mut r, &d, sc.goal) {
+                        eprintln!("error: {name} drive: {e}");
+                        return exit::NO_PATH;
+                    }
+                }
+                all.extend(r);
                 if events.is_none() {
                     streams.push((name, summary_of(&d, costmap.hz, args.clock_mhz * 1e6)));
                 }
@@ -248,6 +306,9 @@ pub fn run(args: &Args) -> u8 {
         }
         for (name, s) in &streams {
             print(&stream_line(name, s, args.clock_mhz));
+        }
+        if args.dstar {
+            print(&dstar_summary(&all));
         }
     }
     if let Some(d) = &last {
@@ -312,6 +373,38 @@ fn summary(rows: &[Row]) -> String {
             w.iterations,
             c.iterations,
             100.0 * (f64::from(w.raw_length) / f64::from(c.raw_length) - 1.0)
+        );
+    }
+    out
+}
+
+/// `--dstar`, drive by drive: D* Lite's initial search and its replans against the exact A* from
+/// scratch on the same problems (expansions), and the memory each keeps at its most.
+fn dstar_summary(rows: &[Row]) -> String {
+    let mut out = String::new();
+    let mut modes: Vec<&str> = rows.iter().map(|r| r.mode).collect();
+    modes.dedup();
+    for mode in modes {
+        let d: Vec<&DstarCols> = rows
+            .iter()
+            .filter(|r| r.mode == mode)
+            .filter_map(|r| r.dstar.as_ref())
+            .collect();
+        let Some(first) = d.first() else { continue };
+        let replans = d.get(1..).unwrap_or_default();
+        let list = |f: &dyn Fn(&DstarCols) -> String| {
+            replans.iter().map(|c| f(c)).collect::<Vec<_>>().join(", ")
+        };
+        let mem = d.iter().map(|c| c.stats.memory_bytes).max().unwrap_or(0);
+        let amem = d.iter().map(|c| c.astar.memory_bytes).max().unwrap_or(0);
+        out += &format!(
+            "D* Lite ({mode} drive): initial {} expansions (A* {}); replans {} (A* from scratch {}); memory {} (A* {})\n",
+            first.stats.expanded,
+            first.astar.expanded,
+            if replans.is_empty() { "-".into() } else { list(&|c| c.stats.expanded.to_string()) },
+            if replans.is_empty() { "-".into() } else { list(&|c| c.astar.expanded.to_string()) },
+            kib(mem),
+            kib(amem)
         );
     }
     out
