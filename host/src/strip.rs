@@ -4,6 +4,8 @@
 //! Colours: free cells white, obstacles dark grey, cells blocked by a change red, cells cleared
 //! by one green; the robot's trail blue, the plan it follows orange (raw path light, smoothed
 //! waypoints dark), the plan it dropped light grey; the robot a blue square, the goal a black one.
+//! A bar across the top of each panel says what answered the plan: grey a cold run, orange a
+//! warm run (the colony kept), teal the rest of the last answer (reused, no run).
 
 use std::path::Path;
 
@@ -24,6 +26,18 @@ const SMOOTH: Rgb<u8> = Rgb([230, 110, 0]);
 const OLD: Rgb<u8> = Rgb([190, 190, 190]);
 const GOAL: Rgb<u8> = Rgb([0, 0, 0]);
 const GAP: u32 = 8;
+const MARK_COLD: Rgb<u8> = Rgb([120, 120, 120]);
+const MARK_WARM: Rgb<u8> = Rgb([250, 150, 0]);
+const MARK_REUSED: Rgb<u8> = Rgb([0, 160, 170]);
+
+/// The bar's colour for a plan's origin.
+pub fn mark(origin: ohaca::planner::Origin) -> Rgb<u8> {
+    match origin {
+        ohaca::planner::Origin::Cold => MARK_COLD,
+        ohaca::planner::Origin::Warm => MARK_WARM,
+        ohaca::planner::Origin::Reused => MARK_REUSED,
+    }
+}
 
 /// Pixels per cell: the map fills about 512 pixels on its longer side.
 fn scale(map: &Map) -> u32 {
@@ -36,13 +50,16 @@ struct Canvas {
     x0: u32,
 }
 
+/// Pixels of the bar above each panel that says what answered its plan.
+const BAR: u32 = 8;
+
 impl Canvas {
     fn cell(&mut self, p: Point, c: Rgb<u8>) {
         for dy in 0..self.s {
             for dx in 0..self.s {
                 let (x, y) = (
                     self.x0 + u32::from(p.x) * self.s + dx,
-                    u32::from(p.y) * self.s + dy,
+                    BAR + u32::from(p.y) * self.s + dy,
                 );
                 if x < self.img.width() && y < self.img.height() {
                     self.img.put_pixel(x, y, c);
@@ -65,7 +82,7 @@ impl Canvas {
         let s = i64::from(self.s);
         (
             i64::from(self.x0) + i64::from(p.x) * s + s / 2,
-            i64::from(p.y) * s + s / 2,
+            i64::from(BAR) + i64::from(p.y) * s + s / 2,
         )
     }
 
@@ -141,6 +158,14 @@ fn scene(c: &mut Canvas, drive: &Drive, at: &[usize], k: usize, t: usize, goal: 
     if let Some(&p) = drive.trail.get(t) {
         c.dot(p, r, TRAIL);
     }
+    // What answered this plan: the bar above the panel.
+    let pw = i64::from(step.map.width) * i64::from(c.s);
+    let x0 = i64::from(c.x0);
+    for y in 0..i64::from(BAR) - 2 {
+        for x in x0..x0 + pw {
+            c.pixel(x, y, mark(step.plan.origin));
+        }
+    }
 }
 
 /// A strip of panels, one per plan, at the moment the robot planned it.
@@ -153,7 +178,7 @@ pub fn strip(drive: &Drive, goal: Point) -> Result<RgbImage, String> {
     );
     let n = drive.steps.len() as u32;
     let mut c = Canvas {
-        img: RgbImage::from_pixel(n * pw + (n - 1) * GAP, ph, Rgb([255, 255, 255])),
+        img: RgbImage::from_pixel(n * pw + (n - 1) * GAP, BAR + ph, Rgb([255, 255, 255])),
         s,
         x0: 0,
     };
@@ -194,7 +219,7 @@ pub fn save_gif(drive: &Drive, goal: Point, path: &Path) -> Result<(), String> {
     for &t in &times {
         let k = at.iter().rposition(|&a| a <= t).unwrap_or(0);
         let mut c = Canvas {
-            img: RgbImage::from_pixel(pw, ph, FREE),
+            img: RgbImage::from_pixel(pw, BAR + ph, FREE),
             s,
             x0: 0,
         };
