@@ -145,8 +145,8 @@ fn plan_warm_keeps_the_colony_only_for_the_same_goal_and_map() {
 /// robot drives, one new obstacle in ten on or next to its path, a `PlanWarm` after each, on a
 /// 256 x 256 city and on Nav2's depot at 5 cm. Every answer is valid on the map of its time
 /// (checked by `stream`) and the host core's bit for bit, reused ones included; most are reused.
-/// The share of a 100 MHz core's time spent planning goes to stderr (`BENCHMARKS.md`,
-/// "Replanning", has the figures).
+/// (The share of the board's time spent planning is measured under `-icount`: `BENCHMARKS.md`,
+/// "Replanning".)
 #[test]
 fn a_costmap_stream_on_the_device_is_the_host_cores() {
     use ohaca_host::stream::{stream, summary, Stream};
@@ -180,13 +180,11 @@ fn a_costmap_stream_on_the_device_is_the_host_cores() {
             sum.warm > 0,
             "{name}: obstacles on the path make runs: {sum:?}"
         );
+        // This QEMU runs without `-icount`, so its ticks are not instructions: the cost figures
+        // come from `ohaca replan --stream` on `scripts/qemu-serve.sh --icount` (BENCHMARKS.md).
         eprintln!(
-            "{name}: {} replans, {} reused, {} warm; {:.1} M instructions, {:.1} % of a 100 MHz core",
-            sum.replans,
-            sum.reused,
-            sum.warm,
-            sum.instructions.unwrap_or(0) as f64 / 1e6,
-            100.0 * sum.busy.unwrap_or(0.0)
+            "{name}: {} replans, {} reused, {} warm",
+            sum.replans, sum.reused, sum.warm
         );
     }
 }

@@ -38,6 +38,14 @@ use super::workspace::Workspace;
 use colony::Best;
 use polish::{Polish, SMALL_REFINE_LINKS};
 
+/// A warm start whose changed cells' bounding box holds more than `1 / REBUILD_SHARE` of the
+/// map's cells prunes and routes from scratch instead of repairing the last run's marks and
+/// route: the repair re-examines every cell of the box and its cascade, about four times what a
+/// fresh pruning costs a cell (on a 256 x 256 city, a whole-map box cost 20-30 M instructions
+/// of repair against 7.8 M of setup from scratch; `BENCHMARKS.md` 4b). Both give the same marks
+/// and route bit for bit, so this moves cost, never a path.
+pub const REBUILD_SHARE: usize = 8;
+
 /// A planning run in progress. See the module docs.
 pub struct Run<'g, 'a> {
     grid: &'g Grid<'g>,
@@ -253,9 +261,12 @@ impl<'g, 'a> Run<'g, 'a> {
         }
         // The last run's pruning marks are reused (repaired locally) when it kept them and this
         // run prunes too; its route's links too when it stashed them in `delta` (restored here,
-        // before `delta` is cleared).
+        // before `delta` is cleared). Not when the changes span more than [`REBUILD_SHARE`] of
+        // the map: the repair then costs more than pruning and routing from scratch, which give
+        // the same marks and route bit for bit.
+        let local = |c: Option<Area>| c.is_none_or(|a| a.cells() <= (cells / REBUILD_SHARE) as u64);
         let reuse = match warm {
-            Some((changes, Some(kept))) if params.prune => Some((changes, kept)),
+            Some((changes, Some(kept))) if params.prune && local(changes) => Some((changes, kept)),
             _ => None,
         };
         let relinked = reuse.is_some_and(|(_, k)| k.route) && {
