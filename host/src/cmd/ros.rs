@@ -140,6 +140,10 @@ pub struct Args {
     /// Stop after this many seconds (default: run until killed)
     #[arg(long, value_name = "SECONDS")]
     pub run_for: Option<f64>,
+    /// The shortest time between two replans for map updates: a burst of `/map_updates` within
+    /// it is applied at once and replanned once when it has passed (0: replan after every pass)
+    #[arg(long, value_name = "SECONDS", default_value_t = 0.0)]
+    pub min_replan_interval: f64,
     /// Log level: error, warn, info or debug (debug also shows the DDS libraries' lines)
     #[arg(long, value_name = "LEVEL", default_value = "info")]
     pub log_level: log::Level,
@@ -228,6 +232,11 @@ fn config(args: &Args) -> Result<NodeConfig, String> {
         gif: args.gif.clone(),
         png: args.png.clone(),
         run_for: args.run_for.map(|v| seconds(v, "--run-for")).transpose()?,
+        min_replan: if args.min_replan_interval == 0.0 {
+            Duration::ZERO
+        } else {
+            seconds(args.min_replan_interval, "--min-replan-interval")?
+        },
     })
 }
 

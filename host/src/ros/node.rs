@@ -108,6 +108,10 @@ pub struct NodeConfig {
     pub png: Option<PathBuf>,
     /// Stop after this long (tests, benchmarks); run until killed otherwise.
     pub run_for: Option<Duration>,
+    /// The shortest time between two replans for map updates: updates that arrive sooner are
+    /// applied at once and their replan waits until the interval has passed, one replan for the
+    /// whole burst (`--min-replan-interval`; zero: a replan after every pass over the topics).
+    pub min_replan: Duration,
 }
 
 fn name(s: &str) -> Result<Name, String> {
@@ -215,6 +219,43 @@ struct State {
     recorder: Option<Recorder>,
     /// Plans still to draw (`--gif`).
     to_draw: Vec<(Map, (Point, Point), Planned)>,
+    /// Map-update replans, at most one per [`NodeConfig::min_replan`].
+    coalesce: Coalesce,
+}
+
+/// The replans for map updates, at most one per `min` ([`NodeConfig::min_replan`]).
+#[derive(Clone, Copy, Debug)]
+struct Coalesce {
+    min: Duration,
+    /// When the last replan for map updates was made.
+    last: Option<Instant>,
+    /// Passes with map updates since, whose replan waits.
+    pending: u32,
+}
+
+impl Coalesce {
+    /// One pass over the topics at `now`: `updates` if map updates arrived, `other` if something
+    /// else (a goal, a map) makes a plan anyway. Returns whether to plan for the updates now.
+    fn pass(&mut self, updates: bool, other: bool, now: Instant) -> bool {
+        if updates {
+            self.pending = self.pending.saturating_add(1);
+        }
+        if self.pending == 0 {
+            return false;
+        }
+        let due = other
+            || self
+                .last
+                .is_none_or(|t| now.saturating_duration_since(t) >= self.min);
+        if due {
+            if self.pending > 1 {
+                log::info!("{} map updates coalesced into one replan", self.pending);
+            }
+            self.pending = 0;
+            self.last = Some(now);
+        }
+        due && !other
+    }
 }
 
 impl State {
@@ -437,6 +478,15 @@ impl State {
                 }
             }
         }
+        // Coalescing: a replan for map updates waits until `min_replan` has passed since the
+        // last one; a new goal or map plans at once (and takes the waiting updates with it).
+        let updates = replan == Some("map_update");
+        let other = replan.is_some() && !updates;
+        if self.coalesce.pass(updates, other, Instant::now()) {
+            replan = Some("map_update");
+        } else if updates {
+            replan = None;
+        }
         if let Some(trigger) = replan {
             match (self.start, self.goal) {
                 (Some(s), Some(g)) => {
@@ -493,6 +543,11 @@ pub fn run(cfg: NodeConfig, planning: Planning) -> Result<(), String> {
         recorder: (cfg.gif.is_some() || cfg.png.is_some())
             .then(|| Recorder::new(cfg.gif.clone(), cfg.png.clone())),
         to_draw: Vec::new(),
+        coalesce: Coalesce {
+            min: cfg.min_replan,
+            last: None,
+            pending: 0,
+        },
     };
     let began = Instant::now();
     loop {
@@ -506,5 +561,39 @@ pub fn run(cfg: NodeConfig, planning: Planning) -> Result<(), String> {
         if !busy {
             std::thread::sleep(Duration::from_millis(5));
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn map_update_replans_are_coalesced() {
+        let t0 = Instant::now();
+        let ms = |n: u64| t0 + Duration::from_millis(n);
+        let mut c = Coalesce {
+            min: Duration::from_millis(500),
+            last: None,
+            pending: 0,
+        };
+        assert!(c.pass(true, false, ms(0)), "the first update plans at once");
+        assert!(!c.pass(true, false, ms(100)), "the next waits");
+        assert!(!c.pass(true, false, ms(300)), "and the one after");
+        assert!(!c.pass(false, false, ms(400)), "still within the interval");
+        assert!(c.pass(false, false, ms(500)), "one replan for the burst");
+        assert!(!c.pass(false, false, ms(600)), "nothing pending");
+        assert!(!c.pass(true, false, ms(700)), "waits again");
+        assert!(
+            !c.pass(false, true, ms(800)),
+            "a goal plans and takes the updates along"
+        );
+        assert!(!c.pass(false, false, ms(2000)), "nothing left");
+        let mut every = Coalesce {
+            min: Duration::ZERO,
+            last: None,
+            pending: 0,
+        };
+        assert!(every.pass(true, false, ms(0)) && every.pass(true, false, ms(0)));
     }
 }
