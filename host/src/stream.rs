@@ -108,8 +108,10 @@ pub fn stream(
         }
         let to = per.min(path.len() - 2);
         trail.extend(path.iter().skip(1).take(to));
-        robot = path[to];
-        let ahead = &path[to..];
+        let (Some(&here), Some(ahead)) = (path.get(to), path.get(to..)) else {
+            break;
+        };
+        robot = here;
         let (cells, blocked) = if !live.is_empty() && rng.unit() < 0.5 {
             let i = rng.below(live.len());
             // Leave the robot's own cell alone (it drove onto a cell an obstacle left).
@@ -158,11 +160,11 @@ fn obstacle(
     };
     for _ in 0..64 {
         let centre = if near {
-            let lo = 3.min(ahead.len() - 1);
-            let hi = 40.min(ahead.len() - 1);
-            let c = ahead[lo + rng.below(hi - lo + 1)];
+            let last = ahead.len().saturating_sub(1);
+            let (lo, hi) = (3.min(last), 40.min(last));
+            let c = ahead.get(lo + rng.below(hi - lo + 1)).copied();
             let (dx, dy) = (rng.below(3) as i64 - 1, rng.below(3) as i64 - 1);
-            free(i64::from(c.x) + dx, i64::from(c.y) + dy)
+            c.and_then(|c| free(i64::from(c.x) + dx, i64::from(c.y) + dy))
         } else {
             let i = rng.below(map.cells());
             let w = usize::from(map.width);
