@@ -368,7 +368,7 @@ proptest! {
 }
 
 proptest! {
-    #![proptest_config(gen::config(48))]
+    #![proptest_config(gen::config(128))]
     /// Large maps (more than 1,024 cells), cells blocked on and beside the path: repaired
     /// answers are valid and no cleared cell beats them either.
     #[test]
