@@ -242,8 +242,9 @@ fn box_distance(p: Point, area: Area) -> f32 {
 /// Octile distance from `p` to the nearest cell of `area` (0 inside).
 fn box_octile(p: Point, area: Area) -> f32 {
     let q = Point::new(
-        p.x.clamp(area.min.x, area.max.x),
-        p.y.clamp(area.min.y, area.max.y),
+        // Not `clamp`: it panics on `min > max`, which an `Area` never has.
+        p.x.max(area.min.x).min(area.max.x),
+        p.y.max(area.min.y).min(area.max.y),
     );
     octile(p, q)
 }
