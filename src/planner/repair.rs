@@ -264,7 +264,7 @@ pub(super) fn repair<'a>(
     };
     if ks < 2
         || points.get(ns_at) != Some(&li)
-        || points.get(ns_at.checked_add(ks - 1)?) != Some(&lj)
+        || points.get(ns_at.checked_add(ks.wrapping_sub(1))?) != Some(&lj)
     {
         return None;
     }
