@@ -227,7 +227,7 @@ def dec_reply(body):
     elif tag == 2:
         out = {"kind": "Path", "raw_length": r.f32(), "length": r.f32(), "turns": r.varint(),
                "iterations": r.varint(), "best_iteration": r.varint(), "moves": r.varint(),
-               "ticks": r.varint(), "raw_cells": r.varint(), "origin": ("cold", "warm", "reused")[min(r.byte(), 2)]}
+               "ticks": r.varint(), "raw_cells": r.varint(), "origin": ("cold", "warm", "reused", "repaired")[min(r.byte(), 3)]}
         w = r.bytes()
         out["waypoints"] = [struct.unpack_from("<HH", w, i) for i in range(0, len(w), 4)]
         out["directions"] = list(r.bytes())

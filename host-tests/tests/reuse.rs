@@ -326,7 +326,7 @@ fn reused_answers_are_never_beaten(
     let Some(a) = robot.plan(here, true) else {
         return Ok(false);
     };
-    if a.origin != Origin::Reused {
+    if a.origin != Origin::Reused && a.origin != Origin::Repaired {
         return Ok(false);
     }
     assert_valid(&robot.map, &a, here, g);
@@ -365,6 +365,78 @@ proptest! {
     ) {
         reused_answers_are_never_beaten(map, s, g, at, flips)?;
     }
+}
+
+proptest! {
+    #![proptest_config(gen::config(128))]
+    /// Large maps (more than 1,024 cells), cells blocked on and beside the path: repaired
+    /// answers are valid and no cleared cell beats them either.
+    #[test]
+    fn repaired_answers_are_valid_and_never_beaten(
+        (map, s, g) in gen::case(56),
+        at in 0usize..64,
+        flips in proptest::collection::vec((0usize..64, -1i64..=1, -1i64..=1, any::<bool>()), 1..5),
+    ) {
+        reused_answers_are_never_beaten(map, s, g, at, flips)?;
+    }
+}
+
+/// 120 x 120 open cells with a few blocks off the straight line.
+fn open_map() -> Map {
+    let mut m = Map::empty(120, 120);
+    for (x0, y0) in [(30u16, 20u16), (70, 90), (20, 80), (95, 30)] {
+        for y in y0..y0 + 6 {
+            for x in x0..x0 + 6 {
+                m.set(Point::new(x, y), true);
+            }
+        }
+    }
+    m
+}
+
+#[test]
+fn a_wall_across_the_path_on_a_large_map_is_repaired() {
+    let (s, g) = (Point::new(5, 60), Point::new(114, 58));
+    let mut robot = Robot::new(open_map(), g, Params::default());
+    let first = robot.plan(s, true).expect("first plan");
+    let here = first.raw[8];
+    // A wall of 9 cells across the path where it crosses x = 60.
+    let c = *first
+        .raw
+        .iter()
+        .find(|p| p.x == 60)
+        .expect("crosses x = 60");
+    let wall: Vec<Point> = (c.y - 4..=c.y + 4).map(|y| Point::new(60, y)).collect();
+    robot.change(&wall, true);
+    let a = robot.plan(here, true).expect("repaired");
+    assert_eq!(a.origin, Origin::Repaired);
+    assert_eq!(a.moves, 0);
+    assert_valid(&robot.map, &a, here, g);
+    let opt = opt8(&robot.map, here, g).unwrap();
+    assert!(
+        f64::from(a.raw_length) <= opt * 1.01,
+        "raw {} opt8 {opt}",
+        a.raw_length
+    );
+    // And the next replan, further on and with nothing changed, reuses the repaired answer.
+    let on = a.raw[5];
+    let b = robot.plan(on, true).expect("reused");
+    assert_eq!(b.origin, Origin::Reused);
+    assert_valid(&robot.map, &b, on, g);
+}
+
+#[test]
+fn a_wall_without_a_detour_in_the_box_runs_the_colony() {
+    let (s, g) = (Point::new(5, 60), Point::new(114, 58));
+    let mut robot = Robot::new(open_map(), g, Params::default());
+    let first = robot.plan(s, true).expect("first plan");
+    let here = first.raw[8];
+    // A wall down the map but for a gap at the top, far outside any box around the path.
+    let wall: Vec<Point> = (3..120).map(|y| Point::new(60, y)).collect();
+    robot.change(&wall, true);
+    let a = robot.plan(here, true).expect("planned");
+    assert_eq!(a.origin, Origin::Warm);
+    assert_valid(&robot.map, &a, here, g);
 }
 
 #[test]

@@ -190,12 +190,14 @@ fn obstacle(
 pub struct Summary {
     /// Replans (updates answered).
     pub replans: usize,
-    /// Answers by kind: cold, warm, reused.
+    /// Answers by kind: cold, warm, reused, repaired.
     pub cold: usize,
     /// See `cold`.
     pub warm: usize,
     /// See `cold`.
     pub reused: usize,
+    /// See `cold`.
+    pub repaired: usize,
     /// Device instructions over all replans (ticks x 1000 under `-icount shift=0`), if a device
     /// answered.
     pub instructions: Option<u64>,
@@ -221,6 +223,7 @@ pub fn summary(d: &Drive, hz: f64, clock_hz: f64) -> Summary {
             ohaca::planner::Origin::Cold => s.cold += 1,
             ohaca::planner::Origin::Warm => s.warm += 1,
             ohaca::planner::Origin::Reused => s.reused += 1,
+            ohaca::planner::Origin::Repaired => s.repaired += 1,
         }
         s.moves += st.plan.moves;
         instructions = match (instructions, st.plan.ticks) {
@@ -267,9 +270,12 @@ mod tests {
         }
         let sum = summary(&a, s.hz, 100e6);
         assert_eq!(sum.replans, a.steps.len() - 1);
-        assert_eq!(sum.cold + sum.warm + sum.reused, sum.replans);
+        assert_eq!(sum.cold + sum.warm + sum.reused + sum.repaired, sum.replans);
         assert!(sum.reused > sum.replans / 2, "{sum:?}");
-        assert!(sum.warm > 0, "an obstacle on the path makes a run: {sum:?}");
+        assert!(
+            sum.warm + sum.repaired > 0,
+            "an obstacle on the path makes a run or a repair: {sum:?}"
+        );
         assert_eq!(sum.instructions, None, "the host core has no ticks");
         // Cold: every answer a run.
         let mut p = HostPlanner::new(Params::default());

@@ -5,7 +5,8 @@
 //! by one green; the robot's trail blue, the plan it follows orange (raw path light, smoothed
 //! waypoints dark), the plan it dropped light grey; the robot a blue square, the goal a black one.
 //! A bar across the top of each panel says what answered the plan: grey a cold run, orange a
-//! warm run (the colony kept), teal the rest of the last answer (reused, no run).
+//! warm run (the colony kept), teal the rest of the last answer (reused, no run),
+//! purple the rest with a local detour (repaired, no run).
 
 use std::path::Path;
 
@@ -29,6 +30,7 @@ const GAP: u32 = 8;
 const MARK_COLD: Rgb<u8> = Rgb([120, 120, 120]);
 const MARK_WARM: Rgb<u8> = Rgb([250, 150, 0]);
 const MARK_REUSED: Rgb<u8> = Rgb([0, 160, 170]);
+const MARK_REPAIRED: Rgb<u8> = Rgb([150, 60, 200]);
 
 /// The bar's colour for a plan's origin.
 pub fn mark(origin: ohaca::planner::Origin) -> Rgb<u8> {
@@ -36,6 +38,7 @@ pub fn mark(origin: ohaca::planner::Origin) -> Rgb<u8> {
         ohaca::planner::Origin::Cold => MARK_COLD,
         ohaca::planner::Origin::Warm => MARK_WARM,
         ohaca::planner::Origin::Reused => MARK_REUSED,
+        ohaca::planner::Origin::Repaired => MARK_REPAIRED,
     }
 }
 

@@ -30,6 +30,7 @@
 pub mod arena;
 mod params;
 mod plan;
+mod repair;
 mod reuse;
 mod run;
 mod warm;
@@ -37,6 +38,7 @@ mod workspace;
 
 pub use params::{Algorithm, Params};
 pub use plan::{CurvePoint, Origin, Plan, RawPath};
+pub use repair::{longest_detour, MARGIN as REPAIR_MARGIN};
 pub use reuse::reuse;
 pub use run::{Run, REFINE_GAIN};
 pub use warm::{Area, Memory, FREED, REPAIR_RADIUS};

@@ -33,6 +33,10 @@ pub enum Origin {
     /// `2`: no run: the rest of the previous answer from the robot's cell, checked on the map as
     /// it is now, because no change since can shorten it or blocks it ([`super::reuse`]).
     Reused,
+    /// `3`: no run: the rest of the previous answer with a local detour around what blocks it
+    /// (exact A* in a box, smoothed again), checked whole on the map as it is now and against
+    /// every cleared cell ([`super::reuse`], large maps).
+    Repaired,
 }
 
 impl Origin {
@@ -41,12 +45,13 @@ impl Origin {
         self != Origin::Cold
     }
 
-    /// The name used in logs and tables: `cold`, `warm`, `reused`.
+    /// The name used in logs and tables: `cold`, `warm`, `reused`, `repaired`.
     pub fn name(self) -> &'static str {
         match self {
             Origin::Cold => "cold",
             Origin::Warm => "warm",
             Origin::Reused => "reused",
+            Origin::Repaired => "repaired",
         }
     }
 }

@@ -88,21 +88,6 @@ pub fn reuse<'a>(
         p = neighbour(p, d);
     }
     let at = at?;
-    // 2. The rest of the raw path, move by move on the map as it is now.
-    let rest = tour.get(at..)?;
-    let (mut straight, mut diagonal) = (0u32, 0u32);
-    let mut p = start;
-    for &d in rest {
-        p = grid.step(p, d)?;
-        if is_diagonal(d) {
-            diagonal = diagonal.wrapping_add(1);
-        } else {
-            straight = straight.wrapping_add(1);
-        }
-    }
-    if p != goal {
-        return None;
-    }
     // The waypoints after the segment nearest the robot.
     let wps: &[Point] = ws.points.get(first..end)?;
     let mut entry = nearest_segment(wps, start)?;
@@ -113,29 +98,43 @@ pub fn reuse<'a>(
             entry = entry.wrapping_add(1);
         }
     }
+    // 2. The rest of the raw path, move by move on the map as it is now ...
+    let rest = tour.get(at..)?;
+    let (mut straight, mut diagonal) = (0u32, 0u32);
+    let mut p = Some(start);
+    for &d in rest {
+        p = p.and_then(|p| grid.step(p, d));
+        if is_diagonal(d) {
+            diagonal = diagonal.wrapping_add(1);
+        } else {
+            straight = straight.wrapping_add(1);
+        }
+    }
     // ... every segment clear, the robot's first one included; their length summed as
     // [`crate::geometry::polyline_length`] sums the answer's waypoints (left to right from 0), so it is the
     // length a run would report for them.
     let mut prev = start;
     let mut polyline = 0.0f32;
+    let mut clear = p == Some(goal);
     for &w in wps.get(entry..)? {
-        if !segment_clear(grid, prev, w) {
-            return None;
+        if !clear || !segment_clear(grid, prev, w) {
+            clear = false;
+            break;
         }
         polyline += distance(prev, w);
         prev = w;
+    }
+    if !clear {
+        // Blocked: repaired around what blocks it on large maps, else planned.
+        return super::repair::repair(grid, start, goal, params, ws, memory, answer, at, entry);
     }
     // 3. The lengths, against every cleared rectangle's lower bounds.
     let raw_length = steps_length(straight, diagonal);
     // Without smoothing a run reports the raw length (`Run::finish`).
     let smoothed = params.algorithm == Algorithm::Ohaca && params.smoothing != SmoothingKind::None;
     let length = if smoothed { polyline } else { raw_length };
-    for area in memory.freed.areas() {
-        let euclid = box_distance(start, area) + box_distance(goal, area) - SLACK;
-        let oct = box_octile(start, area) + box_octile(goal, area) - SLACK;
-        if oct < raw_length || euclid < length {
-            return None;
-        }
+    if !cannot_shorten(memory, start, goal, raw_length, length) {
+        return None;
     }
     // The robot's cell goes into the slot before the entry: a waypoint it has passed.
     let k0 = first.wrapping_add(entry).checked_sub(1)?;
@@ -166,6 +165,22 @@ pub fn reuse<'a>(
         origin: Origin::Reused,
         curve: &[],
         params: *params,
+    })
+}
+
+/// Rule 3: no rectangle of cells cleared since the answer was planned can give a path from
+/// `start` to `goal` shorter than `raw_length` (octile) or `length` (Euclidean).
+pub(super) fn cannot_shorten(
+    memory: &Memory,
+    start: Point,
+    goal: Point,
+    raw_length: f32,
+    length: f32,
+) -> bool {
+    memory.freed.areas().all(|area| {
+        let euclid = box_distance(start, area) + box_distance(goal, area) - SLACK;
+        let oct = box_octile(start, area) + box_octile(goal, area) - SLACK;
+        oct >= raw_length && euclid >= length
     })
 }
 
@@ -227,8 +242,9 @@ fn box_distance(p: Point, area: Area) -> f32 {
 /// Octile distance from `p` to the nearest cell of `area` (0 inside).
 fn box_octile(p: Point, area: Area) -> f32 {
     let q = Point::new(
-        p.x.clamp(area.min.x, area.max.x),
-        p.y.clamp(area.min.y, area.max.y),
+        // Not `clamp`: it panics on `min > max`, which an `Area` never has.
+        p.x.max(area.min.x).min(area.max.x),
+        p.y.max(area.min.y).min(area.max.y),
     );
     octile(p, q)
 }

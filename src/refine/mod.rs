@@ -637,5 +637,64 @@ impl Refiner {
     }
 }
 
+/// The exact shortest 8-connected path from `from` to `to` inside a box around the cells
+/// `lo..=hi` (a bounding box: `lo` its top-left, `hi` its bottom-right corner, both ends inside),
+/// grown by `margin` cells and then into whatever else `scratch` holds (as a local search window
+/// is, [`MAX_SIDE`] a side at most, clipped to the map). Writes its cells, `from` first and `to`
+/// last, to `out` and returns how many; `None` when the box does not fit the scratch, no path
+/// inside it exists, or `out` is too short. Used by [`crate::planner::reuse`] to repair a kept
+/// answer around a new obstacle ([`crate::planner`]'s `repair`).
+pub(crate) fn detour(
+    grid: &Grid<'_>,
+    from: Point,
+    to: Point,
+    (lo, hi): (Point, Point),
+    margin: usize,
+    scratch: &mut Scratch<'_>,
+    out: &mut [Point],
+) -> Option<usize> {
+    let shape = Shape {
+        cells: scratch.cells(),
+        margin,
+        min_side: 1,
+        map_w: usize::from(grid.width()),
+        map_h: usize::from(grid.height()),
+    };
+    let ex = usize::from(hi.x.checked_sub(lo.x)?).saturating_add(1);
+    let ey = usize::from(hi.y.checked_sub(lo.y)?).saturating_add(1);
+    if !shape.fits(ex, ey) {
+        return None;
+    }
+    let (bw, bh) = shape.dims(ex, ey);
+    let bbox = Box2 {
+        x0: place(lo.x, ex, shape.map_w, bw),
+        y0: place(lo.y, ey, shape.map_h, bh),
+        w: bw,
+        h: bh,
+    };
+    search(grid, &bbox, from, to, scratch, &mut Budget::unlimited())?;
+    let ti = bbox.local(to)?;
+    // Count the steps back to `from` (at most one per box cell), then write them back to front.
+    let cells = bbox.cells();
+    let (mut steps, mut i, mut p) = (0usize, ti, to);
+    while p != from {
+        if steps >= cells {
+            return None;
+        }
+        (p, i) = pred(grid, &bbox, scratch, p, i)?;
+        steps = steps.wrapping_add(1);
+    }
+    let n = steps.checked_add(1)?;
+    let cells_out = out.get_mut(..n)?;
+    let (mut i, mut p) = (ti, to);
+    for slot in cells_out.iter_mut().rev() {
+        *slot = p;
+        if p != from {
+            (p, i) = pred(grid, &bbox, scratch, p, i)?;
+        }
+    }
+    Some(n)
+}
+
 #[cfg(test)]
 mod tests;

@@ -340,8 +340,8 @@ fn stream_line(name: &str, s: &Summary, clock_mhz: f64) -> String {
         _ => format!("{} ant moves", s.moves),
     };
     format!(
-        "stream {name}: {} replans in {:.1} s: {} reused, {} warm, {} cold; {cost}\n",
-        s.replans, s.seconds, s.reused, s.warm, s.cold
+        "stream {name}: {} replans in {:.1} s: {} reused, {} repaired, {} warm, {} cold; {cost}\n",
+        s.replans, s.seconds, s.reused, s.repaired, s.warm, s.cold
     )
 }
 
