@@ -47,15 +47,20 @@ pub use layout::{lend, take, MapBuf, PlanStorage, BYTES, MAP_INIT};
 #[cfg(not(feature = "twin-h743"))]
 #[cfg(not(feature = "board-stm32h743"))]
 mod layout {
+    use ohaca::board::Layout;
     use ohaca::grid::Grid;
-    use ohaca::planner::arena::{self, F411_WORDS};
+    use ohaca::planner::arena;
     use ohaca::planner::Workspace;
     use static_cell::ConstStaticCell;
 
+    use crate::firmware::board::BOARD;
     use crate::firmware::state::{MAP_BYTES, PLAN_CELLS, PLAN_STEPS};
 
-    /// The arena's words (`ohaca::planner::arena::F411_WORDS`).
-    const WORDS: usize = F411_WORDS;
+    /// The arena's words: the board's (`ohaca::board::F411`'s 25,856).
+    const WORDS: usize = match BOARD.layout {
+        Layout::Arena { words } => words,
+        Layout::Separate { .. } => 0,
+    };
     // Every map the device takes fits the arena at full resolution, and its map bytes are the
     // arena's first words (what the receiver writes).
     const _: () = assert!(arena::capacity(WORDS) >= PLAN_CELLS);
@@ -125,12 +130,13 @@ mod layout {
     use static_cell::ConstStaticCell;
 
     use ohaca::bitmap::words;
+    use ohaca::board::Layout;
     use ohaca::grid::{Dir, Point};
     use ohaca::pheromone::BLOCKS;
     use ohaca::planner::{Buffers, Workspace};
     use ohaca::route::GUIDE_BLOCKS;
-    use ohaca::tighten::hash_words;
 
+    use crate::firmware::board::BOARD;
     use crate::firmware::state::{MAP_BYTES, PLAN_CELLS, PLAN_STEPS};
 
     /// The map buffer behind `state::MAP`'s lock: the [`MAP`] static, lent to it once by
@@ -160,18 +166,19 @@ mod layout {
     const WORDS: usize = words(PLAN_CELLS);
     /// Entries of each tour and of the path cells: paths of up to [`PLAN_STEPS`] steps.
     const STEPS: usize = PLAN_STEPS + 1;
+    /// Links and the move table's cells, from the board's description (`ohaca::board::H743`).
+    const SEPARATE: (usize, usize) = match BOARD.layout {
+        Layout::Separate { links, moves } => (links, moves),
+        Layout::Arena { .. } => (0, 0),
+    };
     /// Links: tightening's smallest hash table for the longest path (`ohaca::tighten::hash_words`:
     /// 32,768 half-word slots for 16,385 cells, a load factor of up to 2/3; one of 1/2 would
     /// need 65,536), and at least the coarse route's blocks (its heap): 16,384 words, all of
-    /// SRAM4. The host mirrors it (`host/tests/common/qemu.rs`, `core_plan_steps`).
-    const LINKS: usize = if hash_words(STEPS) > GUIDE_BLOCKS {
-        hash_words(STEPS)
-    } else {
-        GUIDE_BLOCKS
-    };
-    const _: () = assert!(4 * LINKS <= 65_536);
+    /// SRAM4. The host plans in the same (`ohaca plan --board h743`).
+    const LINKS: usize = SEPARATE.0;
+    const _: () = assert!(LINKS >= GUIDE_BLOCKS && 4 * LINKS <= 65_536);
     /// The move table for maps of up to this many cells (larger maps compute moves on the fly).
-    const MOVES: usize = 1024;
+    const MOVES: usize = SEPARATE.1;
 
     /// Memory the startup code does not initialise (a NOLOAD section): [`Region::fill`] writes
     /// every element before the memory is lent out, once.
