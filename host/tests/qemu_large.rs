@@ -22,7 +22,7 @@ use ohaca_host::replan::{DevicePlanner, HostPlanner, Planned, Planner};
 use ohaca_host::Map;
 use qemu::{assert_core_path, core_plan, have_qemu, longest_scenario, maps, Qemu};
 
-/// The F411's capacity (`src/firmware/board/mod.rs`, `SMALL`).
+/// The F411's capacity (`ohaca::board::F411`).
 const CELLS: u32 = 262_144;
 const STEPS: u32 = 2047;
 
