@@ -14,7 +14,8 @@
 //! The device's board is known from the capacity in Hello (`ohaca::board::Board::with_capacity`):
 //! when it plans the map in another layout than `ohaca plan` does by default (the STM32F411's
 //! compact one, on maps of more than 68,256 cells), a note on stderr says so and names the
-//! `ohaca plan --board` that gives the device's path.
+//! `ohaca plan --board` that gives the device's path (not for a map fitted to the device, which
+//! has its own note).
 //!
 //! `--goals FILE` plans many requests over one connection, pipelined, and prints one JSON line
 //! per request, in file order. Each line of the file is `SX,SY GX,GY` (start and goal) or
@@ -397,7 +398,9 @@ impl Sender {
     fn talk<T: Transport>(&mut self, args: &Args, mut link: Link<T>) -> Result<u8, String> {
         let info = link.hello().map_err(|e| self.fail(e))?;
         self.fit(args, &info)?;
-        if let Some(note) = layout_note(&info, &self.map) {
+        // A fitted map has its note already, and `plan --board` of the original map cannot
+        // reproduce a path on the fitted one.
+        if let (None, Some(note)) = (&self.fitted, layout_note(&info, &self.map)) {
             eprintln!("note: {note}");
         }
         let fail = |e: LinkError| self.fail(e);
