@@ -42,6 +42,11 @@
 
 pub use layout::{lend, take, MapBuf, PlanStorage, BYTES, MAP_INIT};
 
+/// The lock the map buffer lives behind (`state::MAP`), which [`take`] lends the map to on the
+/// boards whose map is a static of its own.
+pub type MapLock =
+    embassy_sync::mutex::Mutex<embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex, MapBuf>;
+
 /// The map and the planner's buffers in one arena behind the map's lock (STM32F411 and the
 /// default QEMU board).
 #[cfg(not(feature = "twin-h743"))]
@@ -54,7 +59,7 @@ mod layout {
     use static_cell::ConstStaticCell;
 
     use crate::firmware::board::BOARD;
-    use crate::firmware::state::{MAP_BYTES, PLAN_CELLS, PLAN_STEPS};
+    use crate::firmware::limits::{MAP_BYTES, PLAN_CELLS, PLAN_STEPS};
 
     /// The arena's words: the board's (`ohaca::board::F411`'s 25,856).
     const WORDS: usize = match BOARD.layout {
@@ -112,9 +117,9 @@ mod layout {
 
     static STORAGE: ConstStaticCell<PlanStorage> = ConstStaticCell::new(PlanStorage);
 
-    /// Hand out the planner's storage (the arena is already in `state::MAP`). Call once, at
-    /// boot, before any task runs; a second call panics.
-    pub fn take() -> &'static mut PlanStorage {
+    /// Hand out the planner's storage (the arena is already the map buffer behind `_map`, the
+    /// lock `state::MAP`). Call once, at boot, before any task runs; a second call panics.
+    pub fn take(_map: &super::MapLock) -> &'static mut PlanStorage {
         STORAGE.take()
     }
 }
@@ -137,7 +142,7 @@ mod layout {
     use ohaca::route::GUIDE_BLOCKS;
 
     use crate::firmware::board::BOARD;
-    use crate::firmware::state::{MAP_BYTES, PLAN_CELLS, PLAN_STEPS};
+    use crate::firmware::limits::{MAP_BYTES, PLAN_CELLS, PLAN_STEPS};
 
     /// The map buffer behind `state::MAP`'s lock: the [`MAP`] static, lent to it once by
     /// [`take`]; empty before (nothing can read unset memory through it).
@@ -304,10 +309,11 @@ mod layout {
         ))
     }
 
-    /// Build the planner's storage from the statics and lend the map static to `state::MAP`:
-    /// the one place that does. Call once, at boot, after the board's `init` (on the STM32H743 it
-    /// enables the SRAM1-3 clocks) and before any task runs; a second call panics.
-    pub fn take() -> &'static mut PlanStorage {
+    /// Build the planner's storage from the statics and lend the map static to `map` (the map
+    /// buffer behind `state::MAP`'s lock): the one place that does. Call once, at boot, after
+    /// the board's `init` (on the STM32H743 it enables the SRAM1-3 clocks) and before any task
+    /// runs; a second call panics.
+    pub fn take(map_lock: &super::MapLock) -> &'static mut PlanStorage {
         static STORAGE: ConstStaticCell<Option<PlanStorage>> = ConstStaticCell::new(None);
         let taken = TAKEN.swap(true, Ordering::AcqRel);
         defmt::assert!(!taken, "the planner's buffers are taken once");
@@ -336,10 +342,7 @@ mod layout {
             links,
             guide,
         });
-        let mut buf = defmt::unwrap!(
-            crate::firmware::state::MAP.try_lock().ok(),
-            "the map buffer is locked at boot"
-        );
+        let mut buf = defmt::unwrap!(map_lock.try_lock().ok(), "the map buffer is locked at boot");
         buf.0 = Some(map);
         storage
     }
