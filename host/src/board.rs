@@ -16,10 +16,35 @@
 //! bound ([`differs_from_host`]).
 
 use ohaca::board::{Board, Layout, MapLayout, F411, H743};
-use ohaca::heap::HeapStorage;
+use ohaca::heap::{AllocError, HeapStorage};
 use ohaca::planner::{arena, Workspace};
 
-use crate::plan_map::PlanError;
+/// Why a board's buffers cannot plan a map.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum BoardError {
+    /// The map has more cells than the board takes.
+    #[error("the {board} board takes maps of up to {capacity} cells, not {cells}")]
+    TooLarge {
+        /// The board's name.
+        board: &'static str,
+        /// The map's cells.
+        cells: usize,
+        /// The board's most cells.
+        capacity: usize,
+    },
+    /// The buffers could not be allocated.
+    #[error(transparent)]
+    Storage(#[from] AllocError),
+    /// The core refused the layout (`ohaca::planner::arena::carve`).
+    #[error("{0}")]
+    Core(ohaca::Error),
+}
+
+impl From<ohaca::Error> for BoardError {
+    fn from(e: ohaca::Error) -> Self {
+        BoardError::Core(e)
+    }
+}
 
 /// A `--board` value.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -37,20 +62,6 @@ impl BoardArg {
             BoardArg::F411 => F411,
             BoardArg::H743 => H743,
         }
-    }
-}
-
-/// Something that lends the planner a workspace for a map: the host's [`HeapStorage`] or a
-/// board's buffers ([`BoardStorage`]).
-pub trait Lend {
-    /// A workspace for a map of `cells` cells and runs of up to `iterations` iterations.
-    fn lend(&mut self, cells: usize, iterations: usize) -> Result<Workspace<'_>, PlanError>;
-}
-
-impl Lend for HeapStorage {
-    fn lend(&mut self, cells: usize, iterations: usize) -> Result<Workspace<'_>, PlanError> {
-        self.ensure(cells, iterations)?;
-        Ok(self.workspace())
     }
 }
 
@@ -72,11 +83,11 @@ enum Buffers {
 }
 
 impl BoardStorage {
-    /// `board`'s buffers for maps of `cells` cells; [`PlanError::TooLarge`] when the board does
+    /// `board`'s buffers for maps of `cells` cells; [`BoardError::TooLarge`] when the board does
     /// not take such a map.
-    pub fn new(board: Board, cells: usize, iterations: usize) -> Result<Self, PlanError> {
+    pub fn new(board: Board, cells: usize, iterations: usize) -> Result<Self, BoardError> {
         if board.plans(cells).is_none() {
-            return Err(PlanError::TooLarge {
+            return Err(BoardError::TooLarge {
                 board: board.name,
                 cells,
                 capacity: board.cells,
@@ -100,7 +111,7 @@ impl BoardStorage {
     /// Like [`BoardStorage::new`], but a map the board does not take gets heap storage with the
     /// board's path bound instead of an error, as long as it fits the host (`ohaca replan` and
     /// `ohaca ros --host` without `--board`: the STM32F411's layout where it applies).
-    pub fn lenient(board: Board, cells: usize, iterations: usize) -> Result<Self, PlanError> {
+    pub fn lenient(board: Board, cells: usize, iterations: usize) -> Result<Self, BoardError> {
         let fits_arena = match board.layout {
             Layout::Arena { words } => cells <= arena::capacity(words),
             Layout::Separate { .. } => board.plans(cells).is_some(),
@@ -136,7 +147,7 @@ impl BoardStorage {
     /// A workspace for a run on a map of the storage's size: the arena carved again (so what a
     /// previous run left in it, the colony of a warm start, stays where it was), or the heap
     /// buffers.
-    pub fn workspace(&mut self) -> Result<Workspace<'_>, PlanError> {
+    pub fn workspace(&mut self) -> Result<Workspace<'_>, BoardError> {
         match &mut self.buffers {
             Buffers::Arena(words) => {
                 Ok(arena::carve(words, self.cells, self.board.max_steps)?.workspace)
@@ -144,10 +155,10 @@ impl BoardStorage {
             Buffers::Heap(h) => Ok(h.workspace()),
         }
     }
-}
 
-impl Lend for BoardStorage {
-    fn lend(&mut self, cells: usize, iterations: usize) -> Result<Workspace<'_>, PlanError> {
+    /// A workspace for a map of `cells` cells: the storage made again for that size when it
+    /// was for another.
+    pub fn lend(&mut self, cells: usize, iterations: usize) -> Result<Workspace<'_>, BoardError> {
         if cells != self.cells {
             *self = BoardStorage::new(self.board, cells, iterations)?;
         }

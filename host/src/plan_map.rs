@@ -9,11 +9,12 @@ use std::time::Instant;
 
 use ohaca::{Error, Params, Point, Run};
 
-use crate::board::{BoardStorage, Lend};
+use crate::board::{BoardError, BoardStorage};
 use crate::map::Map;
 use crate::output::PlanReport;
 use ohaca::board::Board;
 use ohaca::heap::{AllocError, HeapStorage};
+use ohaca::planner::Workspace;
 
 /// Why a request could not be planned at all (as opposed to "no path").
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
@@ -39,6 +40,44 @@ pub enum PlanError {
 impl From<Error> for PlanError {
     fn from(e: Error) -> Self {
         PlanError::Core(e)
+    }
+}
+
+impl From<BoardError> for PlanError {
+    fn from(e: BoardError) -> Self {
+        match e {
+            BoardError::TooLarge {
+                board,
+                cells,
+                capacity,
+            } => PlanError::TooLarge {
+                board,
+                cells,
+                capacity,
+            },
+            BoardError::Storage(e) => PlanError::Storage(e),
+            BoardError::Core(e) => PlanError::Core(e),
+        }
+    }
+}
+
+/// Something that lends the planner a workspace for a map: the host's [`HeapStorage`] or a
+/// board's buffers ([`BoardStorage`]).
+pub trait Lend {
+    /// A workspace for a map of `cells` cells and runs of up to `iterations` iterations.
+    fn lend(&mut self, cells: usize, iterations: usize) -> Result<Workspace<'_>, PlanError>;
+}
+
+impl Lend for HeapStorage {
+    fn lend(&mut self, cells: usize, iterations: usize) -> Result<Workspace<'_>, PlanError> {
+        self.ensure(cells, iterations)?;
+        Ok(self.workspace())
+    }
+}
+
+impl Lend for BoardStorage {
+    fn lend(&mut self, cells: usize, iterations: usize) -> Result<Workspace<'_>, PlanError> {
+        Ok(BoardStorage::lend(self, cells, iterations)?)
     }
 }
 

@@ -11,10 +11,9 @@ use std::time::Instant;
 
 use ohaca::{Error, Params, Point, Run};
 
-use crate::board::Lend;
 use crate::map::Map;
 use crate::output::PlanReport;
-use crate::plan_map::PlanError;
+use crate::plan_map::{Lend, PlanError};
 
 /// A run's report with its convergence curve and, if asked for, its pheromone.
 #[derive(Clone, Debug, PartialEq)]

@@ -9,10 +9,11 @@
 use std::path::PathBuf;
 
 use ohaca::Algorithm;
-use ohaca_host::board::{BoardArg, BoardStorage, Lend};
+use ohaca_host::board::{BoardArg, BoardStorage};
 use ohaca_host::draw::{self, Layer, Scene};
 use ohaca_host::experiment::params_brief;
 use ohaca_host::input::{MapArgs, MultiParamArgs, Scenario};
+use ohaca_host::plan_map::Lend;
 use ohaca_host::trace::{cell_pheromone, plan_traced};
 use ohaca_host::{exit, HeapStorage};
 
@@ -59,7 +60,7 @@ pub fn run(args: &Args) -> u8 {
             let iterations = usize::from(base.iterations);
             match BoardStorage::new(b.board(), sc.map.cells(), iterations) {
                 Ok(s) => Box::new(s),
-                Err(e) => return bad_input(plan_error(&sc, &e)),
+                Err(e) => return bad_input(plan_error(&sc, &e.into())),
             }
         }
     };

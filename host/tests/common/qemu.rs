@@ -403,15 +403,15 @@ pub fn core_plan_on(
     goal: Point,
     params: &Params,
 ) -> Result<CorePath, ErrorReply> {
-    use ohaca_host::PlanError;
+    use ohaca_host::board::BoardError;
     let grid = map.grid().map_err(ErrorReply::from)?;
     params.validate().map_err(ErrorReply::from)?;
-    let reply = |e: PlanError| match e {
-        PlanError::Core(e) => ErrorReply::from(e),
-        PlanError::TooLarge {
+    let reply = |e: BoardError| match e {
+        BoardError::Core(e) => ErrorReply::from(e),
+        BoardError::TooLarge {
             cells, capacity, ..
         } => ErrorReply::with(ErrorCode::MapTooLarge, cells as u32, capacity as u32),
-        PlanError::Storage(e) => panic!("host storage: {e}"),
+        BoardError::Storage(e) => panic!("host storage: {e}"),
     };
     let iterations = usize::from(params.iterations);
     let mut storage =
