@@ -64,7 +64,7 @@ pub struct Args {
     /// bound; maps larger than it takes are fitted as for a device): f411 (also the default QEMU
     /// firmware) or h743 (also its QEMU twin) [default: as the f411, with heap storage on maps
     /// larger than its arena, and no fitting]
-    #[arg(long, value_enum, value_name = "BOARD", requires = "host")]
+    #[arg(long, value_enum, value_name = "BOARD", conflicts_with_all = ["tcp", "serial"])]
     pub board: Option<BoardArg>,
     /// Plan on a device on a TCP port, e.g. QEMU's UART (scripts/qemu-serve.sh): HOST:PORT
     #[arg(long, value_name = "HOST:PORT")]

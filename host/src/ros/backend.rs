@@ -299,6 +299,23 @@ mod tests {
     }
 
     #[test]
+    fn the_host_core_as_a_board_reports_its_capacity_and_refuses_more() {
+        let mut b = HostBackend::on(Params::default(), ohaca::board::F411);
+        let cap = b.capacity().unwrap().unwrap();
+        assert_eq!(
+            (cap.cells, cap.max_side, cap.max_steps),
+            (262_144, 4096, 2047)
+        );
+        assert!(b.describe().contains("f411"));
+        assert!(matches!(
+            b.upload(&Map::from_fn(512, 513, |_, _| false)),
+            Err(BackendError::Refused(_))
+        ));
+        b.upload(&Map::from_fn(10, 10, |_, _| false)).unwrap();
+        assert!(b.plan(Point::new(0, 0), Point::new(9, 9), false).is_ok());
+    }
+
+    #[test]
     fn an_unreachable_device_is_an_error_not_a_panic() {
         let connect: Connect<std::net::TcpStream> =
             Box::new(|| Link::tcp("127.0.0.1:1", std::time::Duration::from_millis(200)));
