@@ -2,7 +2,8 @@
 # The main job, end to end: build the firmware and the host tool, boot the firmware in QEMU
 # (mps2-an386, Cortex-M4) with its UART on a local TCP port, send it the complex-26 map and the
 # request (0,0) -> (25,25) with `ohaca send`, and show the path it planned. Then check that the
-# device's path is bit-identical to the host's, draw it into demo-path.png (if `ohaca render`
+# device's path is bit-identical to the host's (`ohaca plan --board f411`: the default QEMU
+# firmware is the STM32F411's, arena and layout included, so any map it takes), draw it into demo-path.png (if `ohaca render`
 # exists), and print the firmware's boot log (if defmt-print is installed). QEMU is stopped on
 # exit, whatever happens. Needs no input.
 #
@@ -95,10 +96,10 @@ if [ "$status" -gt 1 ]; then
   exit "$status"
 fi
 
-step "check: the device's path against the host's (same planner, same seed)"
+step "check: the device's path against the host's (ohaca plan --board f411: same planner, layout and seed)"
 "$ohaca" send --tcp "127.0.0.1:$port" --map "$map" "$sflag" "$start" "$gflag" "$goal" \
   "${extra[@]}" --json </dev/null >"$tmp/device.json" || true
-"$ohaca" plan --map "$map" "$sflag" "$start" "$gflag" "$goal" "${extra[@]}" --json \
+"$ohaca" plan --board f411 --map "$map" "$sflag" "$start" "$gflag" "$goal" "${extra[@]}" --json \
   </dev/null >"$tmp/host.json" || true
 # Everything but the timings and the device's extra keys must be equal, f32 digits included.
 strip() { sed -E 's/"elapsed_us":[0-9]+,//; s/,"ticks":[0-9]+//; s/,"device":"[^"]*"//' "$1"; }
@@ -117,7 +118,7 @@ if "$ohaca" render --help >"$tmp/render.help" 2>/dev/null; then
       --report "$tmp/device.json" --out demo-path.png </dev/null
   else
     step "draw: demo-path.png (the host's plan, identical to the device's)"
-    "$ohaca" render --map "$map" "$sflag" "$start" "$gflag" "$goal" "${extra[@]}" \
+    "$ohaca" render --board f411 --map "$map" "$sflag" "$start" "$gflag" "$goal" "${extra[@]}" \
       --out demo-path.png </dev/null
   fi
   echo "wrote demo-path.png"

@@ -26,9 +26,8 @@
 //! `f32` lengths from [`crate::geometry::distance`]); no allocation, no panic: a buffer too
 //! short leaves the input as it was.
 
-use crate::geometry::{distance, polyline_length, segment_clear};
+use crate::geometry::{distance, drop_collinear, polyline_length, segment_clear};
 use crate::grid::{Grid, Point};
-use crate::smoothing::drop_collinear;
 
 /// Corridor half-width in cells (Chebyshev distance from the smoothed path's segments).
 pub const RADIUS: u16 = 3;

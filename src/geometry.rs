@@ -1,4 +1,6 @@
-//! Path geometry: lengths, and the segment rule every path is checked against.
+//! Path geometry: lengths, the segment rule every path is checked against, and dropping the
+//! waypoints a polyline does not need ([`drop_collinear`], shared by the smoothing, the taut
+//! path and the corridor).
 //!
 //! **The segment rule.** Cell `(x, y)` is the closed square `[x, x+1] x [y, y+1]`; a waypoint
 //! stands for its cell's centre `(x + 0.5, y + 0.5)`. A straight segment between two waypoints is
@@ -258,6 +260,56 @@ pub fn turns(points: &[Point]) -> u32 {
         }
     }
     n
+}
+
+/// True if `b` lies on the straight line from `a` to `c`, between them.
+fn collinear_between(a: Point, b: Point, c: Point) -> bool {
+    let (cross, dot) = bend(a, b, c);
+    cross == 0 && dot >= 0
+}
+
+/// Remove interior points of `pts[..n]` that lie straight between their neighbours; returns the
+/// new length. (A point on a straight segment between two kept points adds nothing, and the
+/// segment it belongs to was already checked clear, so the merged segment is clear too.)
+pub fn drop_collinear(pts: &mut [Point], n: usize) -> usize {
+    drop_middles(pts, n, collinear_between)
+}
+
+/// Keep `pts[0]` and the last point of `pts[..n]`; drop each interior point `b` for which
+/// `needless(a, b, c)` holds, with `a` the last kept point and `c` the next one. In place; returns
+/// the new length. The one filter behind [`drop_collinear`] and the smoothing's greedy merge.
+pub(crate) fn drop_middles(
+    pts: &mut [Point],
+    n: usize,
+    needless: impl Fn(Point, Point, Point) -> bool,
+) -> usize {
+    let n = n.min(pts.len());
+    if n < 3 {
+        return n;
+    }
+    // Bounds: 3 <= n <= pts.len() and 1 <= k <= i < n, so no `wrapping_` here wraps.
+    let last_i = n.wrapping_sub(1);
+    let mut k = 1usize; // pts[..k] is the output so far; pts[k-1] is the last kept point.
+    for i in 1..last_i {
+        let (Some(&a), Some(&b), Some(&c)) = (
+            pts.get(k.wrapping_sub(1)),
+            pts.get(i),
+            pts.get(i.wrapping_add(1)),
+        ) else {
+            break;
+        };
+        if !needless(a, b, c) {
+            if let Some(slot) = pts.get_mut(k) {
+                *slot = b;
+            }
+            k = k.wrapping_add(1);
+        }
+    }
+    let last = pts.get(last_i).copied();
+    if let (Some(last), Some(slot)) = (last, pts.get_mut(k)) {
+        *slot = last;
+    }
+    k.wrapping_add(1)
 }
 
 #[cfg(test)]

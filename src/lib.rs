@@ -27,6 +27,7 @@
 //! | [`refine`] | local search: the exact shortest path in a window sliding along a raw path |
 //! | [`astar`] | the exact A* baseline: a whole-map search in 4 bits a cell plus a heap (not used by the planner) |
 //! | [`planner`] | parameters, caller-provided storage, the iteration loop and the result |
+//! | [`board`] | what each board's firmware holds (cells, longest path, buffer layout), described once for the firmware and the host |
 //! | `heap` | (feature `alloc`) the planner's storage on the heap, sized at run time |
 //! | `protocol` | (feature `protocol`) the wire protocol between a host and the firmware |
 //! | [`rng`] | the small seedable generator every platform shares |
@@ -101,6 +102,7 @@ mod named;
 pub mod ant;
 pub mod astar;
 pub mod bitmap;
+pub mod board;
 pub mod corridor;
 pub mod dir;
 pub mod error;

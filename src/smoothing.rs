@@ -24,7 +24,8 @@
 //!
 //! All three work in place on the caller's buffers and keep collinear points out of the output.
 
-use crate::geometry::{bend, distance, segment_clear};
+pub use crate::geometry::drop_collinear;
+use crate::geometry::{distance, drop_middles, segment_clear};
 use crate::grid::{Grid, Point};
 use crate::named::named;
 
@@ -51,56 +52,6 @@ named!(
     "All three, default first.",
     [Shortest => "shortest", Greedy => "greedy", None => "none"]
 );
-
-/// True if `b` lies on the straight line from `a` to `c`, between them.
-fn collinear_between(a: Point, b: Point, c: Point) -> bool {
-    let (cross, dot) = bend(a, b, c);
-    cross == 0 && dot >= 0
-}
-
-/// Remove interior points of `pts[..n]` that lie straight between their neighbours; returns the
-/// new length. (A point on a straight segment between two kept points adds nothing, and the
-/// segment it belongs to was already checked clear, so the merged segment is clear too.)
-pub fn drop_collinear(pts: &mut [Point], n: usize) -> usize {
-    drop_middles(pts, n, collinear_between)
-}
-
-/// Keep `pts[0]` and the last point of `pts[..n]`; drop each interior point `b` for which
-/// `needless(a, b, c)` holds, with `a` the last kept point and `c` the next one. In place; returns
-/// the new length. The one filter behind [`drop_collinear`] and the greedy merge.
-fn drop_middles(
-    pts: &mut [Point],
-    n: usize,
-    needless: impl Fn(Point, Point, Point) -> bool,
-) -> usize {
-    let n = n.min(pts.len());
-    if n < 3 {
-        return n;
-    }
-    // Bounds: 3 <= n <= pts.len() and 1 <= k <= i < n, so no `wrapping_` here wraps.
-    let last_i = n.wrapping_sub(1);
-    let mut k = 1usize; // pts[..k] is the output so far; pts[k-1] is the last kept point.
-    for i in 1..last_i {
-        let (Some(&a), Some(&b), Some(&c)) = (
-            pts.get(k.wrapping_sub(1)),
-            pts.get(i),
-            pts.get(i.wrapping_add(1)),
-        ) else {
-            break;
-        };
-        if !needless(a, b, c) {
-            if let Some(slot) = pts.get_mut(k) {
-                *slot = b;
-            }
-            k = k.wrapping_add(1);
-        }
-    }
-    let last = pts.get(last_i).copied();
-    if let (Some(last), Some(slot)) = (last, pts.get_mut(k)) {
-        *slot = last;
-    }
-    k.wrapping_add(1)
-}
 
 /// How many raw cells back the [`SmoothingKind::Shortest`] DP looks for a cell that sees the
 /// current one (`K`).

@@ -21,9 +21,8 @@
 //! the device pull the same path taut.
 
 use crate::dir::{DX, DY};
-use crate::geometry::{distance, segment_clear};
+use crate::geometry::{distance, drop_collinear, segment_clear};
 use crate::grid::{Grid, Point};
-use crate::smoothing::drop_collinear;
 
 /// Passes over the waypoints at most (measured on the shared small maps: one to three passes
 /// change something, the rest find nothing).

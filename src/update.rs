@@ -63,31 +63,55 @@ pub fn deposit(table: &mut Table<'_>, grid: &Grid<'_>, start: Point, tour: &[Dir
     }
 }
 
-/// The wolves-distribution terms: reward the iteration's best path with `b * q / l_best` and
-/// punish its worst with `w * q / l_worst`, both added into `delta` (merged into `tau` by
-/// [`Table::evaporate_and_merge`], which clamps). Does nothing when `l_worst <= l_best`.
-#[allow(clippy::too_many_arguments)]
+/// Where [`wolves`] finds the iteration's best and worst paths, one at a time: the best first
+/// (deposited on before the worst is asked for, so a workspace that walks both ants again can
+/// use one buffer for both), then the worst. `None`: that path cannot be had, and gets nothing.
+pub trait WolfPaths {
+    /// The iteration's best path (its first ant's), as directions from the start.
+    fn best(&mut self) -> Option<&[Dir]>;
+    /// The iteration's worst path (its first ant's), asked for after the best one's deposit.
+    fn worst(&mut self) -> Option<&[Dir]>;
+}
+
+/// Both paths at hand: `(best, worst)`.
+impl WolfPaths for (&[Dir], &[Dir]) {
+    fn best(&mut self) -> Option<&[Dir]> {
+        Some(self.0)
+    }
+    fn worst(&mut self) -> Option<&[Dir]> {
+        Some(self.1)
+    }
+}
+
+/// The wolves-distribution terms: reward the iteration's best path (`best`: its length and how
+/// many ants took that length) with `b * q / l_best` and punish its worst with
+/// `w * q / l_worst`, both added into `delta` (merged into `tau` by
+/// [`Table::evaporate_and_merge`], which clamps), the best first; the paths come from `paths`.
+/// Does nothing when `l_worst <= l_best` (or `l_best <= 0`), and then says so (`false`). The
+/// colony's iteration (`planner::run`) calls it; it is the rule's one copy.
 pub fn wolves(
     delta: &mut Table<'_>,
     grid: &Grid<'_>,
     start: Point,
     q: f32,
-    best: (&[Dir], f32, u32),
-    worst: (&[Dir], f32, u32),
-) {
-    let (best_tour, l_best, b) = best;
-    let (worst_tour, l_worst, w) = worst;
-    if let Some((reward, punish)) = wolves_amounts(q, (l_best, b), (l_worst, w)) {
-        deposit(delta, grid, start, best_tour, reward);
-        deposit(delta, grid, start, worst_tour, punish);
+    (best, worst): ((f32, u32), (f32, u32)),
+    paths: &mut impl WolfPaths,
+) -> bool {
+    let Some((reward, punish)) = wolves_amounts(q, best, worst) else {
+        return false;
+    };
+    if let Some(t) = paths.best() {
+        deposit(delta, grid, start, t, reward);
     }
+    if let Some(t) = paths.worst() {
+        deposit(delta, grid, start, t, punish);
+    }
+    true
 }
 
 /// The amounts [`wolves`] deposits, in its order: `b * q / l_best` on the best path, then
-/// `-(w * q / l_worst)` on the worst; `None` when `l_worst <= l_best` (or `l_best <= 0`). A
-/// caller that has the two paths one at a time (a workspace that replays them instead of keeping
-/// them) deposits these itself, in this order, and gets [`wolves`]'s increments bit for bit.
-pub fn wolves_amounts(q: f32, best: (f32, u32), worst: (f32, u32)) -> Option<(f32, f32)> {
+/// `-(w * q / l_worst)` on the worst; `None` when `l_worst <= l_best` (or `l_best <= 0`).
+fn wolves_amounts(q: f32, best: (f32, u32), worst: (f32, u32)) -> Option<(f32, f32)> {
     let ((l_best, b), (l_worst, w)) = (best, worst);
     if l_worst <= l_best || l_best <= 0.0 {
         return None;
@@ -109,14 +133,15 @@ mod tests {
         let start = Point::new(0, 0);
         let best = [1u8, 0, 0]; // SE, E, E
         let worst = [0u8, 0, 2, 0]; // E, E, S, E
-        wolves(
+        let done = wolves(
             &mut delta,
             &g,
             start,
             1.0,
-            (&best, 2.0, 3),
-            (&worst, 4.0, 1),
+            ((2.0, 3), (4.0, 1)),
+            &mut (&best[..], &worst[..]),
         );
+        assert!(done);
         assert_eq!(delta.get(Point::new(0, 0), 1), 1.5);
         assert_eq!(delta.get(Point::new(0, 0), 0), -0.25);
         // An edge on both paths gets both: (1,1)->E? best walks (1,1)->(2,1)->(3,1); worst walks
@@ -125,7 +150,15 @@ mod tests {
         // Equal lengths: no wolves term.
         let mut buf2 = [[0.0f32; 4]; 12];
         let mut d2 = Table::new(Blocks::new(4, 3), &mut buf2);
-        wolves(&mut d2, &g, start, 1.0, (&best, 2.0, 3), (&worst, 2.0, 1));
+        let paths = &mut (&best[..], &worst[..]);
+        assert!(!wolves(
+            &mut d2,
+            &g,
+            start,
+            1.0,
+            ((2.0, 3), (2.0, 1)),
+            paths
+        ));
         assert!(d2.entries().iter().flatten().all(|v| *v == 0.0));
     }
 }

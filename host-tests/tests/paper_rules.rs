@@ -2,7 +2,9 @@
 //!
 //! - the pheromone update (eq. 11-13) of whole iterations of [`Run::step_observed`], recomputed by
 //!   hand from the tours the ants walked, for every edge of the table, with and without the
-//!   wolves rule, with the bounds in play;
+//!   wolves rule, with the bounds in play, in a storage that keeps the iteration's best and worst
+//!   paths and in one that walks those ants again (as every firmware board does): the
+//!   production path of the wolves rule (`update::wolves`, called by the colony) both ways;
 //! - the wolves rule's reading (`docs/ALGORITHM.md`): the worst ants' deposits are withdrawn
 //!   exactly (with one worst ant, `w = 1`, its own deposit), the best ants' deposit doubled;
 //! - a map where only reinforcement finds the short route (no heuristic: `beta = 0`, or no goal
@@ -25,16 +27,22 @@ fn length((s, k): (u32, u32)) -> f64 {
     f64::from(s) + f64::from(k) * std::f64::consts::SQRT_2
 }
 
-/// Run `iterations` iterations of a fresh run; the tours of each and the table at the end.
+/// Run `iterations` iterations of a fresh run; the tours of each and the table at the end. With
+/// `replaying`, the storage has no buffers for the iteration's best and worst paths: the run
+/// walks those ants again for the wolves rule, as the devices do.
 fn run_steps(
     map: &Map,
     start: Point,
     goal: Point,
     p: &Params,
     iterations: usize,
+    replaying: bool,
 ) -> (Vec<Vec<Vec<Dir>>>, Vec<[f32; 4]>) {
     let grid = map.grid();
     let mut storage = ohaca_host_tests::heap::storage(map.cells());
+    if replaying {
+        storage = storage.replaying();
+    }
     let mut all = Vec::new();
     {
         let mut run = Run::new(&grid, start, goal, p, storage.workspace()).expect("run");
@@ -185,7 +193,8 @@ fn pheromone_update_is_eq_11_to_13_on_every_edge() {
     ];
     const STEPS: usize = 3;
     let mut tied = 0;
-    for (name, p) in cases {
+    for ((name, p), replaying) in cases.iter().flat_map(|c| [(c, false), (c, true)]) {
+        let p = *p;
         for seed in 1..=2 {
             // No early stop: every one of the STEPS iterations runs (the default's runs that
             // refine may stop after 2).
@@ -199,14 +208,15 @@ fn pheromone_update_is_eq_11_to_13_on_every_edge() {
             let mut want = vec![[f64::from(p.tau0); 4]; map.cells()];
             for k in 1..=STEPS {
                 // A fresh run of k iterations walks the same ants as a longer one.
-                let (tours, tau) = run_steps(&map, start, goal, &p, k);
+                let (tours, tau) = run_steps(&map, start, goal, &p, k, replaying);
                 want = expected_update(&map, start, &p, &want, &tours[k - 1]);
                 for (i, (g, w)) in tau.iter().zip(&want).enumerate() {
                     for s in 0..4 {
                         let (g, w) = (f64::from(g[s]), w[s]);
                         assert!(
                             (g - w).abs() <= 2e-5 * w.abs().max(1.0),
-                            "{name} seed {seed} iteration {k}: cell {:?} slot {s}: {g} vs {w}",
+                            "{name} (replaying {replaying}) seed {seed} iteration {k}: \
+                             cell {:?} slot {s}: {g} vs {w}",
                             map.point(i)
                         );
                     }
@@ -332,7 +342,7 @@ fn the_worst_ants_deposits_are_withdrawn_and_the_best_doubled() {
         algorithm: Algorithm::Haca,
         ..fork_params(Algorithm::Haca, 0.0, 0.05, 3)
     };
-    let (tours, tau) = run_steps(&map, FORK_START, FORK_GOAL, &p, 1);
+    let (tours, tau) = run_steps(&map, FORK_START, FORK_GOAL, &p, 1, false);
     let b = tours[0].iter().filter(|t| t.len() == 10).count() as f32;
     let w = tours[0].iter().filter(|t| t.len() == 18).count() as f32;
     assert_eq!(b + w, 50.0);
@@ -353,7 +363,7 @@ fn the_worst_ants_deposits_are_withdrawn_and_the_best_doubled() {
     let mut one = None;
     for seed in 1..400 {
         let p = Params { seed, ants: 3, ..p };
-        let (tours, tau) = run_steps(&map, FORK_START, FORK_GOAL, &p, 1);
+        let (tours, tau) = run_steps(&map, FORK_START, FORK_GOAL, &p, 1, false);
         if tours[0].iter().filter(|t| t.len() == 18).count() == 1 {
             one = Some((tours, tau));
             break;

@@ -12,6 +12,7 @@
 //! | --- | --- |
 //! | [`map`] | every map format (Moving AI, text grid, ROS YAML, image), one `load`, the metric frame, inflation, resampling and fitting a device |
 //! | [`args`] | command-line values shared by subcommands: `X,Y` points and the planner flags |
+//! | [`board`] | `--board`: the host core planning in a board's buffers and layout, bit for bit the device's |
 //! | [`plan_map`](mod@plan_map) | one planning run on a loaded map, timed, as a [`output::PlanReport`] |
 //! | [`output`] | the JSON report (a stable contract) and the ASCII renderer |
 //! | [`exit`] | the tool's exit codes |
@@ -50,6 +51,7 @@
 )]
 
 pub mod args;
+pub mod board;
 pub mod draw;
 pub mod dstar;
 pub mod exit;
@@ -69,4 +71,4 @@ pub use args::{parse_point, ParamArgs, Preset};
 pub use map::{Map, MapError};
 pub use ohaca::heap::HeapStorage;
 pub use output::PlanReport;
-pub use plan_map::{plan_map, plan_map_in, PlanError};
+pub use plan_map::{plan_map, plan_map_in, plan_map_on, PlanError};

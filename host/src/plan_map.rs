@@ -1,7 +1,7 @@
 //! One planning run on a loaded [`Map`], timed, turned into a [`PlanReport`].
 //!
 //! This is the step every path-producing subcommand shares: build the core's grid, lend it
-//! [`HeapStorage`], run [`ohaca::Run`] to the end, and report. "No path" is a normal outcome (a
+//! [`HeapStorage`] (or a board's buffers, `--board`: [`crate::board`]), run [`ohaca::Run`] to the end, and report. "No path" is a normal outcome (a
 //! report with `found: false`); everything else the core rejects — bad parameters, start or goal
 //! outside the map or on an obstacle — is a [`PlanError`], i.e. bad input.
 
@@ -9,9 +9,12 @@ use std::time::Instant;
 
 use ohaca::{Error, Params, Point, Run};
 
+use crate::board::{BoardError, BoardStorage};
 use crate::map::Map;
 use crate::output::PlanReport;
+use ohaca::board::Board;
 use ohaca::heap::{AllocError, HeapStorage};
+use ohaca::planner::Workspace;
 
 /// Why a request could not be planned at all (as opposed to "no path").
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
@@ -22,11 +25,59 @@ pub enum PlanError {
     /// The planner's buffers could not be allocated.
     #[error(transparent)]
     Storage(#[from] AllocError),
+    /// `--board`: the map has more cells than the board takes.
+    #[error("the {board} board takes maps of up to {capacity} cells, not {cells}")]
+    TooLarge {
+        /// The board's name.
+        board: &'static str,
+        /// The map's cells.
+        cells: usize,
+        /// The board's most cells.
+        capacity: usize,
+    },
 }
 
 impl From<Error> for PlanError {
     fn from(e: Error) -> Self {
         PlanError::Core(e)
+    }
+}
+
+impl From<BoardError> for PlanError {
+    fn from(e: BoardError) -> Self {
+        match e {
+            BoardError::TooLarge {
+                board,
+                cells,
+                capacity,
+            } => PlanError::TooLarge {
+                board,
+                cells,
+                capacity,
+            },
+            BoardError::Storage(e) => PlanError::Storage(e),
+            BoardError::Core(e) => PlanError::Core(e),
+        }
+    }
+}
+
+/// Something that lends the planner a workspace for a map: the host's [`HeapStorage`] or a
+/// board's buffers ([`BoardStorage`]).
+pub trait Lend {
+    /// A workspace for a map of `cells` cells and runs of up to `iterations` iterations.
+    fn lend(&mut self, cells: usize, iterations: usize) -> Result<Workspace<'_>, PlanError>;
+}
+
+impl Lend for HeapStorage {
+    fn lend(&mut self, cells: usize, iterations: usize) -> Result<Workspace<'_>, PlanError> {
+        self.ensure(cells, iterations)?;
+        Ok(self.workspace())
+    }
+}
+
+impl Lend for BoardStorage {
+    fn lend(&mut self, cells: usize, iterations: usize) -> Result<Workspace<'_>, PlanError> {
+        Ok(BoardStorage::lend(self, cells, iterations)?)
     }
 }
 
@@ -43,23 +94,41 @@ pub fn plan_map(
     plan_map_in(&mut storage, map, start, goal, params)
 }
 
-/// Plan in caller-provided storage (grown if it is too small), e.g. one storage for many runs.
+/// Plan from `start` to `goal` on `map` as `board`'s firmware does (`--board`: its buffers and
+/// layout, [`crate::board`]), or without one in the host's own storage ([`plan_map`]).
+pub fn plan_map_on(
+    board: Option<Board>,
+    map: &Map,
+    start: Point,
+    goal: Point,
+    params: &Params,
+) -> Result<PlanReport, PlanError> {
+    let Some(board) = board else {
+        return plan_map(map, start, goal, params);
+    };
+    params.validate()?;
+    let mut storage = BoardStorage::new(board, map.cells(), usize::from(params.iterations))?;
+    plan_map_in(&mut storage, map, start, goal, params)
+}
+
+/// Plan in caller-provided storage (a [`HeapStorage`] is grown if it is too small), e.g. one
+/// storage for many runs.
 ///
 /// Returns a report with `found: false` when the goal is unreachable (or, with
 /// [`ohaca::DeadEnd::Die`], no ant reached it), and [`PlanError`] for bad input. The time covers
 /// the core's work only (validation, flood fill, iterations, smoothing), not the allocation.
-pub fn plan_map_in(
-    storage: &mut HeapStorage,
+pub fn plan_map_in<S: Lend + ?Sized>(
+    storage: &mut S,
     map: &Map,
     start: Point,
     goal: Point,
     params: &Params,
 ) -> Result<PlanReport, PlanError> {
     params.validate()?;
-    storage.ensure(map.cells(), usize::from(params.iterations))?;
+    let ws = storage.lend(map.cells(), usize::from(params.iterations))?;
     let grid = map.grid()?;
     let t0 = Instant::now();
-    let mut run = Run::new(&grid, start, goal, params, storage.workspace())?;
+    let mut run = Run::new(&grid, start, goal, params, ws)?;
     while run.step() {}
     let iterations = run.iteration();
     match run.finish() {

@@ -30,10 +30,11 @@ use std::collections::BinaryHeap;
 
 use serde::Deserialize;
 
-use ohaca::heap::HeapStorage;
+use ohaca::board::{Board, F411};
 use ohaca::planner::{reuse, Memory, Origin, Run};
 use ohaca::{Grid, Params, Point};
 
+use crate::board::BoardStorage;
 use crate::link::{DevicePath, Link, LinkError, Transport};
 use crate::map::Map;
 
@@ -187,52 +188,66 @@ pub trait Planner {
     fn plan(&mut self, start: Point, goal: Point, warm: bool) -> Result<Planned, String>;
 }
 
-/// The host core, planning as the STM32F411 firmware does (in an arena of its size laid out by
-/// `ohaca::planner::arena::carve`, its 2,047-step path bound), so its paths are the device's bit
-/// for bit; on a map too large for that arena, with heap storage and the same path bound.
+/// The host core, planning as a board's firmware does ([`crate::board::BoardStorage`]), so its
+/// paths are the device's bit for bit. [`HostPlanner::new`] (`ohaca replan` and `ohaca ros
+/// --host` without `--board`) plans as the STM32F411 and the default QEMU firmware do (in an
+/// arena of its length laid out by `ohaca::planner::arena::carve`, its 2,047-step path bound),
+/// and on a map too large for that arena with heap storage and the same path bound;
+/// [`HostPlanner::on`] (`--board`) exactly as the board does, refusing maps it does not take.
 pub struct HostPlanner {
     map: Map,
     params: Params,
-    storage: HeapStorage,
-    /// The firmware's arena (empty: the map does not fit it, `storage` plans).
-    arena: Vec<u32>,
+    board: Board,
+    /// Refuse maps the board does not take (`--board`), rather than plan them on the heap.
+    strict: bool,
+    /// The board's buffers for the map (none before the first map).
+    storage: Option<BoardStorage>,
     memory: Memory,
 }
 
-/// The device's longest ant path (`firmware::state::PLAN_STEPS`: the STM32F411's and the default
-/// QEMU board's, Hello's `capacity.max_steps`).
-pub const DEVICE_STEPS: usize = 2047;
+/// The default QEMU firmware's longest ant path (the STM32F411's, [`ohaca::board::F411`];
+/// Hello's `capacity.max_steps`).
+pub const DEVICE_STEPS: usize = F411.max_steps;
 
 impl HostPlanner {
-    /// A planner with `params` and no map yet.
+    /// A planner with `params` and no map yet, planning as the STM32F411 does (see the type's
+    /// docs).
     pub fn new(params: Params) -> Self {
         HostPlanner {
             map: Map::from_fn(0, 0, |_, _| false),
             params,
-            storage: HeapStorage::default(),
-            arena: Vec::new(),
+            board: F411,
+            strict: false,
+            storage: None,
             memory: Memory::new(),
         }
+    }
+
+    /// A planner with `params` planning exactly as `board` does (`--board`).
+    pub fn on(params: Params, board: Board) -> Self {
+        HostPlanner {
+            board,
+            strict: true,
+            ..HostPlanner::new(params)
+        }
+    }
+
+    /// The board it plans as.
+    pub fn board(&self) -> Board {
+        self.board
     }
 }
 
 impl Planner for HostPlanner {
     fn set_map(&mut self, map: &Map) -> Result<(), String> {
-        self.map = map.clone();
-        let words = ohaca::planner::arena::F411_WORDS;
-        if map.cells() <= ohaca::planner::arena::capacity(words) {
-            self.arena = vec![0; words];
-            self.storage = HeapStorage::default();
+        let iterations = usize::from(self.params.iterations);
+        let storage = if self.strict {
+            BoardStorage::new(self.board, map.cells(), iterations)
         } else {
-            self.arena = Vec::new();
-            self.storage = HeapStorage::with_steps(
-                map.cells(),
-                DEVICE_STEPS,
-                true,
-                usize::from(self.params.iterations),
-            )
-            .map_err(|e| e.to_string())?;
-        }
+            BoardStorage::lenient(self.board, map.cells(), iterations)
+        };
+        self.storage = Some(storage.map_err(|e| e.to_string())?);
+        self.map = map.clone();
         self.memory.forget();
         Ok(())
     }
@@ -249,15 +264,14 @@ impl Planner for HostPlanner {
 
     fn plan(&mut self, start: Point, goal: Point, warm: bool) -> Result<Planned, String> {
         let grid = self.map.grid().map_err(|e| e.to_string())?;
-        let mut ws = if self.arena.is_empty() {
-            self.storage.workspace()
-        } else {
-            ohaca::planner::arena::carve(&mut self.arena, self.map.cells(), DEVICE_STEPS)
-                .map_err(|e| e.to_string())?
-                .workspace
-        };
+        let mut ws = self
+            .storage
+            .as_mut()
+            .ok_or("no map yet")?
+            .workspace()
+            .map_err(|e| e.to_string())?;
         // As the firmware does: a warm replan that no change since can shorten or block is the
-        // rest of the last answer.
+        // rest of the last answer (or its local repair).
         if warm {
             if let Some(plan) = reuse(&grid, start, goal, &self.params, &mut ws, &mut self.memory) {
                 return Ok(Planned::of(&plan, None));

@@ -2,7 +2,8 @@
 //! final pheromone table. `render` and `experiment` use it; [`crate::plan_map::plan_map_in`]
 //! stays the lean path for `plan`.
 //!
-//! The pheromone is read from the [`HeapStorage`] after the plan is turned into an owned report:
+//! The pheromone is read from the storage ([`ohaca::heap::HeapStorage`], or a board's:
+//! [`crate::board::BoardStorage`]) after the plan is turned into an owned report:
 //! the core leaves the table of the last iteration in the workspace's `tau` buffer (smoothing only
 //! uses the increment table), so nothing in the core needs to change to get it.
 
@@ -12,8 +13,7 @@ use ohaca::{Error, Params, Point, Run};
 
 use crate::map::Map;
 use crate::output::PlanReport;
-use crate::plan_map::PlanError;
-use ohaca::heap::HeapStorage;
+use crate::plan_map::{Lend, PlanError};
 
 /// A run's report with its convergence curve and, if asked for, its pheromone.
 #[derive(Clone, Debug, PartialEq)]
@@ -34,8 +34,8 @@ pub struct Traced {
 
 /// Plan like [`crate::plan_map::plan_map_in`], keeping the curve and (with `pheromone`) a copy of
 /// the final pheromone table. The time in the report covers the core's work only.
-pub fn plan_traced(
-    storage: &mut HeapStorage,
+pub fn plan_traced<S: Lend + ?Sized>(
+    storage: &mut S,
     map: &Map,
     start: Point,
     goal: Point,
@@ -43,10 +43,11 @@ pub fn plan_traced(
     pheromone: bool,
 ) -> Result<Traced, PlanError> {
     params.validate()?;
-    storage.ensure(map.cells(), usize::from(params.iterations))?;
+    let iterations_max = usize::from(params.iterations);
+    let ws = storage.lend(map.cells(), iterations_max)?;
     let grid = map.grid()?;
     let t0 = Instant::now();
-    let mut run = Run::new(&grid, start, goal, params, storage.workspace())?;
+    let mut run = Run::new(&grid, start, goal, params, ws)?;
     while run.step() {}
     let iterations = run.iteration();
     let ants_sent = u64::from(iterations) * u64::from(params.ants);
@@ -80,11 +81,13 @@ pub fn plan_traced(
         Err(e) => return Err(e.into()),
     };
     // The plan is gone; the workspace's pheromone buffer still holds the last iteration's table.
-    let pheromone = (pheromone && !no_path).then(|| {
-        let ws = storage.workspace();
+    let pheromone = if pheromone && !no_path {
+        let ws = storage.lend(map.cells(), iterations_max)?;
         let tau = ws.pheromone();
-        tau.get(..map.cells()).unwrap_or(tau).to_vec()
-    });
+        Some(tau.get(..map.cells()).unwrap_or(tau).to_vec())
+    } else {
+        None
+    };
     Ok(Traced {
         report,
         best_so_far,
@@ -135,6 +138,7 @@ mod tests {
     use super::*;
     use crate::map::Format;
     use crate::plan_map::plan_map;
+    use ohaca::heap::HeapStorage;
     use ohaca::DeadEnd;
 
     fn map() -> Map {

@@ -22,7 +22,7 @@ use ohaca_host::replan::{DevicePlanner, HostPlanner, Planned, Planner};
 use ohaca_host::Map;
 use qemu::{assert_core_path, core_plan, have_qemu, longest_scenario, maps, Qemu};
 
-/// The F411's capacity (`src/firmware/board/mod.rs`, `SMALL`).
+/// The F411's capacity (`ohaca::board::F411`).
 const CELLS: u32 = 262_144;
 const STEPS: u32 = 2047;
 
@@ -163,4 +163,105 @@ fn a_warm_replan_on_a_512x512_map_is_the_host_cores() {
         "NewYork_0_512: cold {} iterations, {} moves; warm {} iterations, {} moves",
         cold.iterations, cold.moves, warm.iterations, warm.moves
     );
+}
+
+/// `ohaca` (the binary under test) with `args`: its stdout and stderr.
+fn ohaca_cli(args: &[String]) -> (String, String) {
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_ohaca"))
+        .args(args)
+        .output()
+        .expect("run the ohaca binary");
+    let text = |b: &[u8]| String::from_utf8_lossy(b).into_owned();
+    assert!(
+        o.status.success(),
+        "ohaca {args:?}: {}\n{}",
+        o.status,
+        text(&o.stderr)
+    );
+    (text(&o.stdout), text(&o.stderr))
+}
+
+/// The keys of a plan report that the device's plan and the host's must share, float bits
+/// included (`elapsed_us`, `ticks` and `device` are not the plan's).
+fn plan_keys(json: &str) -> Vec<(String, String)> {
+    let v: serde_json::Value = serde_json::from_str(json.trim()).expect("one JSON report");
+    [
+        "found",
+        "raw",
+        "waypoints",
+        "raw_length",
+        "length",
+        "turns",
+        "iterations",
+        "best_iteration",
+        "moves",
+    ]
+    .iter()
+    .map(|k| (k.to_string(), v[*k].to_string()))
+    .collect()
+}
+
+/// Issue 29: on maps of more than 68,256 cells the STM32F411 (and this QEMU build) plans in the
+/// compact layout, which `ohaca plan` reproduces only with `--board f411`. Nav2's depot
+/// (604 x 307) and NewYork_0_512 (512 x 512) through the CLI: `ohaca send` to the QEMU firmware
+/// (whose stderr notes the layout) against `ohaca plan --board f411`, one seed each.
+#[test]
+fn send_to_the_f411_build_is_plan_board_f411_on_the_depot_and_new_york() {
+    need_qemu!();
+    let (ny_start, ny_goal) = longest_scenario("large/NewYork_0_512.map.scen");
+    let pt = |p: Point| format!("{},{}", p.x, p.y);
+    let cases = [
+        ("depot.map", "9,4".to_string(), "596,300".to_string()),
+        ("large/NewYork_0_512.map", pt(ny_start), pt(ny_goal)),
+    ];
+    let q = Qemu::tcp();
+    for (file, start, goal) in cases {
+        let path = maps().join(file);
+        let map = Map::load(&path).expect("map");
+        assert!(
+            ohaca_host::board::differs_from_host(&ohaca::board::F411, map.cells()).is_some(),
+            "{file}: the F411 plans it in its compact layout"
+        );
+        let common: Vec<String> = [
+            "--map",
+            &path.display().to_string(),
+            "--start",
+            &start,
+            "--goal",
+            &goal,
+            "--seed",
+            "1",
+            "--json",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+        let t0 = Instant::now();
+        let mut send = vec!["send".to_string(), "--tcp".into(), q.addr().into()];
+        send.extend(["--timeout".to_string(), "600".into()]);
+        send.extend(common.iter().cloned());
+        let (dev, note) = ohaca_cli(&send);
+        println!("{file}: ohaca send {:.1} s", t0.elapsed().as_secs_f64());
+        assert!(
+            note.contains("compact layout") && note.contains("--board f411"),
+            "{file}: send's note: {note}"
+        );
+        let mut plan = vec!["plan".to_string(), "--board".into(), "f411".into()];
+        plan.extend(common.iter().cloned());
+        let (host, _) = ohaca_cli(&plan);
+        assert_eq!(
+            plan_keys(&dev),
+            plan_keys(&host),
+            "{file}: send vs plan --board f411"
+        );
+        // The host's default layout plans another path here (why `--board` exists).
+        let mut default = vec!["plan".to_string()];
+        default.extend(common.iter().cloned());
+        let (own, _) = ohaca_cli(&default);
+        assert_ne!(
+            plan_keys(&own),
+            plan_keys(&host),
+            "{file}: the host's default layout"
+        );
+    }
 }

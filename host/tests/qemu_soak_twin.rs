@@ -52,7 +52,7 @@ use qemu::{
 
 const DEFAULT_ROUNDS: usize = 1;
 const DEFAULT_SEED: u64 = 0x0ACA_5CA1;
-/// The twin's limits (`src/firmware/state.rs` with `LARGE`).
+/// The twin's limits (`src/firmware/state.rs` with `ohaca::board::H743`).
 const LIMITS: MapLimits = MapLimits {
     max_cells: 2_097_152,
     max_side: 4096,

@@ -26,7 +26,7 @@ use qemu::{
     assert_core_path, core_plan_steps, have_qemu, longest_scenario, maps, twin_firmware, Qemu,
 };
 
-/// The H743's capacity (`src/firmware/board/mod.rs`, `LARGE`).
+/// The H743's capacity (`ohaca::board::H743`).
 const CELLS: u32 = 2_097_152;
 const STEPS: u32 = 16_384;
 

@@ -42,20 +42,30 @@
 
 pub use layout::{lend, take, MapBuf, PlanStorage, BYTES, MAP_INIT};
 
+/// The lock the map buffer lives behind (`state::MAP`), which [`take`] lends the map to on the
+/// boards whose map is a static of its own.
+pub type MapLock =
+    embassy_sync::mutex::Mutex<embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex, MapBuf>;
+
 /// The map and the planner's buffers in one arena behind the map's lock (STM32F411 and the
 /// default QEMU board).
 #[cfg(not(feature = "twin-h743"))]
 #[cfg(not(feature = "board-stm32h743"))]
 mod layout {
+    use ohaca::board::Layout;
     use ohaca::grid::Grid;
-    use ohaca::planner::arena::{self, F411_WORDS};
+    use ohaca::planner::arena;
     use ohaca::planner::Workspace;
     use static_cell::ConstStaticCell;
 
-    use crate::firmware::state::{MAP_BYTES, PLAN_CELLS, PLAN_STEPS};
+    use crate::firmware::board::BOARD;
+    use crate::firmware::limits::{MAP_BYTES, PLAN_CELLS, PLAN_STEPS};
 
-    /// The arena's words (`ohaca::planner::arena::F411_WORDS`).
-    const WORDS: usize = F411_WORDS;
+    /// The arena's words: the board's (`ohaca::board::F411`'s 25,856).
+    const WORDS: usize = match BOARD.layout {
+        Layout::Arena { words } => words,
+        Layout::Separate { .. } => 0,
+    };
     // Every map the device takes fits the arena at full resolution, and its map bytes are the
     // arena's first words (what the receiver writes).
     const _: () = assert!(arena::capacity(WORDS) >= PLAN_CELLS);
@@ -107,9 +117,9 @@ mod layout {
 
     static STORAGE: ConstStaticCell<PlanStorage> = ConstStaticCell::new(PlanStorage);
 
-    /// Hand out the planner's storage (the arena is already in `state::MAP`). Call once, at
-    /// boot, before any task runs; a second call panics.
-    pub fn take() -> &'static mut PlanStorage {
+    /// Hand out the planner's storage (the arena is already the map buffer behind `_map`, the
+    /// lock `state::MAP`). Call once, at boot, before any task runs; a second call panics.
+    pub fn take(_map: &super::MapLock) -> &'static mut PlanStorage {
         STORAGE.take()
     }
 }
@@ -125,13 +135,14 @@ mod layout {
     use static_cell::ConstStaticCell;
 
     use ohaca::bitmap::words;
+    use ohaca::board::Layout;
     use ohaca::grid::{Dir, Point};
     use ohaca::pheromone::BLOCKS;
     use ohaca::planner::{Buffers, Workspace};
     use ohaca::route::GUIDE_BLOCKS;
-    use ohaca::tighten::hash_words;
 
-    use crate::firmware::state::{MAP_BYTES, PLAN_CELLS, PLAN_STEPS};
+    use crate::firmware::board::BOARD;
+    use crate::firmware::limits::{MAP_BYTES, PLAN_CELLS, PLAN_STEPS};
 
     /// The map buffer behind `state::MAP`'s lock: the [`MAP`] static, lent to it once by
     /// [`take`]; empty before (nothing can read unset memory through it).
@@ -160,18 +171,19 @@ mod layout {
     const WORDS: usize = words(PLAN_CELLS);
     /// Entries of each tour and of the path cells: paths of up to [`PLAN_STEPS`] steps.
     const STEPS: usize = PLAN_STEPS + 1;
+    /// Links and the move table's cells, from the board's description (`ohaca::board::H743`).
+    const SEPARATE: (usize, usize) = match BOARD.layout {
+        Layout::Separate { links, moves } => (links, moves),
+        Layout::Arena { .. } => (0, 0),
+    };
     /// Links: tightening's smallest hash table for the longest path (`ohaca::tighten::hash_words`:
     /// 32,768 half-word slots for 16,385 cells, a load factor of up to 2/3; one of 1/2 would
     /// need 65,536), and at least the coarse route's blocks (its heap): 16,384 words, all of
-    /// SRAM4. The host mirrors it (`host/tests/common/qemu.rs`, `core_plan_steps`).
-    const LINKS: usize = if hash_words(STEPS) > GUIDE_BLOCKS {
-        hash_words(STEPS)
-    } else {
-        GUIDE_BLOCKS
-    };
-    const _: () = assert!(4 * LINKS <= 65_536);
+    /// SRAM4. The host plans in the same (`ohaca plan --board h743`).
+    const LINKS: usize = SEPARATE.0;
+    const _: () = assert!(LINKS >= GUIDE_BLOCKS && 4 * LINKS <= 65_536);
     /// The move table for maps of up to this many cells (larger maps compute moves on the fly).
-    const MOVES: usize = 1024;
+    const MOVES: usize = SEPARATE.1;
 
     /// Memory the startup code does not initialise (a NOLOAD section): [`Region::fill`] writes
     /// every element before the memory is lent out, once.
@@ -297,10 +309,11 @@ mod layout {
         ))
     }
 
-    /// Build the planner's storage from the statics and lend the map static to `state::MAP`:
-    /// the one place that does. Call once, at boot, after the board's `init` (on the STM32H743 it
-    /// enables the SRAM1-3 clocks) and before any task runs; a second call panics.
-    pub fn take() -> &'static mut PlanStorage {
+    /// Build the planner's storage from the statics and lend the map static to `map` (the map
+    /// buffer behind `state::MAP`'s lock): the one place that does. Call once, at boot, after
+    /// the board's `init` (on the STM32H743 it enables the SRAM1-3 clocks) and before any task
+    /// runs; a second call panics.
+    pub fn take(map_lock: &super::MapLock) -> &'static mut PlanStorage {
         static STORAGE: ConstStaticCell<Option<PlanStorage>> = ConstStaticCell::new(None);
         let taken = TAKEN.swap(true, Ordering::AcqRel);
         defmt::assert!(!taken, "the planner's buffers are taken once");
@@ -329,10 +342,7 @@ mod layout {
             links,
             guide,
         });
-        let mut buf = defmt::unwrap!(
-            crate::firmware::state::MAP.try_lock().ok(),
-            "the map buffer is locked at boot"
-        );
+        let mut buf = defmt::unwrap!(map_lock.try_lock().ok(), "the map buffer is locked at boot");
         buf.0 = Some(map);
         storage
     }

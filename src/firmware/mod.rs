@@ -17,6 +17,7 @@
 
 mod board;
 mod buffers;
+mod limits;
 mod plan;
 mod rx;
 mod stack;
@@ -58,7 +59,7 @@ pub fn run(spawner: Spawner) {
     );
     // The map and the planner's buffers: after the board's init (the STM32H743's enables the
     // RAM regions they live in), before any task runs.
-    let storage = buffers::take();
+    let storage = buffers::take(&state::MAP);
     let port = TX.init(Mutex::new(tx));
     spawner.spawn(defmt::unwrap!(tx::tx_task(port)));
     spawner.spawn(defmt::unwrap!(plan::planner_task(storage, port)));

@@ -22,32 +22,15 @@ use ohaca::planner::{Memory, Params};
 use ohaca::protocol::{MapLimits, Reply, StatsReply};
 
 use super::board::{self, Board};
-use super::buffers::{MapBuf, MAP_INIT};
+use super::buffers::{MapLock, MAP_INIT};
 use super::stack;
 
-/// Most cells of a map the device holds and plans on, whatever its shape: the board's
-/// [`board::CAPACITY`] (262,144 cells, 32 KiB at one bit a cell in the arena the planner's
-/// buffers share, on the STM32F411 and the default QEMU board, so what QEMU proves holds on the
-/// chip; 2,097,152 cells on the STM32H743 and its QEMU twin).
-pub const MAX_CELLS: usize = board::CAPACITY.cells;
-/// Longest side of a map the device takes (a 4096 x 64 corridor has as many cells as 512 x 512).
-pub const MAX_SIDE: u16 = 4096;
-/// Bytes of the map buffer.
-pub const MAP_BYTES: usize = MAX_CELLS.div_ceil(8);
-/// Most cells of a map the planner plans on: every map the device holds, at full resolution.
-pub const PLAN_CELLS: usize = MAX_CELLS;
-/// Longest ant path the planner keeps, in steps (an ant whose path grows longer is dropped, and a
-/// plan no ant finishes that way is `Error PathTooLong`): the board's [`board::CAPACITY`]. A
-/// straight path across a 256 x 256 map has at most 255 steps, but a maze's or a long corridor's
-/// (4096 x 16) can be far longer: the longest scenario of `maps/large/maze-128-128-2` has 1,379
-/// steps (BENCHMARKS.md, section 4), within the 2,047 of the STM32F411 and the default QEMU
-/// board (the STM32H743 and its twin keep 16,384). On the small boards' maps of more than 68,256
-/// cells the arena leaves fewer (`ohaca::planner::arena::steps_for`: 1,876 at 512 x 512).
-pub const PLAN_STEPS: usize = board::CAPACITY.steps;
 /// The planner's storage (`super::buffers`): nothing of its own on the small boards (its
 /// buffers are carved out of [`MAP`]'s arena per plan), buffers spread over the RAM regions on
 /// the STM32H743 and its twin.
 pub use super::buffers::PlanStorage;
+/// The board's limits (`super::limits`), here too for the tasks that share the state.
+pub use super::limits::{MAP_BYTES, MAX_CELLS, MAX_SIDE, PLAN_CELLS, PLAN_STEPS};
 /// The map limits, for [`ohaca::protocol::Upload`].
 pub const LIMITS: MapLimits = MapLimits {
     max_cells: MAX_CELLS as u32,
@@ -86,7 +69,7 @@ pub type TxPort = Mutex<Raw, board::Tx>;
 /// small boards the first [`MAP_BYTES`] bytes of the arena the planner's buffers share (103,424
 /// bytes in all, `super::buffers`); on the STM32H743 and its twin a static of the AXI SRAM that
 /// `super::buffers::take` lends to this lock at boot.
-pub static MAP: Mutex<Raw, MapBuf> = Mutex::new(MAP_INIT);
+pub static MAP: MapLock = Mutex::new(MAP_INIT);
 /// Width and height of the complete map in [`MAP`]; `None`: no map (none yet, an upload in
 /// progress, or a failed one).
 static MAP_SIZE: BlockingMutex<Raw, Cell<Option<(u16, u16)>>> = BlockingMutex::new(Cell::new(None));

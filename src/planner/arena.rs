@@ -8,7 +8,7 @@
 //! so it cannot have everything a 256 x 256 map has. The arena holds the map *and* the planner's
 //! buffers, and [`carve`] lays them out for the map at hand:
 //!
-//! | layout | when | what | words at its largest map in the F411's 25,856 |
+//! | layout | when | what | words at its largest map in an arena of 25,856 (the STM32F411's, [`crate::board::F411`]) |
 //! | --- | --- | --- | --- |
 //! | full | it fits (on the F411: maps of up to 65,536 cells) | the map, `tabu` and `dead` (1 bit a cell each), `tau` and `delta` ([`BLOCKS`] entries), the route's [`GUIDE_BLOCKS`] words, [`LINKS`] links, `steps + 1` path cells and two tours (the iteration's best and worst are walked again), the move table on maps of up to 1,024 cells | 25,856 (65,536 cells, 2,047 steps) |
 //! | compact | the full one does not fit | the map, `tabu`; **no pruning marks** (the run does not prune), pheromone on at most [`COMPACT_BLOCKS`] blocks, the same route, links for tightening's hash table (and, on maps of fewer than 129,792 cells, for one slice of the local search's scratch), as many path steps as the rest holds (at most the caller's bound) | 25,856 (262,144 cells, 1,876 steps) |
@@ -51,11 +51,6 @@ pub const LINKS: usize = 4096;
 pub const MIN_STEPS: usize = 1023;
 /// Maps of up to this many cells get the move table (as the F411's `Storage` did).
 const MOVES: usize = 1024;
-/// The STM32F411 firmware's arena (and the default QEMU board's, which copies it): 103,424
-/// bytes, an 8 KiB map buffer and the fixed `Storage` of the full layout (95,232 B) together. A
-/// host that plans as that firmware does carves an arena of this length
-/// ([`carve`]`(.., cells, 2047)`).
-pub const F411_WORDS: usize = 25_856;
 
 /// A map buffer and a workspace carved out of one arena ([`carve`]).
 #[derive(Debug)]
@@ -247,46 +242,8 @@ mod tests {
     use alloc::vec;
     use alloc::vec::Vec;
 
-    const F411: usize = F411_WORDS;
-
-    #[test]
-    fn the_layouts_of_the_f411s_arena() {
-        // The former `Storage` had the 1,024-byte move table (256 words) whatever the map.
-        assert_eq!(full_words(65_536, 2047) + 256, F411);
-        assert_eq!(steps_for(F411, 65_536, 2047), Some((2047, false)));
-        // Without the move table the full layout holds a little more.
-        assert_eq!(steps_for(F411, 68_256, 2047), Some((2047, false)));
-        assert_eq!(steps_for(F411, 68_257, 2047), Some((2047, true)));
-        assert_eq!(steps_for(F411, 604 * 307, 2047), Some((2047, true)));
-        assert_eq!(steps_for(F411, 512 * 512, 2047), Some((1876, true)));
-        assert_eq!(compact_words(512 * 512, 1876), F411);
-        let cap = capacity(F411);
-        assert_eq!(cap, 299_008);
-        assert!(steps_for(F411, cap, 2047).is_some_and(|(s, c)| c && s >= MIN_STEPS));
-        assert_eq!(steps_for(F411, cap + 32, 2047), None);
-        // Every map size between: a layout that fits, the compact one leaving at least MIN_STEPS.
-        for cells in (1..=cap).step_by(997) {
-            let (s, compact) = steps_for(F411, cells, 2047).unwrap();
-            let words = if compact {
-                compact_words(cells, s)
-            } else {
-                full_words(cells, s)
-            };
-            assert!(words <= F411 && s >= MIN_STEPS, "{cells}: {s} {compact}");
-            let mut arena = vec![0u32; F411];
-            let c = carve(&mut arena, cells, 2047).unwrap();
-            assert_eq!((c.workspace.steps(), c.compact), (s, compact), "{cells}");
-            assert!(c.workspace.capacity() >= cells && c.map.len() * 8 >= cells);
-        }
-        let mut arena = vec![0u32; F411];
-        assert_eq!(
-            carve(&mut arena, cap + 32, 2047).unwrap_err(),
-            Error::MapTooLarge {
-                cells: 299_040,
-                capacity: 299_008
-            }
-        );
-    }
+    /// An arena of the length of the STM32F411's (`crate::board::F411`): 103,424 bytes.
+    const ARENA: usize = 25_856;
 
     #[test]
     fn every_map_up_to_the_capacity_fits_any_arena() {
@@ -294,7 +251,7 @@ mod tests {
         // near where the compact layout's links shrink (a tabu set of REFINE_WORDS words).
         let edge = REFINE_WORDS * 32;
         let mut with_cap = 0;
-        for arena in (6_000..60_000).step_by(250).chain([F411_WORDS]) {
+        for arena in (6_000..60_000).step_by(250).chain([ARENA]) {
             let cap = capacity(arena);
             if cap == 0 {
                 continue;
@@ -349,7 +306,7 @@ mod tests {
             };
             let a = plan(&g, s, goal, &p, storage.workspace())
                 .map(|pl| (pl.directions().to_vec(), pl.waypoints().to_vec(), pl.moves));
-            let mut arena = vec![0u32; F411];
+            let mut arena = vec![0u32; ARENA];
             let c = carve(&mut arena, g.cells(), 2047).unwrap();
             assert!(!c.compact);
             let b = plan(&g, s, goal, &p, c.workspace)
@@ -365,7 +322,7 @@ mod tests {
         // two tours must plan the same, cold and warm (the pheromone kept in the arena).
         type Keeping = Storage<{ crate::bitmap::words(65_536) }, 2048, 4096, 1024, 0, 2048>;
         let mut storage = alloc::boxed::Box::new(Keeping::new());
-        let mut arena = vec![0u32; F411_WORDS];
+        let mut arena = vec![0u32; ARENA];
         let (w, h) = (256u16, 256u16);
         let mut bits = walls(w, h, 0.25, 7);
         let (s, goal) = (Point::new(0, 0), Point::new(w - 1, h - 1));

@@ -77,7 +77,9 @@ pub const UNKNOWN_ID: u32 = 0;
 pub const MAX_CHUNK: usize = 128;
 
 /// Longest path, in steps, a device may plan ([`Capacity::max_steps`] is at most this): the
-/// STM32H743's 16,384, the largest of the boards. Every such path fits one [`PathReply`].
+/// wire's bound, not a board's (each board's is `crate::board::Board::max_steps`); today it
+/// equals the STM32H743's 16,384, the largest of the boards. Every such path fits one
+/// [`PathReply`].
 pub const MAX_STEPS: usize = 16_384;
 
 /// Most waypoints in a [`PathReply`]: every cell of a path of [`MAX_STEPS`] steps.

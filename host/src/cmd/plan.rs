@@ -7,9 +7,10 @@
 //! core's message). Nothing is printed on stdout for bad input.
 
 use ohaca::Error;
+use ohaca_host::board::BoardArg;
 use ohaca_host::input::{MapArgs, Scenario};
 use ohaca_host::output::{render, waypoints_csv, LocatedReport, PlanReport};
-use ohaca_host::{exit, plan_map, ParamArgs, PlanError};
+use ohaca_host::{exit, plan_map_on, ParamArgs, PlanError};
 
 use super::{bad_input, print};
 
@@ -35,6 +36,11 @@ pub struct Args {
     /// Print one JSON object instead of the picture (same as --format json)
     #[arg(long)]
     pub json: bool,
+    /// Plan exactly as this board's firmware does (its buffers, layout and path bound; the same
+    /// path as `ohaca send` to it): f411 (also the default QEMU firmware) or h743 (also its QEMU
+    /// twin) [default: the host's own storage, every buffer for the map]
+    #[arg(long, value_enum, value_name = "BOARD")]
+    pub board: Option<BoardArg>,
     #[command(flatten)]
     pub params: ParamArgs,
 }
@@ -56,7 +62,8 @@ pub fn run(args: &Args) -> u8 {
         Err(e) => return bad_input(e),
     };
     let params = args.params.params();
-    let report = match plan_map(&sc.map, sc.start, sc.goal, &params) {
+    let board = args.board.map(BoardArg::board);
+    let report = match plan_map_on(board, &sc.map, sc.start, sc.goal, &params) {
         Ok(r) => r,
         Err(e) => return bad_input(plan_error(&sc, &e)),
     };

@@ -9,9 +9,11 @@
 use std::path::PathBuf;
 
 use ohaca::Algorithm;
+use ohaca_host::board::{BoardArg, BoardStorage};
 use ohaca_host::draw::{self, Layer, Scene};
 use ohaca_host::experiment::params_brief;
 use ohaca_host::input::{MapArgs, MultiParamArgs, Scenario};
+use ohaca_host::plan_map::Lend;
 use ohaca_host::trace::{cell_pheromone, plan_traced};
 use ohaca_host::{exit, HeapStorage};
 
@@ -29,6 +31,11 @@ pub struct Args {
     /// Draw the final pheromone of the first algorithm as a heat map under the paths
     #[arg(long)]
     pub pheromone: bool,
+    /// Plan exactly as this board's firmware does (its buffers, layout and path bound; the same
+    /// path as `ohaca send` to it): f411 (also the default QEMU firmware) or h743 (also its QEMU
+    /// twin) [default: the host's own storage, every buffer for the map]
+    #[arg(long, value_enum, value_name = "BOARD")]
+    pub board: Option<BoardArg>,
     #[command(flatten)]
     pub params: MultiParamArgs,
 }
@@ -47,14 +54,23 @@ pub fn run(args: &Args) -> u8 {
     };
     let base = args.params.params.params();
     let algorithms = args.params.algorithms(&[base.algorithm]);
-    let mut storage = HeapStorage::default();
+    let mut storage: Box<dyn Lend> = match args.board {
+        None => Box::new(HeapStorage::default()),
+        Some(b) => {
+            let iterations = usize::from(base.iterations);
+            match BoardStorage::new(b.board(), sc.map.cells(), iterations) {
+                Ok(s) => Box::new(s),
+                Err(e) => return bad_input(plan_error(&sc, &e.into())),
+            }
+        }
+    };
     let mut layers = Vec::new();
     let mut pheromone = None;
     let mut all_found = true;
     for (i, &algorithm) in algorithms.iter().enumerate() {
         let params = ohaca::Params { algorithm, ..base };
         let want = args.pheromone && i == 0;
-        let t = match plan_traced(&mut storage, &sc.map, sc.start, sc.goal, &params, want) {
+        let t = match plan_traced(storage.as_mut(), &sc.map, sc.start, sc.goal, &params, want) {
             Ok(t) => t,
             Err(e) => return bad_input(plan_error(&sc, &e)),
         };

@@ -13,6 +13,7 @@ use std::time::Duration;
 
 use ohaca::Params;
 use ohaca::Point;
+use ohaca_host::board::BoardArg;
 use ohaca_host::dstar::{self, AstarCost, Stats};
 use ohaca_host::input::MapArgs;
 use ohaca_host::link::{Link, Transport, DEFAULT_BAUD};
@@ -54,6 +55,11 @@ pub struct Args {
     /// Plan on a device on a serial port
     #[arg(long, value_name = "DEVICE")]
     pub serial: Option<String>,
+    /// Plan on the host core exactly as this board's firmware does: f411 (also the default QEMU
+    /// firmware) or h743 (also its QEMU twin) [default: as the f411, with heap storage on maps
+    /// larger than its arena]
+    #[arg(long, value_enum, value_name = "BOARD", conflicts_with_all = ["tcp", "serial"])]
+    pub board: Option<BoardArg>,
     /// Serial baud rate
     #[arg(long, value_name = "N", default_value_t = DEFAULT_BAUD)]
     pub baud: u32,
@@ -174,7 +180,10 @@ fn planner(args: &Args) -> Result<Box<dyn Planner>, String> {
         let link = Link::serial(port, args.baud, timeout).map_err(|e| e.to_string())?;
         return device(link, &params);
     }
-    Ok(Box::new(HostPlanner::new(params)))
+    Ok(match args.board {
+        None => Box::new(HostPlanner::new(params)),
+        Some(b) => Box::new(HostPlanner::on(params, b.board())),
+    })
 }
 
 /// Bytes in KiB, one decimal.

@@ -10,6 +10,7 @@ use std::net::IpAddr;
 use std::path::PathBuf;
 use std::time::Duration;
 
+use ohaca_host::board::BoardArg;
 use ohaca_host::link::{Link, DEFAULT_BAUD};
 use ohaca_host::map::Unknown;
 use ohaca_host::ros::backend::{Backend, Connect, DeviceBackend, HostBackend};
@@ -59,6 +60,12 @@ pub struct Args {
     /// Plan on the host core
     #[arg(long)]
     pub host: bool,
+    /// With --host: plan exactly as this board's firmware does (its buffers, layout and path
+    /// bound; maps larger than it takes are fitted as for a device): f411 (also the default QEMU
+    /// firmware) or h743 (also its QEMU twin) [default: as the f411, with heap storage on maps
+    /// larger than its arena, and no fitting]
+    #[arg(long, value_enum, value_name = "BOARD", conflicts_with_all = ["tcp", "serial"])]
+    pub board: Option<BoardArg>,
     /// Plan on a device on a TCP port, e.g. QEMU's UART (scripts/qemu-serve.sh): HOST:PORT
     #[arg(long, value_name = "HOST:PORT")]
     pub tcp: Option<String>,
@@ -174,7 +181,10 @@ fn backend(args: &Args) -> Result<Box<dyn Backend>, String> {
         let connect: Connect<_> = Box::new(move || Link::serial(&p, baud, timeout));
         return Ok(Box::new(DeviceBackend::new(port, connect, params)));
     }
-    Ok(Box::new(HostBackend::new(params)))
+    Ok(Box::new(match args.board {
+        None => HostBackend::new(params),
+        Some(b) => HostBackend::on(params, b.board()),
+    }))
 }
 
 fn config(args: &Args) -> Result<NodeConfig, String> {

@@ -11,6 +11,12 @@
 //! [`ohaca_host::map::fit`]), unless `--cell` was given; a note on stderr says so, with the new
 //! cell size for maps with a resolution, and start, goal and output are cells of the coarse grid.
 //!
+//! The device's board is known from the capacity in Hello (`ohaca::board::Board::with_capacity`):
+//! when it plans the map in another layout than `ohaca plan` does by default (the STM32F411's
+//! compact one, on maps of more than 68,256 cells), a note on stderr says so and names the
+//! `ohaca plan --board` that gives the device's path (not for a map fitted to the device, which
+//! has its own note).
+//!
 //! `--goals FILE` plans many requests over one connection, pipelined, and prints one JSON line
 //! per request, in file order. Each line of the file is `SX,SY GX,GY` (start and goal) or
 //! `GX,GY` (a goal from `--start`); `#` starts a comment, blank lines are skipped.
@@ -24,8 +30,10 @@ use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
+use ohaca::board::Board;
 use ohaca::protocol::{ErrorCode, ErrorReply};
 use ohaca::{Error, Params, Point};
+use ohaca_host::board::differs_from_host;
 use ohaca_host::input::{resolve_point, MapArgs};
 use ohaca_host::link::{DeviceInfo, DevicePath, Link, LinkError, PlanJob, Transport, DEFAULT_BAUD};
 use ohaca_host::map::{fit, fits, prepare, Fitted, MapFrame};
@@ -189,6 +197,24 @@ fn too_large(map_path: &Path, map: &Map, info: &DeviceInfo) -> String {
         c.cells,
         c.max_side
     )
+}
+
+/// A note when the device plans `map` in another layout than `ohaca plan` does by default (the
+/// STM32F411's compact layout on maps of more than 68,256 cells): the device's board is known
+/// from the capacity in its Hello ([`Board::with_capacity`]).
+fn layout_note(info: &DeviceInfo, map: &Map) -> Option<String> {
+    let c = &info.capacity;
+    let board = Board::with_capacity(
+        usize::try_from(c.cells).ok()?,
+        usize::try_from(c.max_steps).ok()?,
+    )?;
+    let layout = differs_from_host(&board, map.cells())?;
+    Some(format!(
+        "{} plans this {}x{} map in its compact layout (paths of up to {} steps, no pruning, \
+         coarser pheromone), not in the host's default one: `ohaca plan --board {}` gives the \
+         device's path",
+        info.board, map.width, map.height, layout.steps, board.name
+    ))
 }
 
 impl Sender {
@@ -372,6 +398,11 @@ impl Sender {
     fn talk<T: Transport>(&mut self, args: &Args, mut link: Link<T>) -> Result<u8, String> {
         let info = link.hello().map_err(|e| self.fail(e))?;
         self.fit(args, &info)?;
+        // A fitted map has its note already, and `plan --board` of the original map cannot
+        // reproduce a path on the fitted one.
+        if let (None, Some(note)) = (&self.fitted, layout_note(&info, &self.map)) {
+            eprintln!("note: {note}");
+        }
         let fail = |e: LinkError| self.fail(e);
         link.set_params(&self.params).map_err(fail)?;
         // A progress bar on a terminal (never under --json or when stderr is a file or a pipe).

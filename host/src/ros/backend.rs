@@ -7,6 +7,7 @@
 //! request: the backend keeps a copy of the map it sent, so the reconnected device gets it again
 //! (and plans cold once).
 
+use ohaca::board::Board;
 use ohaca::protocol::{Capacity, ErrorCode};
 use ohaca::{Params, Point};
 
@@ -61,23 +62,39 @@ fn rect_cells((x, y, w, h): (u16, u16, u16, u16)) -> Vec<Point> {
 /// The host core (bit-identical to the device's plans, [`HostPlanner`]).
 pub struct HostBackend {
     planner: HostPlanner,
+    /// `--board`: the board it plans as exactly, whose capacity it reports (maps larger than
+    /// it takes are fitted as for a device).
+    board: Option<Board>,
 }
 
 impl HostBackend {
-    /// The core with `params`.
+    /// The core with `params`, planning as [`HostPlanner::new`] does (the STM32F411's layout,
+    /// heap storage on maps larger than its arena; any map).
     pub fn new(params: Params) -> Self {
         HostBackend {
             planner: HostPlanner::new(params),
+            board: None,
+        }
+    }
+
+    /// The core with `params`, planning exactly as `board` does (`--board`).
+    pub fn on(params: Params, board: Board) -> Self {
+        HostBackend {
+            planner: HostPlanner::on(params, board),
+            board: Some(board),
         }
     }
 }
 
 impl Backend for HostBackend {
     fn describe(&self) -> String {
-        "the host core".into()
+        match self.board {
+            Some(b) => format!("the host core as the {} board", b.name),
+            None => "the host core".into(),
+        }
     }
     fn capacity(&mut self) -> Result<Option<Capacity>, BackendError> {
-        Ok(None)
+        Ok(self.board.as_ref().map(crate::board::capacity))
     }
     fn upload(&mut self, map: &Map) -> Result<(), BackendError> {
         self.planner.set_map(map).map_err(BackendError::Refused)
@@ -279,6 +296,23 @@ mod tests {
         assert!(second.raw.iter().all(|p| p.x != 5 || p.y == 9));
         b.set_rect((5, 0, 1, 10), true).unwrap();
         assert!(matches!(b.plan(s, g, true), Err(BackendError::NoPath(_))));
+    }
+
+    #[test]
+    fn the_host_core_as_a_board_reports_its_capacity_and_refuses_more() {
+        let mut b = HostBackend::on(Params::default(), ohaca::board::F411);
+        let cap = b.capacity().unwrap().unwrap();
+        assert_eq!(
+            (cap.cells, cap.max_side, cap.max_steps),
+            (262_144, 4096, 2047)
+        );
+        assert!(b.describe().contains("f411"));
+        assert!(matches!(
+            b.upload(&Map::from_fn(512, 513, |_, _| false)),
+            Err(BackendError::Refused(_))
+        ));
+        b.upload(&Map::from_fn(10, 10, |_, _| false)).unwrap();
+        assert!(b.plan(Point::new(0, 0), Point::new(9, 9), false).is_ok());
     }
 
     #[test]

@@ -15,7 +15,9 @@ use std::process::{Child, Command, Stdio};
 use std::sync::OnceLock;
 use std::time::{Duration, Instant};
 
-use ohaca::protocol::{crc32, decode_request, ErrorReply, RequestReader, MAX_REQUEST_WIRE};
+use ohaca::protocol::{
+    crc32, decode_request, ErrorCode, ErrorReply, RequestReader, MAX_REQUEST_WIRE,
+};
 use ohaca::{Params, Point};
 use ohaca_host::link::{DevicePath, Link};
 use ohaca_host::{HeapStorage, Map};
@@ -377,9 +379,9 @@ pub struct CorePath {
     pub directions: Vec<u8>,
 }
 
-/// The default QEMU firmware's longest ant path, the STM32F411's (`firmware::state::PLAN_STEPS`,
-/// Hello's `capacity.max_steps`; `qemu_e2e`'s maze test checks it against Hello).
-pub const DEVICE_STEPS: usize = 2047;
+/// The default QEMU firmware's longest ant path, the STM32F411's (`ohaca::board::F411`, Hello's
+/// `capacity.max_steps`; `qemu_e2e`'s maze test checks it against Hello).
+pub const DEVICE_STEPS: usize = ohaca::board::F411.max_steps;
 
 /// Plan as the firmware does (`ohaca::plan` on the map's grid), on the host: the path, or the
 /// error reply the device must send.
@@ -389,12 +391,32 @@ pub fn core_plan(
     goal: Point,
     params: &Params,
 ) -> Result<CorePath, ErrorReply> {
-    // The device's arena (`ohaca::planner::arena::F411_WORDS`) and its ant paths of up to
-    // 2,047 steps (`firmware::state::PLAN_STEPS`).
+    core_plan_on(ohaca::board::F411, map, start, goal, params)
+}
+
+/// Plan as `board`'s firmware does, in the buffers `ohaca plan --board` lends the core
+/// (`ohaca_host::board::BoardStorage`, from the board's description `ohaca::board`).
+pub fn core_plan_on(
+    board: ohaca::board::Board,
+    map: &Map,
+    start: Point,
+    goal: Point,
+    params: &Params,
+) -> Result<CorePath, ErrorReply> {
+    use ohaca_host::board::BoardError;
     let grid = map.grid().map_err(ErrorReply::from)?;
     params.validate().map_err(ErrorReply::from)?;
-    let mut arena = vec![0u32; ohaca::planner::arena::F411_WORDS];
-    let ws = ohaca::planner::arena::carve(&mut arena, map.cells(), DEVICE_STEPS)?.workspace;
+    let reply = |e: BoardError| match e {
+        BoardError::Core(e) => ErrorReply::from(e),
+        BoardError::TooLarge {
+            cells, capacity, ..
+        } => ErrorReply::with(ErrorCode::MapTooLarge, cells as u32, capacity as u32),
+        BoardError::Storage(e) => panic!("host storage: {e}"),
+    };
+    let iterations = usize::from(params.iterations);
+    let mut storage =
+        ohaca_host::board::BoardStorage::new(board, map.cells(), iterations).map_err(reply)?;
+    let ws = storage.workspace().map_err(reply)?;
     let plan = ohaca::plan(&grid, start, goal, params, ws)?;
     Ok(core_path(&plan))
 }

@@ -9,10 +9,11 @@ use embassy_stm32::usart::{BufferedUart, BufferedUartRx, BufferedUartTx, Config}
 use embassy_stm32::{bind_interrupts, peripherals, rcc, usart};
 use static_cell::ConstStaticCell;
 
-use super::{Board, Capacity};
+use super::Board;
 
-/// Maps of up to 262,144 cells, paths of up to 2,047 steps (fewer above 68,256 cells).
-pub const CAPACITY: Capacity = super::SMALL;
+/// Maps of up to 262,144 cells, paths of up to 2,047 steps (fewer above 68,256 cells), in one
+/// arena of 103,424 bytes: `ohaca::board::F411`.
+pub const BOARD: ohaca::board::Board = ohaca::board::F411;
 
 bind_interrupts!(struct Irqs {
     USART1 => usart::BufferedInterruptHandler<peripherals::USART1>;

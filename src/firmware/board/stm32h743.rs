@@ -14,10 +14,11 @@ use embassy_stm32::usart::{BufferedUart, BufferedUartRx, BufferedUartTx, Config}
 use embassy_stm32::{bind_interrupts, peripherals, rcc, usart};
 use static_cell::ConstStaticCell;
 
-use super::{Board, Capacity};
+use super::Board;
 
-/// Maps of up to 2,097,152 cells, paths of up to 16,384 steps.
-pub const CAPACITY: Capacity = super::LARGE;
+/// Maps of up to 2,097,152 cells, paths of up to 16,384 steps, buffers over the RAM regions:
+/// `ohaca::board::H743`.
+pub const BOARD: ohaca::board::Board = ohaca::board::H743;
 
 bind_interrupts!(struct Irqs {
     USART3 => usart::BufferedInterruptHandler<peripherals::USART3>;

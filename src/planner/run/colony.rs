@@ -10,7 +10,7 @@ use crate::pheromone::Table;
 use crate::rng::Xoshiro128pp;
 use crate::route::Route;
 use crate::tighten::tighten;
-use crate::update::{deposit, wolves_amounts};
+use crate::update::{deposit, wolves, WolfPaths};
 
 use crate::planner::plan::CurvePoint;
 use crate::planner::workspace::Workspace;
@@ -95,6 +95,55 @@ pub(super) struct Iteration {
     worst_replay: Option<Replay>,
     sum: f32,
     arrived: u32,
+}
+
+/// The iteration's best and worst paths for [`wolves`], each from where it is: `iter_best` and
+/// `iter_worst` on a workspace that keeps them, else walked again from their ants' [`Replay`]s
+/// (`again`: the replay, the path's steps, the buffer), the best into `best` when it is a new
+/// run best (`record` wants it there: `placed`), else into `tour`, the worst into `tour` once the
+/// best's deposit is done.
+struct Paths<'p, F> {
+    again: &'p mut F,
+    it: &'p Iteration,
+    /// Steps of the best and the worst path.
+    steps: (usize, usize),
+    /// `iter_best`, `iter_worst` where the workspace keeps them.
+    kept: (Option<&'p [Dir]>, Option<&'p [Dir]>),
+    best: &'p mut [Dir],
+    tour: &'p mut [Dir],
+    /// The iteration's best path is a new run best.
+    new_best: bool,
+    /// The best path was walked into `best`.
+    placed: bool,
+}
+
+impl<F: FnMut(&Option<Replay>, usize, &mut [Dir]) -> bool> WolfPaths for Paths<'_, F> {
+    fn best(&mut self) -> Option<&[Dir]> {
+        let n = self.steps.0;
+        if let Some(kept) = self.kept.0 {
+            return kept.get(..n);
+        }
+        // A new run best is walked straight into `best`, where `record` wants it.
+        let buf: &mut [Dir] = if self.new_best { self.best } else { self.tour };
+        if (self.again)(&self.it.best_replay, n, buf) {
+            self.placed = self.new_best;
+            buf.get(..n)
+        } else {
+            None
+        }
+    }
+
+    fn worst(&mut self) -> Option<&[Dir]> {
+        let n = self.steps.1;
+        if let Some(kept) = self.kept.1 {
+            return kept.get(..n);
+        }
+        if (self.again)(&self.it.worst_replay, n, self.tour) {
+            self.tour.get(..n)
+        } else {
+            None
+        }
+    }
 }
 
 /// One ant's walk, tightened ([`tighten`]) when `tight` and the walk may have a shortcut: the path
@@ -263,40 +312,23 @@ impl Run<'_, '_> {
             )
         };
         let mut placed = false;
-        let wolves = match (p.algorithm.wolves(), it.best, it.worst) {
-            (true, Some((b, nb)), Some((w, nw))) => {
-                wolves_amounts(p.q, (b.length(), nb), (w.length(), nw)).map(|a| (b, w, a))
-            }
-            _ => None,
-        };
-        if let Some((b, w, (reward, punish))) = wolves {
-            // `update::wolves`'s two deposits, in its order, each path from where it is.
-            let bt = if keep_best {
-                iter_best.get(..b.steps)
-            } else {
-                // A new run best is walked straight into `best`, where `record` wants it.
-                placed = new_best.is_some();
-                let buf: &mut [Dir] = if placed { best } else { tour };
-                if again(&it.best_replay, b.steps, buf) {
-                    buf.get(..b.steps)
-                } else {
-                    placed = false;
-                    None
-                }
+        if let (true, Some((b, nb)), Some((w, nw))) = (p.algorithm.wolves(), it.best, it.worst) {
+            let mut paths = Paths {
+                again: &mut again,
+                it: &it,
+                steps: (b.steps, w.steps),
+                kept: (
+                    keep_best.then_some(&**iter_best),
+                    keep_worst.then_some(&**iter_worst),
+                ),
+                best,
+                tour,
+                new_best: new_best.is_some(),
+                placed: false,
             };
-            if let Some(bt) = bt {
-                deposit(&mut delta, self.grid, self.start, bt, reward);
-            }
-            let wt = if keep_worst {
-                iter_worst.get(..w.steps)
-            } else if again(&it.worst_replay, w.steps, tour) {
-                tour.get(..w.steps)
-            } else {
-                None
-            };
-            if let Some(wt) = wt {
-                deposit(&mut delta, self.grid, self.start, wt, punish);
-            }
+            let lengths = ((b.length(), nb), (w.length(), nw));
+            wolves(&mut delta, self.grid, self.start, p.q, lengths, &mut paths);
+            placed = paths.placed;
         }
         if let (Some(b), false) = (new_best, placed) {
             if keep_best {

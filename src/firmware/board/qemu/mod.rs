@@ -8,16 +8,17 @@ mod uart;
 
 use defmt_semihosting as _;
 
-use super::{Board, Capacity};
+use super::Board;
 
-/// The STM32F411's capacity (the default), or with feature `twin-h743` the STM32H743's: the twin
-/// also has the H743's RAM regions (`twin-h743-memory.x`) and buffer placement.
+/// The STM32F411's board (the default: `ohaca::board::F411`, its capacity and arena, so what
+/// QEMU proves holds on the chip), or with feature `twin-h743` the STM32H743's: the twin also has
+/// the H743's RAM regions (`twin-h743-memory.x`) and buffer placement.
 #[cfg(not(feature = "twin-h743"))]
-pub const CAPACITY: Capacity = super::SMALL;
-/// The STM32H743's capacity: this is its QEMU twin (`twin-h743-memory.x` has the H743's RAM
-/// regions, `crate::firmware::buffers` places the buffers as on the chip).
+pub const BOARD: ohaca::board::Board = ohaca::board::F411;
+/// The STM32H743's board (`ohaca::board::H743`): this is its QEMU twin (`twin-h743-memory.x`
+/// has the H743's RAM regions, `crate::firmware::buffers` places the buffers as on the chip).
 #[cfg(feature = "twin-h743")]
-pub const CAPACITY: Capacity = super::LARGE;
+pub const BOARD: ohaca::board::Board = ohaca::board::H743;
 
 /// System clock of the MPS2 FPGA images, also the SysTick and UART clock.
 pub const SYSCLK_HZ: u32 = 25_000_000;
