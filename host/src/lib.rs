@@ -24,6 +24,8 @@
 //! | [`strip`] | pictures of a replanning drive: a PNG strip, an animated GIF |
 //! | [`dstar`] | D* Lite, the incremental exact baseline of replanning: a persistent search on the core's 8-connected grid, and a drive of `replan` replayed into it |
 //! | [`replan`] | replanning scenarios: a robot driving while cells change, warm or cold replans on the core or a device |
+//! | [`stream`] | a robot's costmap stream: small obstacles coming and going at a fixed rate, a replan after each, and what it cost |
+//! | [`rng`] | SplitMix64, the seeded generator of the simulations and tests |
 //! | [`ros`] | `ohaca ros`: a ROS 2 node (map, goal and pose topics, `/plan`, Nav2's `compute_path_to_pose`) |
 //!
 //! ## Panic freedom
@@ -62,6 +64,7 @@ pub mod map;
 pub mod output;
 pub mod plan_map;
 pub mod replan;
+pub mod rng;
 pub mod ros;
 pub mod stream;
 pub mod strip;

@@ -21,6 +21,7 @@ use ohaca::Point;
 
 use crate::map::Map;
 use crate::replan::{plan_step, Drive, Planner, Step};
+use crate::rng::Rng;
 
 /// How the stream runs. See the module docs.
 #[derive(Clone, Copy, Debug)]
@@ -48,27 +49,6 @@ impl Default for Stream {
             near: 0.1,
             seed: 1,
         }
-    }
-}
-
-/// SplitMix64: a small seeded generator (the stream must not depend on a crate's algorithm).
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    /// Uniform in `0..n` (`n > 0`).
-    fn below(&mut self, n: usize) -> usize {
-        (self.next() % n.max(1) as u64) as usize
-    }
-    /// Uniform in `[0, 1)`.
-    fn unit(&mut self) -> f64 {
-        (self.next() >> 11) as f64 / (1u64 << 53) as f64
     }
 }
 

@@ -72,57 +72,7 @@ const DEFAULT_SEED: u64 = 0x0ACA_50AC;
 
 // ---- a small deterministic generator ------------------------------------------------------------
 
-/// SplitMix64.
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-
-    /// `0..n` (`n > 0`).
-    fn below(&mut self, n: usize) -> usize {
-        (self.next() % n as u64) as usize
-    }
-
-    /// `lo..=hi`.
-    fn range(&mut self, lo: usize, hi: usize) -> usize {
-        lo + self.below(hi - lo + 1)
-    }
-
-    /// True with probability `p`.
-    fn chance(&mut self, p: f64) -> bool {
-        self.unit() < p
-    }
-
-    /// Uniform in `[0, 1)`.
-    fn unit(&mut self) -> f64 {
-        (self.next() >> 11) as f64 / (1u64 << 53) as f64
-    }
-
-    /// Uniform `f32` in `[lo, hi)`.
-    fn f32(&mut self, lo: f32, hi: f32) -> f32 {
-        lo + (hi - lo) * self.unit() as f32
-    }
-
-    fn bytes(&mut self, n: usize) -> Vec<u8> {
-        (0..n).map(|_| self.next() as u8).collect()
-    }
-
-    /// `lo..=hi` random bytes.
-    fn bytes_in(&mut self, lo: usize, hi: usize) -> Vec<u8> {
-        let n = self.range(lo, hi);
-        self.bytes(n)
-    }
-
-    fn nonzero_bytes(&mut self, n: usize) -> Vec<u8> {
-        (0..n).map(|_| (self.next() % 255) as u8 + 1).collect()
-    }
-}
+use ohaca_host::rng::Rng;
 
 // ---- what the device must answer ----------------------------------------------------------------
 

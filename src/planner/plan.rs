@@ -95,6 +95,32 @@ pub struct Plan<'a> {
 }
 
 impl<'a> Plan<'a> {
+    /// An answer without a run ([`super::reuse`], its repair): no iterations, moves or curve,
+    /// the raw length also the colony's.
+    pub(super) fn without_run(
+        (start, tour, waypoints): (Point, &'a [Dir], &'a [Point]),
+        (raw_length, length): (f32, f32),
+        origin: Origin,
+        params: Params,
+    ) -> Self {
+        Plan {
+            start,
+            tour,
+            waypoints,
+            raw_length,
+            colony_length: raw_length,
+            length,
+            turns: crate::geometry::turns(waypoints),
+            iterations: 0,
+            best_iteration: 0,
+            moves: 0,
+            pruned: 0,
+            origin,
+            curve: &[],
+            params,
+        }
+    }
+
     /// The raw 8-connected path, start to goal.
     pub fn raw(&self) -> RawPath<'a> {
         RawPath::new(self.start, self.tour)

@@ -34,7 +34,7 @@
 //! on the same layout, with the same fixed scratch size ([`REFINE_WORDS`]), so a repaired answer
 //! is the same bit for bit on both. Panic-free: every index is checked.
 
-use crate::geometry::{distance, segment_clear, steps_length, turns};
+use crate::geometry::{distance, segment_clear, steps_length};
 use crate::grid::{direction, is_diagonal, neighbour, Dir, Grid, Point};
 use crate::pheromone::BLOCKS;
 use crate::refine::{self, Scratch};
@@ -319,22 +319,12 @@ pub(super) fn repair<'a>(
     });
     let tour: &'a [Dir] = best.get(base..new_steps)?;
     let waypoints: &'a [Point] = points.get(k0..new_end)?;
-    Some(Plan {
-        start,
-        tour,
-        waypoints,
-        raw_length,
-        colony_length: raw_length,
-        length,
-        turns: turns(waypoints),
-        iterations: 0,
-        best_iteration: 0,
-        moves: 0,
-        pruned: 0,
-        origin: Origin::Repaired,
-        curve: &[],
-        params: *params,
-    })
+    Some(Plan::without_run(
+        (start, tour, waypoints),
+        (raw_length, length),
+        Origin::Repaired,
+        *params,
+    ))
 }
 
 /// Raw offsets of waypoints along a raw path, in order ([`Offsets::find`]).

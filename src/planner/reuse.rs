@@ -36,7 +36,7 @@
 //! Host and device call the same function on the same workspace layout, so a reused answer is
 //! the same bit for bit on both. Panic-free like the rest of the core: indices are checked.
 
-use crate::geometry::{bend, distance, segment_clear, sqrt, steps_length, turns};
+use crate::geometry::{bend, distance, segment_clear, sqrt, steps_length};
 use crate::grid::{is_diagonal, neighbour, Dir, Grid, Point};
 use crate::heuristic::octile;
 use crate::smoothing::SmoothingKind;
@@ -150,22 +150,12 @@ pub fn reuse<'a>(
     let Workspace { best, points, .. } = ws;
     let tour: &'a [Dir] = best.get(from.wrapping_add(at)..steps)?;
     let waypoints: &'a [Point] = points.get(k0..end)?;
-    Some(Plan {
-        start,
-        tour,
-        waypoints,
-        raw_length,
-        colony_length: raw_length,
-        length,
-        turns: turns(waypoints),
-        iterations: 0,
-        best_iteration: 0,
-        moves: 0,
-        pruned: 0,
-        origin: Origin::Reused,
-        curve: &[],
-        params: *params,
-    })
+    Some(Plan::without_run(
+        (start, tour, waypoints),
+        (raw_length, length),
+        Origin::Reused,
+        *params,
+    ))
 }
 
 /// Rule 3: no rectangle of cells cleared since the answer was planned can give a path from
