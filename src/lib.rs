@@ -24,9 +24,10 @@
 //! | [`update`] | the per-iteration pheromone update: classic deposit and the wolves rule |
 //! | [`smoothing`] | line-of-sight smoothing of the raw ant path |
 //! | [`taut`] | the smoothed path pulled taut over the cell centres around it |
+//! | [`corridor`] | the exact any-angle path through the cells around a smoothed path (small maps) |
 //! | [`refine`] | local search: the exact shortest path in a window sliding along a raw path |
 //! | [`astar`] | the exact A* baseline: a whole-map search in 4 bits a cell plus a heap (not used by the planner) |
-//! | [`planner`] | parameters, caller-provided storage, the iteration loop and the result |
+//! | [`planner`] | parameters, caller-provided storage, the iteration loop and the result; warm starts, reused and repaired answers |
 //! | [`board`] | what each board's firmware holds (cells, longest path, buffer layout), described once for the firmware and the host |
 //! | `heap` | (feature `alloc`) the planner's storage on the heap, sized at run time |
 //! | `protocol` | (feature `protocol`) the wire protocol between a host and the firmware |

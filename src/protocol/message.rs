@@ -101,7 +101,9 @@ pub enum Request<'a> {
     /// `9`: as [`Request::Plan`], asking for a warm start: keep the colony (pheromone) of the
     /// previous plan to the same goal on this map, across cell updates (the firmware does when
     /// its last started plan was to this goal on a map of this size, see `docs/PROTOCOL.md`;
-    /// else it plans cold). [`PathReply::warm`] says which; the path is valid either way.
+    /// else it plans cold), or answers with the rest of the last answer when no change since can
+    /// block or shorten it (`ohaca::planner::reuse`). [`PathReply::origin`] says which; the path
+    /// is valid either way.
     PlanWarm {
         /// Start cell (the robot's cell now).
         #[serde(with = "PointDef")]
