@@ -6,7 +6,7 @@
 //!
 //! | board | [`Board`] | cells | ant path | layout |
 //! | --- | --- | ---: | ---: | --- |
-//! | STM32F411 (and the default QEMU build, which copies it) | [`F411`] | 262,144 | 2,047 (fewer above 68,256 cells) | one arena of 25,856 words, laid out per map by [`crate::planner::arena::carve`] |
+//! | STM32F411 (and the default QEMU build, which copies it) | [`F411`] | 262,144 | 2,047 (fewer above 258,048 cells: 1,876 at 512 x 512; the compact layout above 68,256) | one arena of 25,856 words, laid out per map by [`crate::planner::arena::carve`] |
 //! | STM32H743 (and its QEMU twin, `twin-h743`) | [`H743`] | 2,097,152 | 16,384 | separate buffers over four RAM regions: every buffer for its largest map, 16,384 links, the move table on maps of up to 1,024 cells |
 //!
 //! The core's planner never names a board: [`crate::planner::arena`] takes an arena's length,
@@ -165,6 +165,10 @@ mod tests {
         assert_eq!(steps_for(WORDS, 68_257, 2047), Some((2047, true)));
         assert_eq!(steps_for(WORDS, 604 * 307, 2047), Some((2047, true)));
         assert_eq!(steps_for(WORDS, 512 * 512, 2047), Some((1876, true)));
+        // The compact layout keeps the full 2,047 steps up to 258,048 cells, then fewer.
+        assert_eq!(steps_for(WORDS, 258_048, 2047), Some((2047, true)));
+        assert_eq!(steps_for(WORDS, 258_049, 2047), Some((2045, true)));
+        assert_eq!(steps_for(WORDS, 512 * 506, 2047), Some((2004, true)));
         assert_eq!(compact_words(512 * 512, 1876), WORDS);
         let cap = capacity(WORDS);
         assert_eq!(cap, 299_008);
