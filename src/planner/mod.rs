@@ -22,6 +22,7 @@
 //! | `plan` | [`Plan`], [`RawPath`], [`CurvePoint`]: the result |
 //! | `warm` | [`Memory`], [`Area`]: warm starts after map changes, and the pheromone repair |
 //! | `reuse` | [`reuse`]: a replan answered with the rest of the last answer, when no change can block or shorten it |
+//! | `repair` | the rest of the last answer with an exact detour around what blocks it ([`longest_detour`]), reached through [`reuse`] |
 //! | [`arena`] | [`arena::carve`]: a map and a workspace laid out in one arena, per map size |
 //!
 //! [`Run::step`] does one iteration, so the firmware can yield to its executor between iterations

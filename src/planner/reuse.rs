@@ -13,7 +13,8 @@
 //! 2. **Nothing blocks it**: every move of the raw rest is allowed on the map as it is now
 //!    ([`Grid::step`]: free cells, no corner cut) and every segment of the waypoints is clear
 //!    ([`segment_clear`]). So a cell blocked since the answer was planned is off it, or the
-//!    answer is not reused.
+//!    answer is not reused: it goes to [`super::repair`] (a local detour, large maps) and, if
+//!    that gives up, to the colony.
 //! 3. **No cleared cell can shorten it**: for every rectangle `R` of cells cleared since the
 //!    answer was planned, `d(s, R) + d(R, g)` is at least the answer's length, for the octile
 //!    distance against the raw length and the Euclidean distance to `R`'s squares against the
@@ -111,8 +112,8 @@ pub fn reuse<'a>(
         }
     }
     // ... every segment clear, the robot's first one included; their length summed as
-    // [`crate::geometry::polyline_length`] sums the answer's waypoints (left to right from 0), so it is the
-    // length a run would report for them.
+    // [`crate::geometry::polyline_length`] sums the answer's waypoints (left to right from 0),
+    // so it is the length a run would report for them.
     let mut prev = start;
     let mut polyline = 0.0f32;
     let mut clear = p == Some(goal);
