@@ -20,6 +20,15 @@ fn scenario(name: &str) -> Scenario {
     Scenario::parse(&text).expect("parse")
 }
 
+/// The device over its link, told the default parameters (returned too, for the host core).
+fn device(q: &Qemu) -> (DevicePlanner<std::net::TcpStream>, Params) {
+    let mut dev = DevicePlanner { link: q.link() };
+    dev.link.hello().expect("hello");
+    let p = Params::default();
+    dev.link.set_params(&p).expect("params");
+    (dev, p)
+}
+
 /// The plan without the device's time.
 fn untimed(p: &Planned) -> Planned {
     Planned {
@@ -49,10 +58,7 @@ fn assert_same_drive(what: &str, host: &Drive, dev: &Drive) {
 fn warm_and_cold_replans_on_the_device_are_the_host_cores() {
     need_qemu!();
     let q = Qemu::tcp();
-    let mut dev = DevicePlanner { link: q.link() };
-    dev.link.hello().expect("hello");
-    let p = Params::default();
-    dev.link.set_params(&p).expect("params");
+    let (mut dev, p) = device(&q);
     let map = Map::load(maps().join("complex-26.map")).expect("map");
     let ends = (Point::new(0, 0), Point::new(25, 25));
     for name in ["wall.json", "complex-26-gap.json"] {
@@ -78,10 +84,7 @@ fn warm_and_cold_replans_on_the_device_are_the_host_cores() {
 fn a_warm_replan_on_the_lab_map_is_the_host_cores() {
     need_qemu!();
     let q = Qemu::tcp();
-    let mut dev = DevicePlanner { link: q.link() };
-    dev.link.hello().expect("hello");
-    let p = Params::default();
-    dev.link.set_params(&p).expect("params");
+    let (mut dev, p) = device(&q);
     let (map, frame) = ohaca_host::map::prepare(
         &root().join("host/assets/ros/lab.yaml"),
         ohaca_host::map::Unknown::Blocked,
@@ -152,10 +155,7 @@ fn a_costmap_stream_on_the_device_is_the_host_cores() {
     use ohaca_host::stream::{stream, summary, Stream};
     need_qemu!();
     let q = Qemu::tcp();
-    let mut dev = DevicePlanner { link: q.link() };
-    dev.link.hello().expect("hello");
-    let p = Params::default();
-    dev.link.set_params(&p).expect("params");
+    let (mut dev, p) = device(&q);
     let s = Stream::default();
     for (name, file, ends) in [
         (

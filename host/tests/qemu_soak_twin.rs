@@ -64,7 +64,8 @@ const REPLY_TIMEOUT: Duration = Duration::from_secs(120);
 
 #[path = "common/depot.rs"]
 mod depot;
-use depot::{depot, Rng};
+use depot::depot;
+use ohaca_host::rng::Rng;
 
 type Incoming = Result<(u32, Response), String>;
 

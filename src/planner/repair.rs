@@ -306,7 +306,7 @@ pub(super) fn repair<'a>(
     let raw_length = steps_length(straight, diagonal);
     let smoothed = params.algorithm == Algorithm::Ohaca && params.smoothing != SmoothingKind::None;
     let length = if smoothed { polyline } else { raw_length };
-    if !super::reuse::cannot_shorten(memory, start, goal, raw_length, length) {
+    if !memory.cannot_shorten(start, goal, raw_length, length) {
         return None;
     }
     memory.answer = Some(Answer {

@@ -37,20 +37,14 @@
 //! Host and device call the same function on the same workspace layout, so a reused answer is
 //! the same bit for bit on both. Panic-free like the rest of the core: indices are checked.
 
-use crate::geometry::{bend, distance, segment_clear, sqrt, steps_length};
+use crate::geometry::{bend, distance, segment_clear, steps_length};
 use crate::grid::{is_diagonal, neighbour, Dir, Grid, Point};
-use crate::heuristic::octile;
 use crate::smoothing::SmoothingKind;
 
 use super::params::{Algorithm, Params};
 use super::plan::{Origin, Plan};
-use super::warm::{Answer, Area, Memory};
+use super::warm::{Answer, Memory};
 use super::workspace::Workspace;
-
-/// A lower bound is lowered by this much before it is compared with a length, so that the
-/// rounding of either (f32, a few ulps) can never turn "a path through the cleared cells could be
-/// shorter" into a reuse.
-const SLACK: f32 = 1.0 / 64.0;
 
 /// The rest of the last answer to `goal` from the robot's cell `start`, when `memory` says the
 /// workspace holds one planned with `params` (any seed) on a map of this size, and no change
@@ -134,7 +128,7 @@ pub fn reuse<'a>(
     // Without smoothing a run reports the raw length (`Run::finish`).
     let smoothed = params.algorithm == Algorithm::Ohaca && params.smoothing != SmoothingKind::None;
     let length = if smoothed { polyline } else { raw_length };
-    if !cannot_shorten(memory, start, goal, raw_length, length) {
+    if !memory.cannot_shorten(start, goal, raw_length, length) {
         return None;
     }
     // The robot's cell goes into the slot before the entry: a waypoint it has passed.
@@ -157,22 +151,6 @@ pub fn reuse<'a>(
         Origin::Reused,
         *params,
     ))
-}
-
-/// Rule 3: no rectangle of cells cleared since the answer was planned can give a path from
-/// `start` to `goal` shorter than `raw_length` (octile) or `length` (Euclidean).
-pub(super) fn cannot_shorten(
-    memory: &Memory,
-    start: Point,
-    goal: Point,
-    raw_length: f32,
-    length: f32,
-) -> bool {
-    memory.freed.areas().all(|area| {
-        let euclid = box_distance(start, area) + box_distance(goal, area) - SLACK;
-        let oct = box_octile(start, area) + box_octile(goal, area) - SLACK;
-        oct >= raw_length && euclid >= length
-    })
 }
 
 fn idx(v: u32) -> usize {
@@ -210,63 +188,9 @@ fn segment_distance2(p: Point, a: Point, b: Point) -> f32 {
     dx * dx + dy * dy
 }
 
-/// Cells between `p` and the rectangle on one axis (0 inside).
-fn gap(v: u16, lo: u16, hi: u16) -> u16 {
-    if v < lo {
-        lo.wrapping_sub(v)
-    } else {
-        v.saturating_sub(hi)
-    }
-}
-
-/// Euclidean distance from the centre of `p` to the union of the closed squares of `area`'s
-/// cells (0 inside).
-fn box_distance(p: Point, area: Area) -> f32 {
-    let d = |g: u16| (f32::from(g) - 0.5).max(0.0);
-    let (dx, dy) = (
-        d(gap(p.x, area.min.x, area.max.x)),
-        d(gap(p.y, area.min.y, area.max.y)),
-    );
-    sqrt(dx * dx + dy * dy)
-}
-
-/// Octile distance from `p` to the nearest cell of `area` (0 inside).
-fn box_octile(p: Point, area: Area) -> f32 {
-    let q = Point::new(
-        // Not `clamp`: it panics on `min > max`, which an `Area` never has.
-        p.x.max(area.min.x).min(area.max.x),
-        p.y.max(area.min.y).min(area.max.y),
-    );
-    octile(p, q)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn box_distances_are_lower_bounds() {
-        let area = Area::rect(10, 10, 3, 2).unwrap();
-        // Inside: 0.
-        assert_eq!(box_distance(Point::new(11, 11), area), 0.0);
-        assert_eq!(box_octile(Point::new(12, 10), area), 0.0);
-        // Beside: to the square's edge (half a cell short of the centre).
-        assert_eq!(box_distance(Point::new(5, 10), area), 4.5);
-        assert_eq!(box_octile(Point::new(5, 10), area), 5.0);
-        // Every cell of the area is at least as far as the bound, from every cell around.
-        for y in 0..25u16 {
-            for x in 0..25u16 {
-                let p = Point::new(x, y);
-                for cy in 10..12u16 {
-                    for cx in 10..13u16 {
-                        let c = Point::new(cx, cy);
-                        assert!(octile(p, c) >= box_octile(p, area));
-                        assert!(distance(p, c) + 0.7072 >= box_distance(p, area));
-                    }
-                }
-            }
-        }
-    }
 
     #[test]
     fn nearest_segment_prefers_the_later_on_a_tie() {

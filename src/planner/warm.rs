@@ -28,7 +28,9 @@
 //! match (another goal, another map, no previous run) is a cold start. Host and device use the same
 //! code, so a sequence of warm plans gives the same paths on both.
 
+use crate::geometry::sqrt;
 use crate::grid::Point;
+use crate::heuristic::octile;
 use crate::pheromone::Table;
 
 /// Pheromone within this many cells (Chebyshev distance) of a changed cell is reset to `tau0` on
@@ -305,6 +307,23 @@ impl Memory {
         }
     }
 
+    /// Rule 3 of [`super::reuse`]: no rectangle of cells cleared since the answer was planned
+    /// can give a path from `start` to `goal` shorter than `raw_length` (octile distances through
+    /// its cells) or `length` (Euclidean distances to its cells' squares).
+    pub(super) fn cannot_shorten(
+        &self,
+        start: Point,
+        goal: Point,
+        raw_length: f32,
+        length: f32,
+    ) -> bool {
+        self.freed.areas().all(|area| {
+            let euclid = box_distance(start, area) + box_distance(goal, area) - SLACK;
+            let oct = box_octile(start, area) + box_octile(goal, area) - SLACK;
+            oct >= raw_length && euclid >= length
+        })
+    }
+
     /// A run on a `width x height` map to `goal` set the pheromone (called by
     /// [`super::Run::warm`]; no changes since).
     pub fn planned(&mut self, width: u16, height: u16, goal: Point) {
@@ -333,6 +352,41 @@ impl Memory {
     }
 }
 
+/// A lower bound is lowered by this much before it is compared with a length, so that the
+/// rounding of either (f32, a few ulps) can never turn "a path through the cleared cells could be
+/// shorter" into a reuse.
+const SLACK: f32 = 1.0 / 64.0;
+
+/// Cells between `p` and the rectangle on one axis (0 inside).
+fn gap(v: u16, lo: u16, hi: u16) -> u16 {
+    if v < lo {
+        lo.wrapping_sub(v)
+    } else {
+        v.saturating_sub(hi)
+    }
+}
+
+/// Euclidean distance from the centre of `p` to the union of the closed squares of `area`'s
+/// cells (0 inside).
+fn box_distance(p: Point, area: Area) -> f32 {
+    let d = |g: u16| (f32::from(g) - 0.5).max(0.0);
+    let (dx, dy) = (
+        d(gap(p.x, area.min.x, area.max.x)),
+        d(gap(p.y, area.min.y, area.max.y)),
+    );
+    sqrt(dx * dx + dy * dy)
+}
+
+/// Octile distance from `p` to the nearest cell of `area` (0 inside).
+fn box_octile(p: Point, area: Area) -> f32 {
+    let q = Point::new(
+        // Not `clamp`: it panics on `min > max`, which an `Area` never has.
+        p.x.max(area.min.x).min(area.max.x),
+        p.y.max(area.min.y).min(area.max.y),
+    );
+    octile(p, q)
+}
+
 /// Prepare a kept pheromone table for a warm start: clamp every entry into `[tau_min, tau_max]`
 /// (the bounds may have changed since), then set every entry of an edge with an end within
 /// [`REPAIR_RADIUS`] cells of `changes` to `tau0`. Returns the entries reset.
@@ -355,6 +409,30 @@ pub(super) fn repair(
 mod tests {
     use super::*;
     use crate::pheromone::Blocks;
+
+    #[test]
+    fn box_distances_are_lower_bounds() {
+        let area = Area::rect(10, 10, 3, 2).unwrap();
+        // Inside: 0.
+        assert_eq!(box_distance(Point::new(11, 11), area), 0.0);
+        assert_eq!(box_octile(Point::new(12, 10), area), 0.0);
+        // Beside: to the square's edge (half a cell short of the centre).
+        assert_eq!(box_distance(Point::new(5, 10), area), 4.5);
+        assert_eq!(box_octile(Point::new(5, 10), area), 5.0);
+        // Every cell of the area is at least as far as the bound, from every cell around.
+        for y in 0..25u16 {
+            for x in 0..25u16 {
+                let p = Point::new(x, y);
+                for cy in 10..12u16 {
+                    for cx in 10..13u16 {
+                        let c = Point::new(cx, cy);
+                        assert!(octile(p, c) >= box_octile(p, area));
+                        assert!(crate::geometry::distance(p, c) + 0.7072 >= box_distance(p, area));
+                    }
+                }
+            }
+        }
+    }
 
     #[test]
     fn areas_grow_and_join() {

@@ -1,26 +1,8 @@
 //! Generated maps the end-to-end tests share: a 604 x 307 depot, the shape of Nav2's sample
 //! depot (`#[path]`-included by the tests that use it).
 
+use ohaca_host::rng::Rng;
 use ohaca_host::Map;
-
-/// SplitMix64.
-pub struct Rng(pub u64);
-
-impl Rng {
-    pub fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    pub fn below(&mut self, n: usize) -> usize {
-        (self.next() % n as u64) as usize
-    }
-    pub fn chance(&mut self, p: f64) -> bool {
-        ((self.next() >> 11) as f64 / (1u64 << 53) as f64) < p
-    }
-}
 
 /// A 604 x 307 depot: outer walls, racks (blocks 2 cells deep, 20-40 long) in rows with aisles,
 /// a few pillars and 1 % noise; the lower-left and upper-right corners are free.
