@@ -25,7 +25,11 @@
 //! [`Memory`] is the bookkeeping: which map size and goal the workspace's pheromone belongs to and
 //! the bounding box of the cells changed since. The caller keeps one beside the storage, reports
 //! map changes to it and passes it to [`super::Run::warm`]; a warm start whose memory does not
-//! match (another goal, another map, no previous run) is a cold start. Host and device use the same
+//! match (another goal, another map, no previous run) is a cold start.
+//!
+//! The memory also keeps where the last answer lies in the workspace and which cells were cleared
+//! since it was planned, for [`super::reuse`]; its rule 3 (no cleared cell can shorten the answer)
+//! is [`Memory::cannot_shorten`], beside the rectangles it reads. Host and device use the same
 //! code, so a sequence of warm plans gives the same paths on both.
 
 use crate::geometry::sqrt;
