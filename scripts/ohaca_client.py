@@ -136,7 +136,7 @@ def unframe(wire):
 
 # ---- messages --------------------------------------------------------------------------------
 
-PROTOCOL_VERSION = 9
+PROTOCOL_VERSION = 10
 ALGORITHMS = ["aca", "paca", "haca", "ohaca"]
 DEAD_ENDS = ["backtrack", "die"]
 SMOOTHING = ["none", "greedy", "shortest"]
@@ -211,6 +211,17 @@ STATS_FIELDS = ["uptime", "boots", "frames_ok", "frames_bad", "rx_overruns", "rx
                 "map_width", "map_height", "queued"]
 
 
+def dec_path(r):
+    out = {"kind": "Path", "raw_length": r.f32(), "length": r.f32(), "turns": r.varint(),
+           "iterations": r.varint(), "best_iteration": r.varint(), "moves": r.varint(),
+           "ticks": r.varint(), "raw_cells": r.varint(),
+           "origin": ("cold", "warm", "reused", "repaired")[min(r.byte(), 3)]}
+    w = r.bytes()
+    out["waypoints"] = [struct.unpack_from("<HH", w, i) for i in range(0, len(w), 4)]
+    out["directions"] = list(r.bytes())
+    return out
+
+
 def dec_reply(body):
     r = Reader(body)
     rid = r.varint()
@@ -220,17 +231,12 @@ def dec_reply(body):
                "board": r.str()}
         out["capacity"] = {k: r.varint() for k in
                            ["cells", "max_side", "max_steps", "max_chunk", "max_request",
-                            "plan_queue", "tick_hz"]}
+                            "plan_queue", "tick_hz", "window", "window_bytes"]}
         out["defaults"] = dec_params(r)
     elif tag == 1:
         out = {"kind": "Ack"}
     elif tag == 2:
-        out = {"kind": "Path", "raw_length": r.f32(), "length": r.f32(), "turns": r.varint(),
-               "iterations": r.varint(), "best_iteration": r.varint(), "moves": r.varint(),
-               "ticks": r.varint(), "raw_cells": r.varint(), "origin": ("cold", "warm", "reused", "repaired")[min(r.byte(), 3)]}
-        w = r.bytes()
-        out["waypoints"] = [struct.unpack_from("<HH", w, i) for i in range(0, len(w), 4)]
-        out["directions"] = list(r.bytes())
+        out = dec_path(r)
     elif tag == 3:
         code = r.byte()
         out = {"kind": "Error", "code": code, "name": ERRORS.get(code, "?"),
@@ -241,6 +247,12 @@ def dec_reply(body):
             out[k] = r.varint()
         out["planning"] = r.byte() != 0
         out["stack_peak"] = r.varint()
+        out["replies_dropped"] = r.varint()
+        out["parted"] = r.varint()
+    elif tag == 5:
+        # One part of a long path: the parts' bytes together are a Path reply's body.
+        out = {"kind": "PathPart", "offset": r.varint(), "total_len": r.varint(),
+               "bytes": r.bytes()}
     else:
         raise ValueError(f"unknown reply {tag}")
     if not r.done():
@@ -294,6 +306,7 @@ class Device:
                 time.sleep(0.1)
         self.s.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
         self.buf = bytearray()
+        self.parts = {}
         self.next_id = 1
         self.s.sendall(b"\x00")  # resynchronise the device's frame reader
 
@@ -308,6 +321,25 @@ class Device:
         return rid
 
     def recv(self):
+        """The next whole reply: the parts of a long path are put together into one Path
+        (other replies that come between them are returned first)."""
+        while True:
+            rid, reply = self.recv_frame()
+            if reply["kind"] != "PathPart":
+                return rid, reply
+            parts = self.parts.setdefault(rid, bytearray())
+            if reply["offset"] != len(parts):
+                raise ValueError(f"part of reply {rid} at {reply['offset']}, expected {len(parts)}")
+            parts += reply["bytes"]
+            if len(parts) >= reply["total_len"]:
+                del self.parts[rid]
+                r = Reader(bytes(parts))
+                path = dec_path(r)
+                if not r.done():
+                    raise ValueError("trailing bytes in a path's parts")
+                return rid, path
+
+    def recv_frame(self):
         while True:
             if 0 in self.buf:
                 i = self.buf.index(0)

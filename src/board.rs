@@ -52,6 +52,12 @@ pub struct Board {
     pub max_steps: usize,
     /// Where the map and the planner's buffers go.
     pub layout: Layout,
+    /// Bytes of its UART's receive buffer: the request bytes a host may have outstanding
+    /// (Hello's `capacity.window_bytes`; within them nothing is lost, at any baud rate).
+    pub rx_ring: usize,
+    /// Requests a host may have outstanding (Hello's `capacity.window`): as many as its reply
+    /// queue holds, so no reply is ever dropped within it.
+    pub window: usize,
 }
 
 /// How a board plans one map: the longest ant path it keeps, and whether that is the arena's
@@ -74,6 +80,8 @@ pub const F411: Board = Board {
     max_side: 4096,
     max_steps: 2047,
     layout: Layout::Arena { words: 25_856 },
+    rx_ring: 1024,
+    window: 8,
 };
 
 /// Longest path of the STM32H743.
@@ -93,6 +101,8 @@ pub const H743: Board = Board {
         links: links_for(H743_STEPS),
         moves: 1024,
     },
+    rx_ring: 1024,
+    window: 8,
 };
 
 /// Links of a [`Layout::Separate`] board with paths of up to `steps` steps: tightening's smallest

@@ -185,6 +185,8 @@ pub fn capacity(board: &Board) -> ohaca::protocol::Capacity {
         max_request: u16::try_from(ohaca::protocol::MAX_REQUEST).unwrap_or(u16::MAX),
         plan_queue: 1,
         tick_hz: 1_000_000,
+        window: u8::try_from(board.window).unwrap_or(u8::MAX),
+        window_bytes: u16::try_from(board.rx_ring).unwrap_or(u16::MAX),
     }
 }
 

@@ -25,3 +25,10 @@ pub const PLAN_CELLS: usize = MAX_CELLS;
 /// board (the STM32H743 and its twin keep 16,384). On the small boards' maps of more than 68,256
 /// cells the arena leaves fewer (`ohaca::planner::arena::steps_for`: 1,876 at 512 x 512).
 pub const PLAN_STEPS: usize = BOARD.max_steps;
+/// Bytes the board's receive buffer holds (the UART driver's ring, 1 KiB on every board): the
+/// request bytes a host may have outstanding (`Capacity::window_bytes`). Within them nothing is
+/// lost, however long the receiver is kept from reading (by a planner piece, or the map's lock),
+/// at any baud rate; at 115,200 baud they are 89 ms of the line.
+pub const RX_RING: usize = BOARD.rx_ring;
+/// Requests a host may have outstanding (`Capacity::window`): the reply queue's depth.
+pub const WINDOW: usize = BOARD.window;

@@ -1,11 +1,18 @@
 //! The planning task: takes plan requests from the queue and runs them a piece at a time (each
 //! piece of the setup, each iteration, each piece of the local search and the smoothing),
 //! yielding to the executor after every piece so frames keep arriving and `Cancel` works.
-//! A path is streamed into the UART as it is encoded ([`PathStream`]), a piece at a time: no
-//! buffer for a whole frame (up to 80 KiB). The planner reads the map in place: it holds
-//! [`MAP`]'s lock from `Run::new` until its path is sent (on the small boards the planner's
-//! buffers share the map's arena), and a writer (a map upload, a cell update) cancels the plan
-//! first, so it gives the lock up at its next yield, or once its path is out.
+//!
+//! The planner reads the map in place: it holds [`MAP`]'s lock from `Run::new` until its path is
+//! planned (on the small boards the planner's buffers share the map's arena), and a writer (a map
+//! upload, a cell update) cancels the plan first, so it gives the lock up at its next yield.
+//!
+//! Then it sends the path without the lock. A path whose body fits one part
+//! (`ohaca::protocol::PART_BYTES`) goes whole, as one `Path` frame encoded under the lock. A
+//! longer one goes as `PathPart` frames: for each, the planner takes the lock, lends itself the
+//! workspace again and reads the part from where the plan lies in it (`ohaca::planner::Placed`),
+//! gives the lock up, waits for the small replies queued meanwhile to go out, and sends the part.
+//! So no reply waits behind more than one part, the receiver can write cell updates while a long
+//! path goes out, and a `Cancel` or a map upload stops it (the request then gets `Cancelled`).
 
 use core::sync::atomic::Ordering;
 
@@ -13,24 +20,51 @@ use embassy_futures::yield_now;
 use embassy_time::Instant;
 use embedded_io_async::Write;
 
-use ohaca::planner::{reuse, Plan, Run};
-use ohaca::protocol::{ErrorCode, ErrorReply, PathReply, PathStream, Reply, Waypoints};
+use ohaca::planner::{reuse, Placed, Plan, Run};
+use ohaca::protocol::{
+    encode_reply, wire_len, ErrorCode, ErrorReply, PathBody, PathPart, PathReply, Reply,
+    Waypoints, PART_BYTES,
+};
 
 use super::buffers;
 use super::stack;
-use super::state::{self, count, Job, PlanStorage, TxPort, JOBS, MAP, PLANNING};
+use super::state::{self, count, Job, PlanStorage, Small, TxPort, JOBS, MAP, PLANNING};
 use super::tx::sent_one;
 
-/// Bytes of a path frame encoded per write to the UART.
-const PIECE: usize = 64;
+/// Room for a path frame: a whole path of at most [`PART_BYTES`] body bytes, or a part (id,
+/// variant, offset, length and byte-string length as the longest varints, the CRC).
+const FRAME: usize = wire_len(PART_BYTES + 5 + 1 + 5 + 5 + 2 + 4);
+
+/// A planned path, ready to go out without the map's lock.
+enum Ready {
+    /// A whole `Path` frame of this many bytes in the frame buffer.
+    Whole(usize),
+    /// A path in parts: its fixed fields, where it lies in the workspace, the map it was planned
+    /// on and the body's length.
+    Parts {
+        fixed: PathReply<'static>,
+        placed: Placed,
+        size: (u16, u16),
+        total: usize,
+    },
+}
 
 #[embassy_executor::task]
 pub async fn planner_task(storage: &'static mut PlanStorage, port: &'static TxPort) {
     loop {
         let job = JOBS.receive().await;
         PLANNING.store(true, Ordering::Relaxed);
-        let result = plan(storage, &job, port).await;
+        // A Cancel or a map upload from now on stops this plan's path while it is sent.
+        let stops = state::stops();
+        let mut frame = [0u8; FRAME];
+        let planned = plan(storage, &job, &mut frame).await;
         PLANNING.store(false, Ordering::Relaxed);
+        let result = match planned {
+            Ok((ticks, ready)) => send(storage, &job, ready, &mut frame, stops, port)
+                .await
+                .map(|()| ticks),
+            Err(e) => Err(e),
+        };
         match result {
             Ok(ticks) => count(|s| {
                 s.plans = s.plans.wrapping_add(1);
@@ -43,19 +77,19 @@ pub async fn planner_task(storage: &'static mut PlanStorage, port: &'static TxPo
                     count(|s| s.plan_errors = s.plan_errors.wrapping_add(1));
                 }
                 defmt::info!("plan {}: error {}", job.id, e.code.code());
-                state::reply(job.id, Reply::Error(e)).await;
+                state::reply(job.id, Small::Error(e));
             }
         }
         defmt::info!("stack peak {} of {} bytes", stack::peak(), stack::size());
     }
 }
 
-/// Run one job and send its path; returns the ticks it took.
+/// Run one job; returns the ticks it took and its path, ready to send.
 async fn plan(
     storage: &mut PlanStorage,
     job: &Job,
-    port: &'static TxPort,
-) -> Result<u64, ErrorReply> {
+    frame: &mut [u8; FRAME],
+) -> Result<(u64, Ready), ErrorReply> {
     let cancelled = || ErrorReply::new(ErrorCode::Cancelled);
     if state::cancelled(job.generation) {
         return Err(cancelled());
@@ -68,6 +102,8 @@ async fn plan(
     }
     let (width, height) = state::map_size().ok_or(ErrorReply::new(ErrorCode::NoMap))?;
     let (grid, mut ws) = buffers::lend(&mut map, storage, width, height)?;
+    // Where the plan will lie, to read its parts again once the lock is given up.
+    let bases = ws.bases();
     let t0 = Instant::now();
     // A warm plan keeps the colony if it is for this map and goal; both kinds record theirs for
     // the next `PlanWarm` once the run started (a refused plan leaves the pheromone as it was).
@@ -87,8 +123,8 @@ async fn plan(
                 plan.waypoints().len(),
                 ticks
             );
-            send(job, &plan, ticks, port).await?;
-            return Ok(ticks);
+            let ready = ready(job, &plan, ticks, bases, (width, height), frame)?;
+            return Ok((ticks, ready));
         }
     }
     let mut run = if job.warm {
@@ -157,18 +193,13 @@ async fn plan(
         in_steps,
         t_end.saturating_duration_since(t_finish).as_ticks()
     );
-    send(job, &plan, ticks, port).await?;
-    Ok(ticks)
+    let ready = ready(job, &plan, ticks, bases, (width, height), frame)?;
+    Ok((ticks, ready))
 }
 
-/// Send `plan` as the path reply to `job`, a piece at a time.
-async fn send(
-    job: &Job,
-    plan: &Plan<'_>,
-    ticks: u64,
-    port: &'static TxPort,
-) -> Result<(), ErrorReply> {
-    let reply = PathReply {
+/// The reply to `job` for `plan`: its fixed fields and slices.
+fn path_reply<'a>(plan: &Plan<'a>, ticks: u64) -> PathReply<'a> {
+    PathReply {
         raw_length: plan.raw_length,
         length: plan.length,
         turns: plan.turns,
@@ -180,29 +211,117 @@ async fn send(
         origin: plan.origin,
         waypoints: Waypoints::Points(plan.waypoints()),
         directions: plan.directions(),
-    };
-    let mut stream = PathStream::new(job.id, &reply).map_err(|e| {
-        defmt::error!("path reply: {}", defmt::Display2Format(&e));
-        ErrorReply::with(
-            ErrorCode::Internal,
-            plan.waypoints().len() as u32,
-            plan.directions().len() as u32,
-        )
-    })?;
-    // The frame goes out while the plan's buffers are still borrowed (and with them the map's
-    // lock: on the small boards they are in the same arena), so the next plan, and a writer,
-    // start once it is sent.
-    let mut piece = [0u8; PIECE];
-    let mut tx = port.lock().await;
-    let mut sent = true;
-    while !stream.is_done() {
-        let n = stream.fill(&mut piece);
-        if tx.write_all(piece.get(..n).unwrap_or(&[])).await.is_err() {
-            sent = false; // the host drops the cut frame at the next delimiter
-            break;
-        }
     }
-    drop(tx);
-    sent_one(sent);
+}
+
+/// An error for a path the protocol cannot carry (it never happens within the board's limits).
+fn unsendable(plan: &Plan<'_>) -> ErrorReply {
+    ErrorReply::with(
+        ErrorCode::Internal,
+        plan.waypoints().len() as u32,
+        plan.directions().len() as u32,
+    )
+}
+
+/// Get `plan` ready to send: a short one encoded whole into `frame`, a long one placed.
+fn ready(
+    job: &Job,
+    plan: &Plan<'_>,
+    ticks: u64,
+    bases: ohaca::planner::Bases,
+    size: (u16, u16),
+    frame: &mut [u8; FRAME],
+) -> Result<Ready, ErrorReply> {
+    let reply = path_reply(plan, ticks);
+    let total = match PathBody::new(&reply) {
+        Ok(body) => body.len(),
+        Err(e) => {
+            defmt::error!("path reply: {}", defmt::Display2Format(&e));
+            return Err(unsendable(plan));
+        }
+    };
+    if total <= PART_BYTES {
+        let n = encode_reply(job.id, &Reply::Path(reply), frame).map_err(|_| unsendable(plan))?;
+        return Ok(Ready::Whole(n));
+    }
+    let placed = plan.place(bases).ok_or_else(|| unsendable(plan))?;
+    let fixed = PathReply {
+        waypoints: Waypoints::Points(&[]),
+        directions: &[],
+        ..reply
+    };
+    Ok(Ready::Parts {
+        fixed,
+        placed,
+        size,
+        total,
+    })
+}
+
+/// Send a planned path: whole, or a part at a time with the small replies passing between the
+/// parts. A `Cancel` or a map upload since `stops` stops a path in parts (`Cancelled`).
+async fn send(
+    storage: &mut PlanStorage,
+    job: &Job,
+    ready: Ready,
+    frame: &mut [u8; FRAME],
+    stops: u32,
+    port: &'static TxPort,
+) -> Result<(), ErrorReply> {
+    let (fixed, placed, size, total) = match ready {
+        Ready::Whole(n) => {
+            state::wait_for_small().await;
+            let mut tx = port.lock().await;
+            let sent = tx.write_all(frame.get(..n).unwrap_or(&[])).await.is_ok();
+            drop(tx);
+            sent_one(sent);
+            return Ok(());
+        }
+        Ready::Parts {
+            fixed,
+            placed,
+            size,
+            total,
+        } => (fixed, placed, size, total),
+    };
+    count(|s| s.parted = s.parted.wrapping_add(1));
+    let mut offset = 0;
+    let mut bytes = [0u8; PART_BYTES];
+    while offset < total {
+        // Read the part under the map's lock, from the workspace lent again as it was.
+        let n = {
+            let mut map = MAP.lock().await;
+            if state::stopped(stops) || state::map_size() != Some(size) {
+                defmt::info!("plan {}: path stopped after {} of {} bytes", job.id, offset, total);
+                return Err(ErrorReply::new(ErrorCode::Cancelled));
+            }
+            let (_grid, ws) = buffers::lend(&mut map, storage, size.0, size.1)?;
+            let (tour, waypoints) = ws
+                .placed(&placed)
+                .ok_or(ErrorReply::new(ErrorCode::Internal))?;
+            let reply = PathReply {
+                waypoints: Waypoints::Points(waypoints),
+                directions: tour,
+                ..fixed
+            };
+            let body = PathBody::new(&reply).map_err(|_| ErrorReply::new(ErrorCode::Internal))?;
+            let k = body.read(offset, &mut bytes);
+            let part = PathPart {
+                offset: offset as u32,
+                total_len: total as u32,
+                bytes: bytes.get(..k).unwrap_or(&[]),
+            };
+            let n = encode_reply(job.id, &Reply::PathPart(part), frame)
+                .map_err(|_| ErrorReply::new(ErrorCode::Internal))?;
+            offset = offset.saturating_add(k.max(1));
+            n
+        };
+        // The small replies queued meanwhile go first; then this part.
+        state::wait_for_small().await;
+        let mut tx = port.lock().await;
+        let sent = tx.write_all(frame.get(..n).unwrap_or(&[])).await.is_ok();
+        drop(tx);
+        sent_one(sent);
+    }
     Ok(())
 }

@@ -11,16 +11,12 @@ use embedded_io_async::Read;
 use ohaca::grid::Point;
 use ohaca::planner::{Area, Params};
 use ohaca::protocol::{
-    check_cells, check_rect, decode_request, set_cells, set_rect, Capacity, Encoding, ErrorCode,
-    ErrorReply, HelloReply, MapChunk, Reply, Request, RequestReader, Upload, Waypoints, MAX_CHUNK,
-    MAX_REQUEST, MAX_REQUEST_WIRE, VERSION,
+    check_cells, check_rect, decode_request, set_cells, set_rect, Encoding, ErrorCode, ErrorReply,
+    MapChunk, Request, RequestReader, Upload, Waypoints, MAX_REQUEST_WIRE,
 };
 
-use super::board::{self, Board};
-use super::state::{
-    self, count, reply, Job, GENERATION, JOBS, LIMITS, MAP, MAX_CELLS, MAX_SIDE, PLAN_CELLS,
-    PLAN_QUEUE, PLAN_STEPS,
-};
+use super::board;
+use super::state::{self, count, reply, Job, Small, GENERATION, JOBS, LIMITS, MAP, PLAN_QUEUE};
 
 #[embassy_executor::task]
 pub async fn rx_task(mut rx: board::Rx) {
@@ -50,7 +46,7 @@ pub async fn rx_task(mut rx: board::Rx) {
                 Err(e) => {
                     count(|s| s.frames_bad = s.frames_bad.wrapping_add(1));
                     defmt::warn!("bad frame: {}", defmt::Display2Format(&e));
-                    reply(e.id(), Reply::Error(e.reply())).await;
+                    reply(e.id(), Small::Error(e.reply()));
                 }
             }
         }
@@ -69,26 +65,8 @@ enum Update<'a> {
     Cells(Waypoints<'a>),
 }
 
-fn error(code: ErrorCode, detail: u32, limit: u32) -> Reply<'static> {
-    Reply::Error(ErrorReply::with(code, detail, limit))
-}
-
-fn hello() -> HelloReply<'static> {
-    HelloReply {
-        protocol_version: VERSION,
-        firmware_version: env!("CARGO_PKG_VERSION"),
-        board: board::Active::NAME,
-        capacity: Capacity {
-            cells: PLAN_CELLS.min(MAX_CELLS) as u32,
-            max_side: MAX_SIDE,
-            max_steps: PLAN_STEPS as u32,
-            max_chunk: MAX_CHUNK as u16,
-            max_request: MAX_REQUEST as u16,
-            plan_queue: PLAN_QUEUE as u8,
-            tick_hz: embassy_time::TICK_HZ as u32,
-        },
-        defaults: Params::default(),
-    }
+fn error(code: ErrorCode, detail: u32, limit: u32) -> Small {
+    Small::Error(ErrorReply::with(code, detail, limit))
 }
 
 impl Session {
@@ -101,7 +79,7 @@ impl Session {
 
     async fn handle(&mut self, id: u32, req: Request<'_>) {
         let r = match req {
-            Request::Hello => Reply::Hello(hello()),
+            Request::Hello => Small::Hello,
             Request::SetMap {
                 width,
                 height,
@@ -148,9 +126,9 @@ impl Session {
                 Ok(()) => {
                     self.params = p;
                     defmt::info!("params: {} ants x {} iterations", p.ants, p.iterations);
-                    Reply::Ack
+                    Small::Ack
                 }
-                Err(e) => Reply::Error(e.into()),
+                Err(e) => Small::Error(e.into()),
             },
             Request::Plan { start, goal, seed } | Request::PlanWarm { start, goal, seed } => {
                 let warm = matches!(req, Request::PlanWarm { .. });
@@ -166,12 +144,14 @@ impl Session {
                 }
             }
             Request::Cancel => {
-                state::cancel_all();
-                Reply::Ack
+                // Also stops a path being sent: its request gets `Cancelled` before this `Ack`
+                // goes out, or right after the part on the wire.
+                state::stop_all();
+                Small::Ack
             }
-            Request::Stats => Reply::Stats(state::stats()),
+            Request::Stats => Small::Stats,
         };
-        reply(id, r).await;
+        reply(id, r);
     }
 
     fn enqueue(
@@ -181,7 +161,7 @@ impl Session {
         goal: Point,
         seed: Option<u64>,
         warm: bool,
-    ) -> Result<(), Reply<'static>> {
+    ) -> Result<(), Small> {
         if state::map_size().is_none() {
             return Err(error(ErrorCode::NoMap, 0, 0));
         }
@@ -208,14 +188,15 @@ impl Session {
 
     /// One chunk of a map upload (raw or run-length). A good first chunk drops the map: plans
     /// get `NoMap` until the last chunk arrives (or a broken upload ends it with no map).
-    async fn set_map(&mut self, c: &MapChunk<'_>) -> Reply<'static> {
+    async fn set_map(&mut self, c: &MapChunk<'_>) -> Small {
         let starts = match self.upload.accept(c, LIMITS) {
             Ok(s) => s,
-            Err(e) => return Reply::Error(e),
+            Err(e) => return Small::Error(e),
         };
         if starts {
-            // Plans received before this map are for the old one.
-            state::cancel_all();
+            // Plans received before this map are for the old one, and a path being sent is read
+            // from buffers the new map may cover.
+            state::stop_all();
             state::set_map_size(None);
         }
         let mut map = MAP.lock().await;
@@ -227,10 +208,10 @@ impl Session {
             Ok(Some((w, h))) => {
                 state::set_map_size(Some((w, h)));
                 defmt::info!("map {}x{} active", w, h);
-                Reply::Ack
+                Small::Ack
             }
-            Ok(None) => Reply::Ack,
-            Err(e) => Reply::Error(e),
+            Ok(None) => Small::Ack,
+            Err(e) => Small::Error(e),
         }
     }
 }
@@ -240,7 +221,7 @@ impl Session {
 const SMALL_RECT: u32 = 64;
 
 /// Block or clear cells of the map in place; cancels the running and queued plans.
-async fn update(u: Update<'_>, blocked: bool) -> Reply<'static> {
+async fn update(u: Update<'_>, blocked: bool) -> Small {
     let Some(size) = state::map_size() else {
         return error(ErrorCode::NoMap, 0, 0);
     };
@@ -249,7 +230,7 @@ async fn update(u: Update<'_>, blocked: bool) -> Reply<'static> {
         Update::Cells(c) => check_cells(size, c),
     };
     if let Err(e) = checked {
-        return Reply::Error(e);
+        return Small::Error(e);
     }
     state::cancel_all();
     let mut map = MAP.lock().await;
@@ -296,7 +277,7 @@ async fn update(u: Update<'_>, blocked: bool) -> Reply<'static> {
     };
     state::set_colony(memory);
     match done {
-        Ok(()) => Reply::Ack,
-        Err(e) => Reply::Error(e),
+        Ok(()) => Small::Ack,
+        Err(e) => Small::Error(e),
     }
 }

@@ -30,6 +30,7 @@
 
 pub mod arena;
 mod params;
+mod placed;
 mod plan;
 mod repair;
 mod reuse;
@@ -38,6 +39,7 @@ mod warm;
 mod workspace;
 
 pub use params::{Algorithm, Params};
+pub use placed::{Bases, Placed};
 pub use plan::{CurvePoint, Origin, Plan, RawPath};
 pub use repair::{longest_detour, MARGIN as REPAIR_MARGIN};
 pub use reuse::reuse;

@@ -10,10 +10,10 @@ use crate::planner::{Origin, Params};
 use super::wire::PointDef;
 #[cfg(doc)] // the doc links
 use super::{
-    ErrorCode, PathStream, RleEncoder, MAX_CHUNK, MAX_DIRECTIONS, MAX_REPLY, MAX_REQUEST,
+    ErrorCode, PathStream, RleEncoder, MAX_CHUNK, PART_BYTES, MAX_DIRECTIONS, MAX_REPLY, MAX_REQUEST,
     MAX_STEPS, MAX_UPDATE_CELLS, MAX_WAYPOINTS, VERSION,
 };
-use super::{ErrorReply, Waypoints};
+use super::{ErrorReply, PathPart, Waypoints};
 
 /// Host to device.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -129,6 +129,10 @@ pub enum Reply<'a> {
     Error(ErrorReply),
     /// `4`: answer to [`Request::Stats`].
     Stats(StatsReply),
+    /// `5`: one part of a planned path too long for one frame (its body is longer than
+    /// [`PART_BYTES`]): the parts, in order, carry the bytes a [`Reply::Path`] would after its
+    /// id and variant; other replies may come between them (`docs/PROTOCOL.md`, "Long paths").
+    PathPart(#[serde(borrow)] PathPart<'a>),
 }
 
 /// What the device is and can do.
@@ -167,6 +171,12 @@ pub struct Capacity {
     pub plan_queue: u8,
     /// Ticks per second of [`PathReply::ticks`] and [`StatsReply::uptime`].
     pub tick_hz: u32,
+    /// Requests a host may have outstanding (sent, and not answered in full) at once: within
+    /// `window` requests and `window_bytes` bytes nothing is lost, at any baud rate.
+    pub window: u8,
+    /// Bytes of request frames a host may have outstanding at once (the device's receive
+    /// buffer): see `window`.
+    pub window_bytes: u16,
 }
 
 /// A planned path: the planner's [`crate::Plan`] plus the time it took.
@@ -239,4 +249,8 @@ pub struct StatsReply {
     /// Most stack the device has used since boot, in bytes (its high-water mark, interrupts
     /// included; 0 if the device does not measure it).
     pub stack_peak: u32,
+    /// Replies not sent because the reply queue was full (a host beyond its window).
+    pub replies_dropped: u32,
+    /// Path replies sent in parts ([`Reply::PathPart`]).
+    pub parted: u32,
 }

@@ -11,7 +11,8 @@
 //! * CRC-32/ISO-HDLC ([`crc32`]) over the postcard bytes, appended little-endian.
 //! * COBS: the frame contains no `0x00` except its delimiter; a lone `0x00` resynchronises.
 //! * Every request carries an `id` chosen by the host; the device answers every request with
-//!   exactly one reply carrying the same `id`. A frame that cannot be attributed (bad CRC, bad
+//!   exactly one reply carrying the same `id` (a long path: with [`PathPart`] frames that
+//!   together are that reply, [`parts`](PathBody)). A frame that cannot be attributed (bad CRC, bad
 //!   COBS, too long) is answered with an [`ErrorCode`] reply whose id is [`UNKNOWN_ID`].
 //!
 //! ```
@@ -36,7 +37,8 @@
 //! | `error_reply` | [`ErrorReply`], [`ErrorCode`] and their mapping to the planner's errors |
 //! | `frame` | CRC-32, COBS and the byte-at-a-time [`FrameReader`] |
 //! | `wire` | serde glue: points on the wire, the packed [`Waypoints`] |
-//! | `stream` | [`PathStream`]: a path reply encoded piece by piece |
+//! | `parts` | [`PathBody`], [`PathPart`]: a long path reply in frames other replies can pass |
+//! | `stream` | [`PathStream`]: a path reply as one frame, encoded piece by piece |
 //! | `map` | map uploads (raw and run-length) and cell updates as the device applies them |
 
 use core::fmt;
@@ -47,6 +49,7 @@ mod error_reply;
 mod frame;
 mod map;
 mod message;
+mod parts;
 mod stream;
 mod wire;
 
@@ -58,6 +61,7 @@ pub use map::{
     RleEncoder, RleError, Upload, MAX_UPDATE_CELLS,
 };
 pub use message::{Capacity, HelloReply, PathReply, Reply, Request, StatsReply};
+pub use parts::{decode_path_body, PathBody, PathPart, PART_BYTES};
 pub use stream::PathStream;
 pub use wire::{Waypoints, WAYPOINT_BYTES};
 
@@ -67,8 +71,9 @@ pub use wire::{Waypoints, WAYPOINT_BYTES};
 /// `warm_patience`; 5: `refine_patience` and `refine`; 6: [`Capacity`] by cells, `max_side` and
 /// `max_steps`; 7: [`MAX_REPLY`] carries every path of [`MAX_STEPS`] steps; 8: [`MAX_STEPS`]
 /// 16,384; 9: [`PathReply::origin`] replaces `warm`, a `PlanWarm` may be answered with the rest
-/// of the previous answer).
-pub const VERSION: u16 = 9;
+/// of the previous answer; 10: a path longer than [`PART_BYTES`] comes as [`Reply::PathPart`]s,
+/// [`Capacity::window`] and `window_bytes`, [`StatsReply::replies_dropped`] and `parted`).
+pub const VERSION: u16 = 10;
 
 /// The id of replies to frames whose request id could not be read. Hosts should not use it.
 pub const UNKNOWN_ID: u32 = 0;

@@ -1,34 +1,31 @@
 //! A path reply encoded a piece at a time, for a device without room for a whole reply frame.
 //!
 //! [`PathStream`] produces exactly the bytes [`super::encode_reply`] writes for a
-//! [`Reply::Path`], in pieces as small as the caller likes: postcard serializes the fixed fields
-//! into a small buffer, the waypoints and directions are read from the caller's slices as they go
-//! out, the CRC is computed on the way, and COBS works one block (at most 254 bytes) ahead. It
-//! takes about 350 bytes instead of a [`MAX_REPLY_WIRE`]-byte frame buffer. A unit test checks
-//! it against [`super::encode_reply`] byte for byte.
+//! [`super::Reply::Path`], in pieces as small as the caller likes: the body is read from the
+//! reply's slices as it goes out ([`PathBody`]), the CRC is computed on the way, and COBS works
+//! one block (at most 254 bytes) ahead. It takes about 350 bytes instead of a
+//! [`MAX_REPLY_WIRE`]-byte frame buffer. A unit test checks it against [`super::encode_reply`]
+//! byte for byte. It suits a link that one long frame may hold; the firmware sends long paths
+//! in parts instead, so that other replies pass them (`super::parts`).
 
 use super::frame::{crc32_step, CRC32_INIT};
-use super::{
-    wire_len, EncodeError, PathReply, Reply, Waypoints, MAX_REPLY, MAX_REPLY_WIRE, WAYPOINT_BYTES,
-};
+use super::parts::PathBody;
+use super::{wire_len, EncodeError, PathReply, MAX_REPLY, MAX_REPLY_WIRE};
 
-/// Room for the id, the variant, the fixed fields of a path (at most 50 bytes) and the length of
-/// the waypoints.
-const HEAD: usize = 64;
+/// Room for the id and the variant (at most 5 + 1 bytes).
+const PREFIX: usize = 6;
 /// Longest COBS block: up to 254 data bytes follow a code byte.
 const BLOCK: usize = 254;
+/// The variant of `Reply::Path`.
+const PATH_VARIANT: u8 = 2;
 
 /// The parts of the payload, in order.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Part {
-    /// Id, variant, fixed fields, length of the waypoints (`head`).
-    Head,
-    /// The waypoints, 4 bytes a point.
-    Waypoints,
-    /// Length of the directions (`mid`).
-    Mid,
-    /// The directions.
-    Directions,
+    /// Id and variant (`prefix`).
+    Prefix,
+    /// The path's body ([`PathBody`]).
+    Body,
     /// The CRC, little-endian.
     Crc,
     /// Nothing left.
@@ -70,13 +67,9 @@ enum Stage {
 /// assert_eq!(wire, &whole[..len]);
 /// ```
 pub struct PathStream<'a> {
-    head: [u8; HEAD],
-    head_len: usize,
-    mid: [u8; 5],
-    mid_len: usize,
-    waypoints: Waypoints<'a>,
-    waypoint_bytes: usize,
-    directions: &'a [u8],
+    prefix: [u8; PREFIX],
+    prefix_len: usize,
+    body: PathBody<'a>,
     part: Part,
     pos: usize,
     crc: u32,
@@ -85,42 +78,20 @@ pub struct PathStream<'a> {
     stage: Stage,
 }
 
-/// Append the postcard varint of `n` to `buf[at..]`; returns the bytes written.
-fn put_len(buf: &mut [u8], at: usize, n: usize) -> Result<usize, EncodeError> {
-    let n = u32::try_from(n).map_err(|_| EncodeError::Serialize)?;
-    let room = buf.get_mut(at..).ok_or(EncodeError::Serialize)?;
-    postcard::to_slice(&n, room)
-        .map(|b| b.len())
-        .map_err(|_| EncodeError::Serialize)
-}
-
 impl<'a> PathStream<'a> {
     /// Prepare the frame of `Reply::Path(path)` with this `id`. Fails with
     /// [`EncodeError::BufferTooSmall`] (`have` = [`MAX_REPLY_WIRE`]) if the path is over the
     /// protocol's limits, exactly when [`super::encode_reply`] into a [`MAX_REPLY_WIRE`] buffer
     /// would.
     pub fn new(id: u32, path: &PathReply<'a>) -> Result<Self, EncodeError> {
-        let fixed = Reply::Path(PathReply {
-            waypoints: Waypoints::Points(&[]),
-            directions: &[],
-            ..*path
-        });
-        let mut head = [0u8; HEAD];
-        let n = postcard::to_slice(&(id, &fixed), &mut head)
+        let body = PathBody::unchecked(path)?;
+        let mut prefix = [0u8; PREFIX];
+        let n = postcard::to_slice(&id, &mut prefix)
             .map_err(|_| EncodeError::Serialize)?
             .len();
-        // It ends with the two empty byte strings, one zero length byte each: drop them.
-        let head_len = n.checked_sub(2).ok_or(EncodeError::Serialize)?;
-        let waypoint_bytes = path.waypoints.len().saturating_mul(WAYPOINT_BYTES);
-        // `put_len` writes into `head[head_len..]`, so the sum is at most `HEAD`.
-        let head_len = head_len.wrapping_add(put_len(&mut head, head_len, waypoint_bytes)?);
-        let mut mid = [0u8; 5];
-        let mid_len = put_len(&mut mid, 0, path.directions.len())?;
-        let payload = head_len
-            .saturating_add(waypoint_bytes)
-            .saturating_add(mid_len)
-            .saturating_add(path.directions.len())
-            .saturating_add(4);
+        *prefix.get_mut(n).ok_or(EncodeError::Serialize)? = PATH_VARIANT;
+        let prefix_len = n.wrapping_add(1); // n < PREFIX
+        let payload = prefix_len.saturating_add(body.len()).saturating_add(4);
         if payload > MAX_REPLY {
             return Err(EncodeError::BufferTooSmall {
                 need: wire_len(payload),
@@ -128,14 +99,10 @@ impl<'a> PathStream<'a> {
             });
         }
         Ok(PathStream {
-            head,
-            head_len,
-            mid,
-            mid_len,
-            waypoints: path.waypoints,
-            waypoint_bytes,
-            directions: path.directions,
-            part: Part::Head,
+            prefix,
+            prefix_len,
+            body,
+            part: Part::Prefix,
             pos: 0,
             crc: CRC32_INIT,
             block: [0; BLOCK],
@@ -213,26 +180,12 @@ impl<'a> PathStream<'a> {
         loop {
             let pos = self.pos;
             let byte = match self.part {
-                Part::Head => self
-                    .head
-                    .get(..self.head_len)
+                Part::Prefix => self
+                    .prefix
+                    .get(..self.prefix_len)
                     .and_then(|h| h.get(pos))
                     .copied(),
-                Part::Waypoints if pos < self.waypoint_bytes => {
-                    let p = self.waypoints.get(pos / WAYPOINT_BYTES).unwrap_or_default();
-                    let le = match pos % WAYPOINT_BYTES {
-                        0 | 1 => p.x.to_le_bytes(),
-                        _ => p.y.to_le_bytes(),
-                    };
-                    le.get(pos % 2).copied()
-                }
-                Part::Waypoints => None,
-                Part::Mid => self
-                    .mid
-                    .get(..self.mid_len)
-                    .and_then(|m| m.get(pos))
-                    .copied(),
-                Part::Directions => self.directions.get(pos).copied(),
+                Part::Body => self.body.byte(pos),
                 Part::Crc => {
                     let crc = (!self.crc).to_le_bytes();
                     if let Some(&b) = crc.get(pos) {
@@ -253,10 +206,8 @@ impl<'a> PathStream<'a> {
                 None => {
                     self.pos = 0;
                     self.part = match self.part {
-                        Part::Head => Part::Waypoints,
-                        Part::Waypoints => Part::Mid,
-                        Part::Mid => Part::Directions,
-                        Part::Directions => Part::Crc,
+                        Part::Prefix => Part::Body,
+                        Part::Body => Part::Crc,
                         Part::Crc | Part::End => Part::End,
                     };
                 }

@@ -45,9 +45,10 @@ use std::time::{Duration, Instant};
 
 use ohaca::grid::{DX, DY};
 use ohaca::protocol::{
-    decode_reply, encode_request, Capacity, DecodeError, EncodeError, ErrorCode, ErrorReply,
+    decode_path_body, decode_reply, encode_request, Capacity, DecodeError, EncodeError, ErrorCode,
+    ErrorReply,
     HelloReply, PathReply, Reply, ReplyReader, Request, RleEncoder, StatsReply, Waypoints,
-    MAX_CHUNK, MAX_REPLY_WIRE, MAX_REQUEST_WIRE, MAX_UPDATE_CELLS, UNKNOWN_ID, VERSION,
+    MAX_CHUNK, MAX_REPLY, MAX_REPLY_WIRE, MAX_REQUEST_WIRE, MAX_UPDATE_CELLS, UNKNOWN_ID, VERSION,
 };
 use ohaca::{Params, Point};
 

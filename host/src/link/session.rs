@@ -39,6 +39,11 @@ pub struct Link<T: Transport> {
     pub(super) outstanding: HashSet<u32>,
     /// Replies to outstanding ids that arrived while another was awaited.
     buffered: VecDeque<(u32, Response)>,
+    /// Requests sent and not answered yet (their last reply frame not received), with their
+    /// bytes on the wire: the device's window ([`Link::send`] keeps within it).
+    unanswered: HashMap<u32, usize>,
+    /// The parts of long paths received so far, by request id.
+    parts: HashMap<u32, Vec<u8>>,
     strays: Vec<Stray>,
     stray_count: u64,
     info: Option<DeviceInfo>,
@@ -104,6 +109,8 @@ impl<T: Transport> Link<T> {
             timeout,
             outstanding: HashSet::new(),
             buffered: VecDeque::new(),
+            unanswered: HashMap::new(),
+            parts: HashMap::new(),
             strays: Vec::new(),
             stray_count: 0,
             info: None,
@@ -165,7 +172,9 @@ impl<T: Transport> Link<T> {
     }
 
     /// Send a request without waiting; returns its id. Its reply is kept until
-    /// [`Link::wait_for`] (or [`Link::recv`]) takes it.
+    /// [`Link::wait_for`] (or [`Link::recv`]) takes it. Keeps within the device's window
+    /// (`Capacity::window` requests and `window_bytes` bytes not answered yet, one request
+    /// before [`Link::hello`]): it first reads and keeps replies until the request fits.
     pub fn send(&mut self, req: &Request<'_>) -> Result<u32, LinkError> {
         let id = self.next_id;
         self.next_id = self.next_id.checked_add(1).unwrap_or(1);
@@ -174,9 +183,57 @@ impl<T: Transport> Link<T> {
             request: request_name(req),
             error,
         })?;
+        self.make_room(n, request_name(req))?;
         self.send_raw(buf.get(..n).unwrap_or(&[]))?;
         self.outstanding.insert(id);
+        self.unanswered.insert(id, n);
         Ok(id)
+    }
+
+    /// The device's window: requests and bytes (one request of any size before Hello).
+    fn window(&self) -> (usize, usize) {
+        self.info.as_ref().map_or((1, MAX_REQUEST_WIRE), |i| {
+            (
+                usize::from(i.capacity.window).max(1),
+                usize::from(i.capacity.window_bytes).max(MAX_REQUEST_WIRE),
+            )
+        })
+    }
+
+    /// Read replies (kept for their callers) until a request of `bytes` bytes fits the window.
+    fn make_room(&mut self, bytes: usize, request: &'static str) -> Result<(), LinkError> {
+        let (requests, room) = self.window();
+        let deadline = Instant::now() + self.timeout;
+        while !self.unanswered.is_empty()
+            && (self.unanswered.len() >= requests
+                || self.unanswered.values().sum::<usize>() + bytes > room)
+        {
+            let (got, resp) = self.read_frame(deadline, request, 0)?;
+            self.keep(got, resp);
+        }
+        Ok(())
+    }
+
+    /// Keep a reply that is not the one awaited: for its caller if its request is outstanding,
+    /// else as a stray.
+    fn keep(&mut self, got: u32, resp: Response) {
+        if got != UNKNOWN_ID && self.outstanding.contains(&got) {
+            self.buffered.push_back((got, resp));
+        } else {
+            self.stray_count += 1;
+            if self.strays.len() >= MAX_STRAYS {
+                self.strays.remove(0);
+            }
+            self.strays.push(Stray::Reply {
+                id: got,
+                response: resp,
+            });
+        }
+    }
+
+    /// Requests sent and not answered yet.
+    pub fn unanswered(&self) -> usize {
+        self.unanswered.len()
     }
 
     /// Wait for the reply to request `id` (named `request` in a timeout message), at most
@@ -512,23 +569,46 @@ impl<T: Transport> Link<T> {
                 self.outstanding.remove(&got);
                 return Ok((got, resp));
             }
-            if got != UNKNOWN_ID && self.outstanding.contains(&got) {
-                self.buffered.push_back((got, resp));
-            } else {
-                self.stray_count += 1;
-                if self.strays.len() >= MAX_STRAYS {
-                    self.strays.remove(0);
-                }
-                self.strays.push(Stray::Reply {
-                    id: got,
-                    response: resp,
-                });
+            self.keep(got, resp);
+        }
+    }
+
+    /// The next complete reply from the wire, decoded, before `deadline`: the parts of a long
+    /// path are put together into one [`Response::Path`].
+    fn read_frame(
+        &mut self,
+        deadline: Instant,
+        request: &'static str,
+        id: u32,
+    ) -> Result<(u32, Response), LinkError> {
+        loop {
+            let (got, resp) = self.read_one(deadline, request, id)?;
+            let Response::Part(part) = resp else {
+                // A reply ends its request, and a path's parts (`Cancelled` after some parts).
+                self.parts.remove(&got);
+                self.unanswered.remove(&got);
+                return Ok((got, resp));
+            };
+            let broken = LinkError::Decode(DecodeError::Undecodable { id: Some(got) });
+            let body = self.parts.entry(got).or_default();
+            if usize::try_from(part.offset).ok() != Some(body.len())
+                || body.len() + part.bytes.len() > MAX_REPLY
+            {
+                self.parts.remove(&got);
+                return Err(broken);
+            }
+            body.extend_from_slice(&part.bytes);
+            if usize::try_from(part.total_len).is_ok_and(|t| body.len() >= t) {
+                let body = self.parts.remove(&got).unwrap_or_default();
+                let path = decode_path_body(&body).ok_or(broken)?;
+                self.unanswered.remove(&got);
+                return Ok((got, Response::Path((&path).into())));
             }
         }
     }
 
     /// The next complete frame from the wire, decoded, before `deadline`.
-    fn read_frame(
+    fn read_one(
         &mut self,
         deadline: Instant,
         request: &'static str,

@@ -181,6 +181,20 @@ pub enum Response {
     Error(ErrorReply),
     /// [`Reply::Stats`].
     Stats(StatsReply),
+    /// [`Reply::PathPart`]: [`super::Link`] puts the parts of a path together and returns a
+    /// [`Response::Path`]; a part is seen only by whoever reads frames one by one.
+    Part(OwnedPart),
+}
+
+/// A [`PathPart`], owned.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct OwnedPart {
+    /// Where its bytes start in the path's body.
+    pub offset: u32,
+    /// The body's length.
+    pub total_len: u32,
+    /// Its bytes.
+    pub bytes: Vec<u8>,
 }
 
 impl From<&Reply<'_>> for Response {
@@ -191,6 +205,11 @@ impl From<&Reply<'_>> for Response {
             Reply::Path(p) => Response::Path(p.into()),
             Reply::Error(e) => Response::Error(*e),
             Reply::Stats(s) => Response::Stats(*s),
+            Reply::PathPart(p) => Response::Part(OwnedPart {
+                offset: p.offset,
+                total_len: p.total_len,
+                bytes: p.bytes.to_vec(),
+            }),
         }
     }
 }
@@ -204,6 +223,7 @@ impl Response {
             Response::Path(_) => "Path",
             Response::Error(_) => "Error",
             Response::Stats(_) => "Stats",
+            Response::Part(_) => "PathPart",
         }
     }
 }

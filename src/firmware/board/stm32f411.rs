@@ -20,7 +20,8 @@ bind_interrupts!(struct Irqs {
 });
 
 /// UART ring buffers (the planner yields once per iteration; a full map chunk is ~160 bytes).
-static RX_BUF: ConstStaticCell<[u8; 1024]> = ConstStaticCell::new([0; 1024]);
+static RX_BUF: ConstStaticCell<[u8; crate::firmware::limits::RX_RING]> =
+    ConstStaticCell::new([0; crate::firmware::limits::RX_RING]);
 static TX_BUF: ConstStaticCell<[u8; 256]> = ConstStaticCell::new([0; 256]);
 
 pub struct Stm32f411;

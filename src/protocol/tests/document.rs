@@ -74,6 +74,8 @@ fn example_stats() -> StatsReply {
         queued: 0,
         planning: false,
         stack_peak: 3176,
+        replies_dropped: 0,
+        parted: 0,
     }
 }
 
@@ -332,6 +334,11 @@ fn reply_fields(id: u32, r: &Reply<'_>) -> Vec<(String, Vec<u8>)> {
                 format!("  capacity.tick_hz = {}", c.tick_hz),
                 ser(&c.tick_hz),
             ));
+            v.push((format!("  capacity.window = {}", c.window), ser(&c.window)));
+            v.push((
+                format!("  capacity.window_bytes = {}", c.window_bytes),
+                ser(&c.window_bytes),
+            ));
             for (name, b) in params_fields(&h.defaults) {
                 v.push((name.replacen("  ", "  defaults.", 1), b));
             }
@@ -385,7 +392,7 @@ fn reply_fields(id: u32, r: &Reply<'_>) -> Vec<(String, Vec<u8>)> {
         }
         Reply::Stats(s) => {
             v.push(("Reply::Stats (variant 4)".into(), vec![4]));
-            let fields: [(&str, Vec<u8>, String); 17] = [
+            let fields: [(&str, Vec<u8>, String); 19] = [
                 ("uptime", ser(&s.uptime), s.uptime.to_string()),
                 ("boots", ser(&s.boots), s.boots.to_string()),
                 ("frames_ok", ser(&s.frames_ok), s.frames_ok.to_string()),
@@ -415,6 +422,12 @@ fn reply_fields(id: u32, r: &Reply<'_>) -> Vec<(String, Vec<u8>)> {
                 ("queued", ser(&s.queued), s.queued.to_string()),
                 ("planning", ser(&s.planning), s.planning.to_string()),
                 ("stack_peak", ser(&s.stack_peak), s.stack_peak.to_string()),
+                (
+                    "replies_dropped",
+                    ser(&s.replies_dropped),
+                    s.replies_dropped.to_string(),
+                ),
+                ("parted", ser(&s.parted), s.parted.to_string()),
             ];
             for (name, b, val) in fields {
                 v.push((format!("  {name} = {val}"), b));

@@ -177,6 +177,8 @@ fn hello() -> HelloReply<'static> {
             max_request: MAX_REQUEST as u16,
             plan_queue: 4,
             tick_hz: 1_000_000,
+            window: 8,
+            window_bytes: 1024,
         },
         defaults: Params::default(),
     }
@@ -209,6 +211,16 @@ fn replies() -> Vec<Reply<'static>> {
             ..path()
         }),
         Reply::Stats(StatsReply::default()),
+        Reply::PathPart(PathPart {
+            offset: 0,
+            total_len: 77,
+            bytes: &[],
+        }),
+        Reply::PathPart(PathPart {
+            offset: u32::MAX,
+            total_len: u32::MAX,
+            bytes: &[0xff; PART_BYTES],
+        }),
         Reply::Stats(StatsReply {
             uptime: u64::MAX,
             boots: 1,
