@@ -58,7 +58,7 @@ fn payload(len: usize) -> Vec<u8> {
             s ^= s << 13;
             s ^= s >> 17;
             s ^= s << 5;
-            if s % 16 == 0 {
+            if s & 15 == 0 {
                 0
             } else {
                 (s >> 8) as u8 | 1
