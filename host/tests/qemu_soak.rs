@@ -50,15 +50,15 @@
 mod qemu;
 
 use std::collections::{BTreeMap, VecDeque};
-use std::io::{Read, Write};
+use std::io::Write;
 use std::net::{Shutdown, TcpStream};
 use std::rc::Rc;
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
 use ohaca::protocol::{
-    decode_reply, decode_request, encode_request, ErrorCode, ErrorReply, ReplyReader, Request,
-    RequestReader, StatsReply, MAX_CHUNK, MAX_REPLY_WIRE, MAX_REQUEST_WIRE,
+    decode_request, encode_request, ErrorCode, ErrorReply, Request, RequestReader, StatsReply,
+    MAX_CHUNK, MAX_REQUEST_WIRE,
 };
 use ohaca::{Algorithm, DeadEnd, Params, Point, SmoothingKind};
 use ohaca_host::link::{DeviceInfo, Response};
@@ -379,38 +379,7 @@ fn from_planner(r: &Response) -> bool {
 
 // ---- the device's replies -----------------------------------------------------------------------
 
-type Incoming = Result<(u32, Response), String>;
-
-/// Read reply frames until the connection closes; every one goes to `tx`, decoded.
-fn read_replies(mut s: TcpStream, tx: mpsc::Sender<Incoming>) {
-    let mut reader = Box::new(ReplyReader::new());
-    let mut buf = vec![0u8; 8192];
-    loop {
-        let n = match s.read(&mut buf) {
-            Ok(0) => {
-                let _ = tx.send(Err("the device closed the connection".into()));
-                return;
-            }
-            Ok(n) => n,
-            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
-            Err(e) => {
-                let _ = tx.send(Err(format!("read: {e}")));
-                return;
-            }
-        };
-        for &b in &buf[..n] {
-            if let Some(f) = reader.push(b).into_frame(MAX_REPLY_WIRE) {
-                let r = f
-                    .and_then(decode_reply)
-                    .map(|(id, r)| (id, Response::from(&r)))
-                    .map_err(|e| format!("undecodable reply frame: {e}"));
-                if tx.send(r).is_err() {
-                    return;
-                }
-            }
-        }
-    }
-}
+use qemu::{read_replies, Incoming};
 
 // ---- the soak -----------------------------------------------------------------------------------
 
@@ -941,6 +910,7 @@ impl Soak {
             Response::Path(_) => self.replies.path += 1,
             Response::Stats(_) => self.replies.stats += 1,
             Response::Error(e) => *self.replies.errors.entry(e.code.code()).or_default() += 1,
+            Response::Part(_) => panic!("reply {id}: a path part the reader did not put together"),
         }
         if from_planner(&resp) {
             self.on_plan_reply(id, resp);

@@ -32,15 +32,14 @@
 #[path = "common/qemu.rs"]
 mod qemu;
 
-use std::io::{Read, Write};
+use std::io::Write;
 use std::net::TcpStream;
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
 use ohaca::protocol::{
-    decode_reply, decode_request, encode_request, Encoding, ErrorCode, ErrorReply, MapChunk,
-    MapLimits, ReplyReader, Request, RequestReader, RleEncoder, Upload, MAX_CHUNK, MAX_REPLY_WIRE,
-    MAX_REQUEST_WIRE,
+    decode_request, encode_request, Encoding, ErrorCode, ErrorReply, MapChunk, MapLimits, Request,
+    RequestReader, RleEncoder, Upload, MAX_CHUNK, MAX_REQUEST_WIRE,
 };
 use ohaca::{Params, Point};
 use ohaca_host::link::Response;
@@ -67,38 +66,7 @@ mod depot;
 use depot::depot;
 use ohaca_host::rng::Rng;
 
-type Incoming = Result<(u32, Response), String>;
-
-/// Read reply frames until the connection closes.
-fn read_replies(mut s: TcpStream, tx: mpsc::Sender<Incoming>) {
-    let mut reader = Box::new(ReplyReader::new());
-    let mut buf = vec![0u8; 8192];
-    loop {
-        let n = match s.read(&mut buf) {
-            Ok(0) => {
-                let _ = tx.send(Err("the device closed the connection".into()));
-                return;
-            }
-            Ok(n) => n,
-            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
-            Err(e) => {
-                let _ = tx.send(Err(format!("read: {e}")));
-                return;
-            }
-        };
-        for &b in &buf[..n] {
-            if let Some(f) = reader.push(b).into_frame(MAX_REPLY_WIRE) {
-                let r = f
-                    .and_then(decode_reply)
-                    .map(|(id, r)| (id, Response::from(&r)))
-                    .map_err(|e| format!("undecodable reply frame: {e}"));
-                if tx.send(r).is_err() {
-                    return;
-                }
-            }
-        }
-    }
-}
+use qemu::{read_replies, Incoming};
 
 /// A reply the model predicts.
 #[derive(Debug, PartialEq)]

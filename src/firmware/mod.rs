@@ -2,16 +2,22 @@
 //! [`ohaca::protocol`] over a UART.
 //!
 //! ```text
-//!   UART rx --> [rx task] --decode--> Hello / Stats / SetParams / Cancel: answered here
+//!   UART rx --> [rx task] --decode--> Hello / Stats / SetParams / Cancel: answered at once
 //!                  |                  SetMap(Rle) / SetRect / SetCells: cancel, lock MAP, write
 //!                  |                  Plan / PlanWarm: queued (JOBS, 4 deep; full -> Busy)
 //!                  v
-//!              [planner task] holds MAP's lock for a plan; one Run::step() per iteration, then
-//!                  |            yield; checks for cancellation (then releases MAP)
-//!                  |            path frames: streamed into the UART a piece at a time --+
-//!                  v                                                                     |
-//!   UART tx <-- [tx task] <-- OUT channel (small replies by value)  <--------------------+
+//!              [planner task] holds MAP's lock while it plans; one Run::step() per iteration,
+//!                  |            then yield; checks for cancellation (then releases MAP)
+//!                  |            path: one Path frame, or PathPart frames (each read under MAP's
+//!                  |            lock, sent without it, after the small replies queued) --+
+//!                  v                                                                      |
+//!   UART tx <-- [tx task] <-- OUT (small replies, 8 deep = the window; full -> dropped)   |
+//!           <-----------------------------------------------------------------------------+
 //! ```
+//!
+//! The receiver never waits for room in a queue, and for the map's lock at most one planner
+//! piece: within the window (`state::WINDOW` requests, `state::RX_RING` bytes) the receive buffer
+//! holds whatever arrives meanwhile, at any baud rate.
 //!
 //! Everything board-specific (UART, time driver, log sink, exit) is behind [`board::Board`].
 

@@ -22,8 +22,8 @@ use embedded_io_async::Write;
 
 use ohaca::planner::{reuse, Placed, Plan, Run};
 use ohaca::protocol::{
-    encode_reply, wire_len, ErrorCode, ErrorReply, PathBody, PathPart, PathReply, Reply,
-    Waypoints, PART_BYTES,
+    encode_reply, wire_len, ErrorCode, ErrorReply, PathBody, PathPart, PathReply, Reply, Waypoints,
+    PART_BYTES,
 };
 
 use super::buffers;
@@ -292,7 +292,12 @@ async fn send(
         let n = {
             let mut map = MAP.lock().await;
             if state::stopped(stops) || state::map_size() != Some(size) {
-                defmt::info!("plan {}: path stopped after {} of {} bytes", job.id, offset, total);
+                defmt::info!(
+                    "plan {}: path stopped after {} of {} bytes",
+                    job.id,
+                    offset,
+                    total
+                );
                 return Err(ErrorReply::new(ErrorCode::Cancelled));
             }
             let (_grid, ws) = buffers::lend(&mut map, storage, size.0, size.1)?;

@@ -2,7 +2,9 @@
 //! plans at once and queues plans for the planner. Map uploads and cell updates are written into
 //! the one map buffer ([`MAP`]): checked first (a refused one changes nothing), then the running
 //! and queued plans are cancelled, then the buffer's lock is taken (the planner gives it up at
-//! its next yield).
+//! its next yield, or after reading one part of a path it is sending). It never waits for room
+//! in a queue: a full plan queue is `Busy`, a full reply queue (a host beyond its window) drops
+//! the reply, counted.
 
 use embassy_futures::yield_now;
 use embassy_sync::channel::TrySendError;

@@ -8,14 +8,12 @@ use core::sync::atomic::Ordering;
 use embedded_io_async::Write;
 
 use ohaca::planner::Params;
-use ohaca::protocol::{
-    encode_reply, Capacity, HelloReply, Reply, MAX_CHUNK, MAX_REQUEST, VERSION,
-};
+use ohaca::protocol::{encode_reply, Capacity, HelloReply, Reply, MAX_CHUNK, MAX_REQUEST, VERSION};
 
 use super::board::{self, Board};
 use super::state::{
-    count, stats, Out, Small, TxPort, MAX_CELLS, MAX_SIDE, OUT, PLAN_CELLS, PLAN_QUEUE,
-    PLAN_STEPS, RX_RING, SENDING_SMALL, WINDOW,
+    count, stats, Out, Small, TxPort, MAX_CELLS, MAX_SIDE, OUT, PLAN_CELLS, PLAN_QUEUE, PLAN_STEPS,
+    RX_RING, SENDING_SMALL, WINDOW,
 };
 
 /// Room for every reply but a path (Hello is the largest, under 110 bytes).

@@ -90,8 +90,14 @@ mod tests {
         let (placed, tour, waypoints) = {
             let ws = s.workspace();
             let bases = ws.bases();
-            let p = plan(&g, Point::new(0, 0), Point::new(7, 5), &Params::default(), ws)
-                .unwrap();
+            let p = plan(
+                &g,
+                Point::new(0, 0),
+                Point::new(7, 5),
+                &Params::default(),
+                ws,
+            )
+            .unwrap();
             let placed = p.place(bases).expect("a run's plan lies in its workspace");
             (placed, p.directions().to_vec(), p.waypoints().to_vec())
         };

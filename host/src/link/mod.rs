@@ -46,9 +46,9 @@ use std::time::{Duration, Instant};
 use ohaca::grid::{DX, DY};
 use ohaca::protocol::{
     decode_path_body, decode_reply, encode_request, Capacity, DecodeError, EncodeError, ErrorCode,
-    ErrorReply,
-    HelloReply, PathReply, Reply, ReplyReader, Request, RleEncoder, StatsReply, Waypoints,
-    MAX_CHUNK, MAX_REPLY, MAX_REPLY_WIRE, MAX_REQUEST_WIRE, MAX_UPDATE_CELLS, UNKNOWN_ID, VERSION,
+    ErrorReply, HelloReply, PathReply, Reply, ReplyReader, Request, RleEncoder, StatsReply,
+    Waypoints, MAX_CHUNK, MAX_REPLY, MAX_REPLY_WIRE, MAX_REQUEST_WIRE, MAX_UPDATE_CELLS,
+    UNKNOWN_ID, VERSION,
 };
 use ohaca::{Params, Point};
 

@@ -42,8 +42,8 @@ pub struct Link<T: Transport> {
     /// Requests sent and not answered yet (their last reply frame not received), with their
     /// bytes on the wire: the device's window ([`Link::send`] keeps within it).
     unanswered: HashMap<u32, usize>,
-    /// The parts of long paths received so far, by request id.
-    parts: HashMap<u32, Vec<u8>>,
+    /// The parts of long paths received so far.
+    parts: Assembler,
     strays: Vec<Stray>,
     stray_count: u64,
     info: Option<DeviceInfo>,
@@ -110,7 +110,7 @@ impl<T: Transport> Link<T> {
             outstanding: HashSet::new(),
             buffered: VecDeque::new(),
             unanswered: HashMap::new(),
-            parts: HashMap::new(),
+            parts: Assembler::default(),
             strays: Vec::new(),
             stray_count: 0,
             info: None,
@@ -583,26 +583,9 @@ impl<T: Transport> Link<T> {
     ) -> Result<(u32, Response), LinkError> {
         loop {
             let (got, resp) = self.read_one(deadline, request, id)?;
-            let Response::Part(part) = resp else {
-                // A reply ends its request, and a path's parts (`Cancelled` after some parts).
-                self.parts.remove(&got);
+            if let Some(resp) = self.parts.push(got, resp).map_err(LinkError::Decode)? {
                 self.unanswered.remove(&got);
                 return Ok((got, resp));
-            };
-            let broken = LinkError::Decode(DecodeError::Undecodable { id: Some(got) });
-            let body = self.parts.entry(got).or_default();
-            if usize::try_from(part.offset).ok() != Some(body.len())
-                || body.len() + part.bytes.len() > MAX_REPLY
-            {
-                self.parts.remove(&got);
-                return Err(broken);
-            }
-            body.extend_from_slice(&part.bytes);
-            if usize::try_from(part.total_len).is_ok_and(|t| body.len() >= t) {
-                let body = self.parts.remove(&got).unwrap_or_default();
-                let path = decode_path_body(&body).ok_or(broken)?;
-                self.unanswered.remove(&got);
-                return Ok((got, Response::Path((&path).into())));
             }
         }
     }

@@ -186,7 +186,47 @@ pub enum Response {
     Part(OwnedPart),
 }
 
-/// A [`PathPart`], owned.
+/// Puts the parts of long paths together ([`Reply::PathPart`], `docs/PROTOCOL.md`, "Long paths
+/// in parts"), for whoever reads reply frames: [`super::Link`] and the tests' own readers.
+#[derive(Debug, Default)]
+pub struct Assembler {
+    parts: HashMap<u32, Vec<u8>>,
+}
+
+impl Assembler {
+    /// Take one decoded reply of request `id`: a whole reply comes back at once (and ends any
+    /// parts of `id`: a path stopped by `Cancel` is answered `Cancelled` after some parts); a
+    /// part is kept, and the last one gives back the whole [`Response::Path`]. A part out of
+    /// order, too long or whose bytes do not decode is [`DecodeError::Undecodable`].
+    pub fn push(&mut self, id: u32, resp: Response) -> Result<Option<Response>, DecodeError> {
+        let Response::Part(part) = resp else {
+            self.parts.remove(&id);
+            return Ok(Some(resp));
+        };
+        let broken = DecodeError::Undecodable { id: Some(id) };
+        let body = self.parts.entry(id).or_default();
+        if usize::try_from(part.offset).ok() != Some(body.len())
+            || body.len() + part.bytes.len() > MAX_REPLY
+        {
+            self.parts.remove(&id);
+            return Err(broken);
+        }
+        body.extend_from_slice(&part.bytes);
+        if !usize::try_from(part.total_len).is_ok_and(|t| body.len() >= t) {
+            return Ok(None);
+        }
+        let body = self.parts.remove(&id).unwrap_or_default();
+        let path = decode_path_body(&body).ok_or(broken)?;
+        Ok(Some(Response::Path((&path).into())))
+    }
+
+    /// Requests with parts received and the rest to come.
+    pub fn pending(&self) -> usize {
+        self.parts.len()
+    }
+}
+
+/// A [`ohaca::protocol::PathPart`], owned.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct OwnedPart {
     /// Where its bytes start in the path's body.

@@ -491,3 +491,47 @@ pub fn assert_core_path(what: &str, core: &CorePath, dev: &DevicePath) {
     assert_eq!(dev_core, *core, "{what}: device path vs host core");
     assert_eq!(bits(&dev_core), bits(core), "{what}: length bits");
 }
+
+/// A reply as a reader thread hands it on: decoded (the parts of a long path put together), or
+/// why the link failed.
+pub type Incoming = Result<(u32, ohaca_host::link::Response), String>;
+
+/// Read reply frames until the connection closes; every reply goes to `tx`, decoded, the parts of
+/// a long path as one `Path` ([`ohaca_host::link::Assembler`]).
+pub fn read_replies(mut s: TcpStream, tx: std::sync::mpsc::Sender<Incoming>) {
+    use ohaca::protocol::{decode_reply, ReplyReader, MAX_REPLY_WIRE};
+    use ohaca_host::link::{Assembler, Response};
+    let mut reader = Box::new(ReplyReader::new());
+    let mut parts = Assembler::default();
+    let mut buf = vec![0u8; 8192];
+    loop {
+        let n = match s.read(&mut buf) {
+            Ok(0) => {
+                let _ = tx.send(Err("the device closed the connection".into()));
+                return;
+            }
+            Ok(n) => n,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+            Err(e) => {
+                let _ = tx.send(Err(format!("read: {e}")));
+                return;
+            }
+        };
+        for &b in &buf[..n] {
+            if let Some(f) = reader.push(b).into_frame(MAX_REPLY_WIRE) {
+                let r = f
+                    .and_then(decode_reply)
+                    .and_then(|(id, r)| Ok((id, parts.push(id, Response::from(&r))?)))
+                    .map_err(|e| format!("undecodable reply frame: {e}"));
+                let r = match r {
+                    Ok((_, None)) => continue, // a part; the path comes with its last
+                    Ok((id, Some(resp))) => Ok((id, resp)),
+                    Err(e) => Err(e),
+                };
+                if tx.send(r).is_err() {
+                    return;
+                }
+            }
+        }
+    }
+}
