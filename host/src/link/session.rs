@@ -241,7 +241,9 @@ impl<T: Transport> Link<T> {
     pub fn wait_for(&mut self, id: u32, request: &'static str) -> Result<Response, LinkError> {
         let r = self.wait_matching(|i| i == id, request, id);
         if r.is_err() {
+            // Given up: a reply that comes later is a stray, and no longer holds the window.
             self.outstanding.remove(&id);
+            self.unanswered.remove(&id);
         }
         r.map(|(_, resp)| resp)
     }
@@ -508,6 +510,7 @@ impl<T: Transport> Link<T> {
                     Err(e) => {
                         for id in inflight.keys() {
                             self.outstanding.remove(id);
+                            self.unanswered.remove(id);
                         }
                         return Err(e);
                     }

@@ -49,6 +49,11 @@ mod fake_device {
             }
             Response::Error(e) => Reply::Error(*e),
             Response::Stats(s) => Reply::Stats(*s),
+            Response::Part(p) => Reply::PathPart(ohaca::protocol::PathPart {
+                offset: p.offset,
+                total_len: p.total_len,
+                bytes: &p.bytes,
+            }),
         };
         let n = encode_reply(id, &reply, &mut buf).unwrap();
         buf.truncate(n);
@@ -118,6 +123,8 @@ mod fake_device {
                 max_request: 256,
                 plan_queue: queue,
                 tick_hz: 1_000_000,
+                window: 8,
+                window_bytes: 1024,
             },
             defaults: Params::default(),
         }
@@ -137,6 +144,107 @@ mod fake_device {
             waypoints: vec![Point::new(0, 0), Point::new(1, 0)],
             directions: vec![0],
         }
+    }
+
+    /// `p`'s body in parts of `size` bytes, as a device sends a long path.
+    fn parts(p: &DevicePath, size: usize) -> Vec<Response> {
+        let reply = PathReply {
+            raw_length: p.raw_length,
+            length: p.length,
+            turns: p.turns,
+            iterations: p.iterations,
+            best_iteration: p.best_iteration,
+            moves: p.moves,
+            ticks: p.ticks,
+            raw_cells: p.raw_cells,
+            origin: p.origin,
+            waypoints: Waypoints::Points(&p.waypoints),
+            directions: &p.directions,
+        };
+        let body = ohaca::protocol::PathBody::new(&reply).unwrap();
+        let mut bytes = vec![0u8; body.len()];
+        assert_eq!(body.read(0, &mut bytes), body.len());
+        bytes
+            .chunks(size)
+            .enumerate()
+            .map(|(k, c)| {
+                Response::Part(OwnedPart {
+                    offset: (k * size) as u32,
+                    total_len: bytes.len() as u32,
+                    bytes: c.to_vec(),
+                })
+            })
+            .collect()
+    }
+
+    #[test]
+    fn the_parts_of_a_long_path_are_one_path_and_other_replies_pass_them() {
+        let long = DevicePath {
+            waypoints: (0..300).map(|i| Point::new(i, i)).collect(),
+            directions: vec![1; 299],
+            raw_cells: 300,
+            ..path(9)
+        };
+        let want = long.clone();
+        let mut plan_id = 0;
+        let mut link = fake(move |id, req| match req {
+            Request::Hello => vec![(id, Response::Hello(info(4)))],
+            Request::Plan { .. } => {
+                plan_id = id;
+                vec![]
+            }
+            // The Stats reply overtakes the path: it comes between its parts.
+            Request::Stats => {
+                let mut out: Vec<(u32, Response)> = Vec::new();
+                let mut p = parts(&long, 192).into_iter().map(|r| (plan_id, r));
+                out.extend(p.by_ref().take(2));
+                out.push((id, Response::Stats(StatsReply::default())));
+                out.extend(p);
+                out
+            }
+            _ => vec![(id, Response::Ack)],
+        });
+        link.hello().unwrap();
+        let plan = link
+            .send(&Request::Plan {
+                start: Point::new(0, 0),
+                goal: Point::new(299, 299),
+                seed: None,
+            })
+            .unwrap();
+        assert_eq!(link.unanswered(), 1);
+        assert_eq!(link.stats().unwrap(), StatsReply::default());
+        assert_eq!(link.wait_for(plan, "Plan").unwrap(), Response::Path(want));
+        assert_eq!(link.unanswered(), 0);
+        assert_eq!(link.stray_count(), 0);
+    }
+
+    #[test]
+    fn parts_out_of_order_are_an_error_and_a_cancel_drops_the_parts() {
+        let long = DevicePath {
+            waypoints: (0..100).map(|i| Point::new(i, 0)).collect(),
+            directions: vec![0; 99],
+            raw_cells: 100,
+            ..path(3)
+        };
+        let mut a = Assembler::default();
+        let p = parts(&long, 100);
+        assert!(p.len() >= 3);
+        assert_eq!(a.push(5, p[0].clone()), Ok(None));
+        assert_eq!(a.pending(), 1);
+        // Cancelled after one part: the reply ends the parts.
+        let cancelled = Response::Error(ErrorReply::new(ErrorCode::Cancelled));
+        assert_eq!(a.push(5, cancelled.clone()), Ok(Some(cancelled)));
+        assert_eq!(a.pending(), 0);
+        // A part that skips one is refused.
+        assert_eq!(a.push(6, p[0].clone()), Ok(None));
+        assert!(a.push(6, p[2].clone()).is_err());
+        // In order, the path.
+        let mut got = None;
+        for r in p {
+            got = a.push(7, r).unwrap();
+        }
+        assert_eq!(got, Some(Response::Path(long)));
     }
 
     #[test]

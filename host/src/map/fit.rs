@@ -364,6 +364,8 @@ mod tests {
             max_request: 256,
             plan_queue: 4,
             tick_hz: 1_000_000,
+            window: 8,
+            window_bytes: 1024,
         }
     }
 

@@ -590,6 +590,8 @@ mod tests {
             max_request: 256,
             plan_queue: 4,
             tick_hz: 1_000_000,
+            window: 8,
+            window_bytes: 1024,
         };
         let mut p = Planning::new(
             Box::new(Small(HostBackend::new(Params::default()), cap)),
