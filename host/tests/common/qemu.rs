@@ -12,13 +12,14 @@ use std::io::{BufRead, BufReader, Read};
 use std::net::{TcpListener, TcpStream};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
-use std::sync::OnceLock;
+use std::sync::{Arc, OnceLock};
 use std::time::{Duration, Instant};
 
 use ohaca::protocol::{
     crc32, decode_request, ErrorCode, ErrorReply, RequestReader, MAX_REQUEST_WIRE,
 };
 use ohaca::{Params, Point};
+use ohaca_host::link::relay::{Counters, Relay, RelayStream};
 use ohaca_host::link::{DevicePath, Link};
 use ohaca_host::{HeapStorage, Map};
 
@@ -279,6 +280,53 @@ impl Qemu {
             }
         }
     }
+}
+
+/// A running QEMU whose UART0 is behind a pacing relay (`ohaca_host::link::relay`: a real
+/// serial line, `baud` 8N1, between the test and the emulated UART); QEMU is killed on drop,
+/// then the relay stops.
+pub struct PacedQemu {
+    child: Child,
+    /// The relay (its counters: [`Relay::counters`]; more clients: [`Relay::client`]).
+    pub relay: Relay,
+}
+
+impl Drop for PacedQemu {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+impl PacedQemu {
+    /// True while QEMU runs.
+    pub fn is_running(&mut self) -> bool {
+        matches!(self.child.try_wait(), Ok(None))
+    }
+}
+
+/// Boot the firmware ([`firmware`]) with UART0 behind a relay at `baud`: the QEMU, a [`Link`]
+/// over the relay's in-process client (its line clocks: `link.transport().wait_sent(..)` and
+/// `.take_arrivals()`), and the relay's counters.
+pub fn boot_paced(baud: u32) -> (PacedQemu, Link<RelayStream>, Arc<Counters>) {
+    boot_paced_with(firmware(), baud)
+}
+
+/// [`boot_paced`] with another firmware ELF.
+pub fn boot_paced_with(elf: &Path, baud: u32) -> (PacedQemu, Link<RelayStream>, Arc<Counters>) {
+    let mut c = Command::new("qemu-system-arm");
+    c.args(["-M", "mps2-an386", "-display", "none", "-monitor", "none"])
+        .args(["-semihosting-config", "enable=on,target=native"])
+        .arg("-kernel")
+        .arg(elf)
+        .stdin(Stdio::null())
+        .stdout(defmt_log())
+        .stderr(Stdio::inherit());
+    let (child, relay) = Relay::spawn_qemu(&mut c, baud).expect("start QEMU behind the relay");
+    let counters = relay.counters();
+    let q = PacedQemu { child, relay };
+    let link = Link::new(q.relay.client(), TIMEOUT).expect("a link over the relay");
+    (q, link, counters)
 }
 
 // ---- frames --------------------------------------------------------------------------------
