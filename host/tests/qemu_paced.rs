@@ -101,7 +101,10 @@ fn an_upload_is_paced_toward_the_device() {
     let before = counters.snapshot();
     let t0 = Instant::now();
     let map = load("large/maze-128-128-2.map");
-    link.set_map(&map).expect("upload");
+    link.set_timeout(Duration::from_secs(5));
+    if let Err(e) = link.set_map(&map) {
+        panic!("upload: {e}; {}; closed {}; strays {:?}", counters.snapshot(), counters.device_closed(), link.take_strays());
+    }
     let took = t0.elapsed();
     let last = link.transport().wait_sent(TIMEOUT).expect("sent");
     let sent = counters.snapshot().since(&before);

@@ -17,7 +17,10 @@
 //!   delivered ([`Counters::backlog_max`]).
 //! * **No flow control toward the device.** A device-bound byte is written, without waiting, at
 //!   its slot; if the device side cannot take it then, it is lost and counted
-//!   ([`Counters::to_device_dropped`]), as a UART without flow control loses it.
+//!   ([`Counters::to_device_dropped`]), as a UART without flow control loses it. "Cannot take"
+//!   means [`DEVICE_SLACK`] bytes are already waiting for QEMU's UART (which takes one when the
+//!   firmware has read the last): room for QEMU's own scheduling delays, not for a receiver that
+//!   stopped reading.
 //! * **Line clocks.** Each direction counts the bytes that have passed on its line (toward the
 //!   device: delivered plus lost). Latencies can so be measured in bytes on the line, which do
 //!   not depend on the host's speed: [`RelayStream::wait_sent`] gives the clocks of both
@@ -318,10 +321,25 @@ impl Line {
     }
 }
 
-/// The smallest buffers the kernel allows, both ways.
+/// Device-bound bytes the device side may leave untaken before the next one is lost: the
+/// relay's end has a send buffer for about this many one-byte writes (Linux charges ~768 bytes
+/// of buffer for each, and doubles the size asked for). A UART's receiver takes a byte within
+/// one byte time, but QEMU reads its socket from its main loop, which a loaded host schedules
+/// milliseconds late now and then: with the kernel's smallest buffer (6 bytes, 0.5 ms at
+/// 115200) uploads lost bytes on a 2-core machine. 64 bytes are 5.6 ms at 115200.
+pub const DEVICE_SLACK: usize = 64;
+
+/// The smallest buffers the kernel allows, both ways (QEMU's end).
 fn shrink_buffers(s: &UnixStream) -> io::Result<()> {
     let r = SockRef::from(s);
     r.set_send_buffer_size(1)?;
+    r.set_recv_buffer_size(1)
+}
+
+/// The relay's end: the smallest buffers but room for [`DEVICE_SLACK`] bytes toward the device.
+fn relay_buffers(s: &UnixStream) -> io::Result<()> {
+    let r = SockRef::from(s);
+    r.set_send_buffer_size(DEVICE_SLACK * 384)?;
     r.set_recv_buffer_size(1)
 }
 
@@ -337,7 +355,7 @@ pub struct Relay {
 impl Relay {
     /// Pace `device` (the relay's end of a socket to the device) at `baud`.
     pub fn new(device: UnixStream, baud: u32) -> io::Result<Relay> {
-        shrink_buffers(&device)?;
+        relay_buffers(&device)?;
         device.set_read_timeout(Some(POLL))?;
         let counters = Arc::new(Counters::new(baud));
         let stop = Arc::new(AtomicBool::new(false));

@@ -325,7 +325,18 @@ pub fn boot_paced_with(elf: &Path, baud: u32) -> (PacedQemu, Link<RelayStream>, 
     let (child, relay) = Relay::spawn_qemu(&mut c, baud).expect("start QEMU behind the relay");
     let counters = relay.counters();
     let q = PacedQemu { child, relay };
-    let link = Link::new(q.relay.client(), TIMEOUT).expect("a link over the relay");
+    let mut link = Link::new(q.relay.client(), TIMEOUT).expect("a link over the relay");
+    // As on a real board, bytes sent before the firmware takes them are lost (QEMU reads its
+    // socket only once the UART receives, and the socket holds a few bytes): say Hello until the
+    // device answers, then forget the strays of the partial frames.
+    link.set_timeout(Duration::from_millis(300));
+    let t0 = Instant::now();
+    while link.hello().is_err() {
+        assert!(t0.elapsed() < Duration::from_secs(60), "the firmware never answered Hello");
+        let _ = link.send_raw(&[0]);
+    }
+    link.set_timeout(TIMEOUT);
+    link.take_strays();
     (q, link, counters)
 }
 
