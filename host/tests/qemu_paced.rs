@@ -18,7 +18,7 @@ use std::time::{Duration, Instant};
 
 use ohaca::protocol::{decode_reply, ReplyReader, Request, MAX_REPLY_WIRE};
 use ohaca::{Params, Point};
-use ohaca_host::link::relay::{byte_time, Arrival, Counters, RelayStream, Stamp};
+use ohaca_host::link::relay::{byte_time, Arrival, Counters, RelayStream, Stamp, MAX_CATCH_UP};
 use ohaca_host::link::{Link, Response};
 use ohaca_host::Map;
 use qemu::{boot_paced, have_qemu, longest_scenario, maps, TIMEOUT};
@@ -101,9 +101,8 @@ fn an_upload_is_paced_toward_the_device() {
     let before = counters.snapshot();
     let t0 = Instant::now();
     let map = load("large/maze-128-128-2.map");
-    link.set_timeout(Duration::from_secs(5));
     if let Err(e) = link.set_map(&map) {
-        panic!("upload: {e}; {}; closed {}; strays {:?}", counters.snapshot(), counters.device_closed(), link.take_strays());
+        panic!("upload: {e}; {}", counters.snapshot());
     }
     let took = t0.elapsed();
     let last = link.transport().wait_sent(TIMEOUT).expect("sent");
@@ -117,11 +116,13 @@ fn an_upload_is_paced_toward_the_device() {
     let least = line_time(sent.to_device - 1, BAUD);
     let span = last.at - first.at;
     assert!(
-        span >= least,
+        span + MAX_CATCH_UP >= least,
         "{} bytes in {span:?} < {least:?}",
         sent.to_device
     );
-    assert!(took >= least + byte_time(BAUD));
+    // From the first write to the last byte's delivery: the whole upload's line time at least.
+    assert!(last.at - t0 >= line_time(sent.to_device, BAUD));
+    assert!(took >= line_time(sent.to_device, BAUD));
     println!(
         "upload of maze-128-128-2 at {BAUD}: {} bytes to the device in {:.1} ms on the line \
          (least {:.1} ms), {:.1} ms with the Acks; {} bytes back",
@@ -150,6 +151,7 @@ fn a_long_path_reply_is_paced_and_the_transmitter_waits() {
             seed: Some(1),
         })
         .expect("send the plan");
+    let sent = link.transport().wait_sent(TIMEOUT).expect("plan sent");
     let reply = link.wait_for(id, "Plan").expect("the path");
     let Response::Path(path) = reply else {
         panic!("not a path: {reply:?}")
@@ -163,7 +165,13 @@ fn a_long_path_reply_is_paced_and_the_transmitter_waits() {
     assert!(bytes > 2000, "{bytes} bytes");
     assert!(last.to_host - first.to_host + 1 >= bytes);
     let least = line_time(bytes - 1, BAUD);
-    assert!(last.at - first.at >= least, "{:?} < {least:?}", last.at - first.at);
+    assert!(
+        last.at - first.at + MAX_CATCH_UP >= least,
+        "{:?} < {least:?}",
+        last.at - first.at
+    );
+    // The reply cannot start before the request is in: its whole line time after that.
+    assert!(last.at - sent.at >= line_time(bytes, BAUD));
     assert!(
         backlog <= MAX_BACKLOG,
         "QEMU had {backlog} bytes written ahead of the line"
@@ -187,6 +195,7 @@ fn a_burst_beyond_the_receive_ring_is_lost_counted_and_survived() {
     let info = link.hello().expect("hello");
     let (start, goal) = maze(&mut link);
     let before = link.stats().expect("stats");
+    let strays = link.stray_count();
     let slow = Params {
         iterations: 400,
         patience: 0,
@@ -233,7 +242,7 @@ fn a_burst_beyond_the_receive_ring_is_lost_counted_and_survived() {
         ms(planned)
     );
     assert!(q.is_running());
-    assert_eq!(link.stray_count(), 0, "{:?}", link.take_strays());
+    assert_eq!(link.stray_count(), strays, "{:?}", link.take_strays());
 }
 
 /// The numbers of BENCHMARKS.md's link section, at 115200 and 921600: Hello's round trip, the
@@ -287,7 +296,7 @@ fn latencies(baud: u32) {
     let answer = fs.iter().find(|f| f.id == stats).expect("the Stats frame");
     let path_bytes: u64 = path.iter().map(|f| f.len).sum();
     let (p0, p1) = (path[0].first, path[path.len() - 1].last);
-    assert!(p1.at - p0.at >= line_time(path_bytes - 1, baud));
+    assert!(p1.at - p0.at + MAX_CATCH_UP >= line_time(path_bytes - 1, baud));
     let wait_bytes = answer.first.to_host.saturating_sub(sent.to_host);
     let wait = answer.first.at.saturating_duration_since(sent.at);
     println!(
@@ -309,6 +318,10 @@ fn latencies(baud: u32) {
 }
 
 fn check_counters(c: &Counters) {
-    assert!(c.backlog_max() <= MAX_BACKLOG, "backlog {}", c.backlog_max());
+    assert!(
+        c.backlog_max() <= MAX_BACKLOG,
+        "backlog {}",
+        c.backlog_max()
+    );
     assert!(!c.device_closed());
 }

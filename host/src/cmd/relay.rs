@@ -29,7 +29,11 @@ pub struct Args {
     #[arg(long, value_name = "HOST:PORT", default_value = "127.0.0.1:5555")]
     pub listen: String,
     /// The firmware ELF
-    #[arg(long, value_name = "PATH", default_value = "target/thumbv7em-none-eabihf/release/ohaca")]
+    #[arg(
+        long,
+        value_name = "PATH",
+        default_value = "target/thumbv7em-none-eabihf/release/ohaca"
+    )]
     pub elf: PathBuf,
     /// Run QEMU with `-icount shift=0` (virtual time: 1 ns per instruction)
     #[arg(long)]

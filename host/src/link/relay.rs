@@ -6,8 +6,12 @@
 //! * **Pacing.** A byte takes [`BITS_PER_BYTE`]` / baud` seconds on the line. Byte `k` of a busy
 //!   stretch is delivered no earlier than `start + (k + 1) * 10 / baud` (the end of its stop bit),
 //!   where `start` is when the line last left idle; the schedule restarts when the line goes idle,
-//!   never runs ahead, and never bursts to catch up: a byte delivered late moves the rest of the
-//!   schedule later, so two deliveries are never less than one byte time apart.
+//!   and never runs ahead. The threads sleep until each slot (they do not spin: that starved
+//!   QEMU on a 2-core machine), so a byte may leave up to [`MAX_CATCH_UP`] after its slot while
+//!   the next keeps its own; a byte later than that restarts the schedule from its delivery
+//!   instead of bursting to catch up. So `n` bytes of a stretch never leave before
+//!   `start + n * 10 / baud`, and the first and last of them are at least
+//!   `(n - 1) * 10 / baud - MAX_CATCH_UP` apart.
 //! * **The device side** is a Unix socket pair whose QEMU end has the kernel's smallest send and
 //!   receive buffers ([`Relay::spawn_qemu`]: `-chardev socket,fd=N`). QEMU's CMSDK UART writes one
 //!   byte per write and holds `TXFULL` while the socket is not writable, so with only a few bytes
@@ -18,7 +22,7 @@
 //! * **No flow control toward the device.** A device-bound byte is written, without waiting, at
 //!   its slot; if the device side cannot take it then, it is lost and counted
 //!   ([`Counters::to_device_dropped`]), as a UART without flow control loses it. "Cannot take"
-//!   means [`DEVICE_SLACK`] bytes are already waiting for QEMU's UART (which takes one when the
+//!   means [`device_slack`] bytes are already waiting for QEMU's UART (which takes one when the
 //!   firmware has read the last): room for QEMU's own scheduling delays, not for a receiver that
 //!   stopped reading.
 //! * **Line clocks.** Each direction counts the bytes that have passed on its line (toward the
@@ -281,43 +285,53 @@ pub fn byte_time(baud: u32) -> Duration {
     Duration::from_nanos(u64::from(BITS_PER_BYTE) * 1_000_000_000 / u64::from(baud.max(1)))
 }
 
-/// Wait until `t`: sleep while far from it, then yield the core until it comes (a plain sleep
-/// overshoots by tens of microseconds, most of a byte at 115200).
-fn wait_until(t: Instant) {
-    loop {
-        let now = Instant::now();
-        if now >= t {
-            return;
-        }
-        let left = t - now;
-        if left > Duration::from_micros(400) {
-            std::thread::sleep(left - Duration::from_micros(300));
-        } else {
-            std::thread::yield_now();
-        }
-    }
-}
+/// How late a byte may leave the line and the schedule still hold: a later one restarts the
+/// schedule from its delivery instead of catching up. Sleeps overshoot by tens of microseconds;
+/// spinning instead (to be exact to the microsecond) took cores from QEMU on a 2-core machine.
+pub const MAX_CATCH_UP: Duration = Duration::from_millis(1);
 
 /// When the line is next free, and the pacing rule.
 struct Line {
     byte: Duration,
+    /// When the current busy stretch began, and the bytes carried since.
+    start: Instant,
+    carried: u32,
     free_at: Instant,
 }
 
 impl Line {
     fn new(baud: u32) -> Line {
+        let now = Instant::now();
         Line {
             byte: byte_time(baud),
-            free_at: Instant::now(),
+            start: now,
+            carried: 0,
+            free_at: now,
         }
     }
 
-    /// Wait until a byte that became available at `ready` has crossed the line; the line is then
-    /// free from now on (a late wake-up moves the schedule later, never earlier).
+    /// Wait until a byte that became available at `ready` has crossed the line: its slot is
+    /// `start + carried * byte` on a busy line; an idle line (or one more than
+    /// [`MAX_CATCH_UP`] behind) starts a new stretch.
     fn carry(&mut self, ready: Instant) {
-        let start = ready.max(self.free_at);
-        wait_until(start + self.byte);
-        self.free_at = Instant::now();
+        if ready > self.free_at || self.carried >= 1 << 30 {
+            self.start = ready;
+            self.carried = 0;
+        }
+        self.carried += 1;
+        let slot = self.start + self.byte * self.carried;
+        let now = Instant::now();
+        if slot > now {
+            std::thread::sleep(slot - now);
+        }
+        let now = Instant::now();
+        if now > slot + MAX_CATCH_UP {
+            self.start = now;
+            self.carried = 0;
+            self.free_at = now;
+        } else {
+            self.free_at = slot;
+        }
     }
 }
 
@@ -326,8 +340,19 @@ impl Line {
 /// of buffer for each, and doubles the size asked for). A UART's receiver takes a byte within
 /// one byte time, but QEMU reads its socket from its main loop, which a loaded host schedules
 /// milliseconds late now and then: with the kernel's smallest buffer (6 bytes, 0.5 ms at
-/// 115200) uploads lost bytes on a 2-core machine. 64 bytes are 5.6 ms at 115200.
+/// 115200) uploads lost bytes on a loaded 2-core machine, and with 64 too. The room is the
+/// larger of 64 bytes and [`DEVICE_SLACK_TIME`] of line ([`device_slack`]: 230 bytes at 115200,
+/// 1,843 at 921600).
 pub const DEVICE_SLACK: usize = 64;
+
+/// [`DEVICE_SLACK`], or the bytes of [`DEVICE_SLACK_TIME`] on the line if more.
+pub fn device_slack(baud: u32) -> usize {
+    let per_s = baud / BITS_PER_BYTE;
+    DEVICE_SLACK.max((per_s as usize * DEVICE_SLACK_TIME.as_millis() as usize) / 1000)
+}
+
+/// The least time of line the device side's room holds (see [`DEVICE_SLACK`]).
+pub const DEVICE_SLACK_TIME: Duration = Duration::from_millis(20);
 
 /// The smallest buffers the kernel allows, both ways (QEMU's end).
 fn shrink_buffers(s: &UnixStream) -> io::Result<()> {
@@ -336,10 +361,11 @@ fn shrink_buffers(s: &UnixStream) -> io::Result<()> {
     r.set_recv_buffer_size(1)
 }
 
-/// The relay's end: the smallest buffers but room for [`DEVICE_SLACK`] bytes toward the device.
-fn relay_buffers(s: &UnixStream) -> io::Result<()> {
+/// The relay's end: the smallest receive buffer, room for [`device_slack`] bytes toward the
+/// device.
+fn relay_buffers(s: &UnixStream, baud: u32) -> io::Result<()> {
     let r = SockRef::from(s);
-    r.set_send_buffer_size(DEVICE_SLACK * 384)?;
+    r.set_send_buffer_size(device_slack(baud) * 384)?;
     r.set_recv_buffer_size(1)
 }
 
@@ -355,7 +381,7 @@ pub struct Relay {
 impl Relay {
     /// Pace `device` (the relay's end of a socket to the device) at `baud`.
     pub fn new(device: UnixStream, baud: u32) -> io::Result<Relay> {
-        relay_buffers(&device)?;
+        relay_buffers(&device, baud)?;
         device.set_read_timeout(Some(POLL))?;
         let counters = Arc::new(Counters::new(baud));
         let stop = Arc::new(AtomicBool::new(false));
@@ -642,7 +668,10 @@ impl Read for RelayStream {
             Some(t) => match rx.recv_timeout(t) {
                 Ok(a) => a,
                 Err(RecvTimeoutError::Timeout) => {
-                    return Err(io::Error::new(io::ErrorKind::TimedOut, "relay read timeout"))
+                    return Err(io::Error::new(
+                        io::ErrorKind::TimedOut,
+                        "relay read timeout",
+                    ))
                 }
                 Err(RecvTimeoutError::Disconnected) => return Ok(0),
             },
@@ -665,7 +694,11 @@ impl Read for RelayStream {
                 }
                 self.arrivals.push_back(a);
             }
-            next = if n < buf.len() { rx.try_recv().ok() } else { None };
+            next = if n < buf.len() {
+                rx.try_recv().ok()
+            } else {
+                None
+            };
         }
         Ok(n)
     }
@@ -674,7 +707,10 @@ impl Read for RelayStream {
 impl Write for RelayStream {
     fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
         if self.counters.device_closed() {
-            return Err(io::Error::new(io::ErrorKind::BrokenPipe, "the device closed"));
+            return Err(io::Error::new(
+                io::ErrorKind::BrokenPipe,
+                "the device closed",
+            ));
         }
         if buf.is_empty() {
             return Ok(0);

@@ -332,7 +332,10 @@ pub fn boot_paced_with(elf: &Path, baud: u32) -> (PacedQemu, Link<RelayStream>, 
     link.set_timeout(Duration::from_millis(300));
     let t0 = Instant::now();
     while link.hello().is_err() {
-        assert!(t0.elapsed() < Duration::from_secs(60), "the firmware never answered Hello");
+        assert!(
+            t0.elapsed() < Duration::from_secs(60),
+            "the firmware never answered Hello"
+        );
         let _ = link.send_raw(&[0]);
     }
     link.set_timeout(TIMEOUT);
