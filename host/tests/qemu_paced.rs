@@ -86,8 +86,14 @@ fn ms(d: Duration) -> f64 {
 
 /// Set the maze and its longest scenario (1,380 raw cells: a Path reply of ~2.5 KB).
 fn maze(link: &mut Link<RelayStream>) -> (Point, Point) {
-    link.set_map(&load("large/maze-128-128-2.map"))
-        .expect("upload the maze");
+    let lost = link.transport().counters().to_device_dropped();
+    if let Err(e) = link.set_map(&load("large/maze-128-128-2.map")) {
+        let c = link.transport().counters().snapshot();
+        panic!(
+            "upload the maze: {e}; {c} ({lost} lost before); strays {:?}",
+            link.take_strays()
+        );
+    }
     longest_scenario("large/maze-128-128-2-random-1.scen")
 }
 
@@ -185,9 +191,11 @@ fn a_long_path_reply_is_paced_and_the_transmitter_waits() {
     );
 }
 
-/// The drop model: while the firmware plans, a burst larger than its 1 KiB receive ring is
-/// lost in part, and counted (by the relay when the device stops taking bytes, or by the device
-/// in `rx_overruns` when it drops them itself); the device keeps serving afterwards.
+/// The drop model: while the firmware plans, a burst larger than its 1 KiB receive ring: what is
+/// lost is counted (by the relay when the device stops taking bytes, or by the device in
+/// `rx_overruns` when it drops them itself), every other byte is received (`rx_bytes`), and the
+/// device keeps serving afterwards. Today's firmware keeps reading its ring while it plans
+/// (every plan step yields to the receiver), so at 115200 nothing is lost: the count is printed.
 #[test]
 fn a_burst_beyond_the_receive_ring_is_lost_counted_and_survived() {
     need_qemu!();
@@ -195,6 +203,7 @@ fn a_burst_beyond_the_receive_ring_is_lost_counted_and_survived() {
     let info = link.hello().expect("hello");
     let (start, goal) = maze(&mut link);
     let before = link.stats().expect("stats");
+    let line0 = counters.snapshot();
     let strays = link.stray_count();
     let slow = Params {
         iterations: 400,
@@ -226,21 +235,26 @@ fn a_burst_beyond_the_receive_ring_is_lost_counted_and_survived() {
     let hello = link.hello().expect("hello after the burst");
     assert_eq!(hello.board, info.board);
     let after = link.stats().expect("stats");
-    let relay_lost = counters.to_device_dropped() - dropped0;
+    let line = counters.snapshot().since(&line0);
+    let relay_lost = line.to_device_dropped;
     let device_lost = u64::from(after.rx_overruns - before.rx_overruns);
+    let device_got = u64::from(after.rx_bytes - before.rx_bytes);
     println!(
-        "burst of {} bytes at {BAUD} during a plan ({} on the line, plan answered {:.0} ms after \
-         the burst began: {}): relay lost {relay_lost}, device counted {device_lost} overruns",
+        "burst of {} bytes at {BAUD} during a plan ({:.0} ms on the line, plan answered {:.0} ms \
+         after the burst began: {}): relay lost {relay_lost}, device counted {device_lost} \
+         overruns, received {device_got} of {} bytes on the line",
         burst.len(),
-        format!("{:.0} ms", ms(burst_time)),
+        ms(burst_time),
         ms(planned),
-        reply.kind()
+        reply.kind(),
+        line.to_device
     );
+    // Every byte that crossed the line was received, or lost and counted by one side.
     assert!(
-        relay_lost + device_lost > 0,
-        "no loss counted: the plan ended before the ring filled? ({:.0} ms)",
-        ms(planned)
+        device_got + device_lost + relay_lost >= line.to_device,
+        "{line}: {device_got} received"
     );
+    assert!(device_got <= line.to_device_delivered(), "{line}");
     assert!(q.is_running());
     assert_eq!(link.stray_count(), strays, "{:?}", link.take_strays());
 }
