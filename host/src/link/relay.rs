@@ -340,9 +340,10 @@ impl Line {
 /// of buffer for each, and doubles the size asked for). A UART's receiver takes a byte within
 /// one byte time, but QEMU reads its socket from its main loop, which a loaded host schedules
 /// milliseconds late now and then: with the kernel's smallest buffer (6 bytes, 0.5 ms at
-/// 115200) uploads lost bytes on a loaded 2-core machine, and with 64 too. The room is the
-/// larger of 64 bytes and [`DEVICE_SLACK_TIME`] of line ([`device_slack`]: 230 bytes at 115200,
-/// 1,843 at 921600).
+/// 115200) uploads lost bytes on a loaded 2-core machine, and with 20 ms of line too (QEMU's
+/// CPU thread descheduled: its UART then takes nothing). The room is the larger of 64 bytes and
+/// [`DEVICE_SLACK_TIME`] of line ([`device_slack`]: 1,152 bytes at 115200, 9,216 at 921600),
+/// at most what `net.core.wmem_max` lets a socket have (Linux caps it silently).
 pub const DEVICE_SLACK: usize = 64;
 
 /// [`DEVICE_SLACK`], or the bytes of [`DEVICE_SLACK_TIME`] on the line if more.
@@ -352,7 +353,7 @@ pub fn device_slack(baud: u32) -> usize {
 }
 
 /// The least time of line the device side's room holds (see [`DEVICE_SLACK`]).
-pub const DEVICE_SLACK_TIME: Duration = Duration::from_millis(20);
+pub const DEVICE_SLACK_TIME: Duration = Duration::from_millis(100);
 
 /// The smallest buffers the kernel allows, both ways (QEMU's end).
 fn shrink_buffers(s: &UnixStream) -> io::Result<()> {

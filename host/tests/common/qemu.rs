@@ -305,6 +305,9 @@ impl PacedQemu {
     }
 }
 
+/// How long a [`boot_paced`] link waits for each reply.
+pub const PACED_TIMEOUT: Duration = Duration::from_secs(30);
+
 /// Boot the firmware ([`firmware`]) with UART0 behind a relay at `baud`: the QEMU, a [`Link`]
 /// over the relay's in-process client (its line clocks: `link.transport().wait_sent(..)` and
 /// `.take_arrivals()`), and the relay's counters.
@@ -338,7 +341,8 @@ pub fn boot_paced_with(elf: &Path, baud: u32) -> (PacedQemu, Link<RelayStream>, 
         );
         let _ = link.send_raw(&[0]);
     }
-    link.set_timeout(TIMEOUT);
+    // Every reply the paced tests wait for comes within seconds: fail in 30 s, not 120.
+    link.set_timeout(PACED_TIMEOUT);
     link.take_strays();
     (q, link, counters)
 }
