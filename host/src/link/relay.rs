@@ -736,3 +736,77 @@ impl Transport for RelayStream {
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn wait(what: &str, mut f: impl FnMut() -> bool) {
+        let t0 = Instant::now();
+        while !f() {
+            assert!(t0.elapsed() < Duration::from_secs(20), "{what}");
+            std::thread::sleep(Duration::from_millis(1));
+        }
+    }
+
+    /// Toward the device: paced, every byte delivered while the device reads, line clocks given.
+    #[test]
+    fn bytes_reach_the_device_at_the_line_rate() {
+        let (mine, mut device) = UnixStream::pair().unwrap();
+        let relay = Relay::new(mine, 115_200).unwrap();
+        let mut client = relay.client();
+        let t0 = Instant::now();
+        client.write_all(&[7u8; 200]).unwrap();
+        let mut got = vec![0u8; 200];
+        device.read_exact(&mut got).unwrap();
+        let last = client.wait_sent(Duration::from_secs(10)).unwrap();
+        assert_eq!(got, vec![7u8; 200]);
+        assert_eq!(last.to_device, 200);
+        assert!(last.at - t0 >= byte_time(115_200) * 200);
+        let c = relay.counters();
+        assert_eq!((c.to_device_delivered(), c.to_device_dropped()), (200, 0));
+        assert_eq!(c.stamp_of(200), Some(last));
+    }
+
+    /// A device that does not read: past the room the relay leaves it, bytes are lost, counted.
+    #[test]
+    fn bytes_the_device_does_not_take_are_lost_and_counted() {
+        let (mine, _device) = UnixStream::pair().unwrap();
+        let baud = 921_600;
+        let relay = Relay::new(mine, baud).unwrap();
+        let mut client = relay.client();
+        let n = device_slack(baud) as u64 + 500;
+        client.write_all(&vec![1u8; n as usize]).unwrap();
+        client.wait_sent(Duration::from_secs(20)).unwrap();
+        let c = relay.counters();
+        assert_eq!(c.to_device_line(), n);
+        assert!(c.to_device_dropped() >= 400, "{:?}", c.snapshot());
+    }
+
+    /// Toward the host: paced, each byte with its clock, read one at a time from the device.
+    #[test]
+    fn bytes_reach_the_client_at_the_line_rate_with_their_clocks() {
+        let (mine, mut device) = UnixStream::pair().unwrap();
+        let relay = Relay::new(mine, 115_200).unwrap();
+        let mut client = relay.client();
+        client.set_io_timeout(Duration::from_secs(5)).unwrap();
+        let t0 = Instant::now();
+        let data: Vec<u8> = (0..100).collect();
+        let writer = std::thread::spawn(move || device.write_all(&data).map(|()| device));
+        let mut got = Vec::new();
+        let mut buf = [0u8; 64];
+        while got.len() < 100 {
+            let n = client.read(&mut buf).unwrap();
+            assert!(n > 0);
+            got.extend_from_slice(&buf[..n]);
+        }
+        let _device = writer.join().unwrap().unwrap();
+        assert_eq!(got, (0..100).collect::<Vec<u8>>());
+        let arrivals = client.take_arrivals();
+        let clocks: Vec<u64> = arrivals.iter().map(|a| a.stamp.to_host).collect();
+        assert_eq!(clocks, (1..=100).collect::<Vec<u64>>());
+        assert!(arrivals[99].stamp.at - t0 >= byte_time(115_200) * 100);
+        wait("backlog", || relay.counters().backlog_max() > 0);
+        assert!(relay.counters().backlog_max() <= 100);
+    }
+}
