@@ -23,8 +23,8 @@
 //!   its slot; if the device side cannot take it then, it is lost and counted
 //!   ([`Counters::to_device_dropped`]), as a UART without flow control loses it. "Cannot take"
 //!   means [`device_slack`] bytes are already waiting for QEMU's UART (which takes one when the
-//!   firmware has read the last): room for QEMU's own scheduling delays, not for a receiver that
-//!   stopped reading.
+//!   firmware has read the last): room for QEMU's own scheduling delays on a loaded host; past
+//!   it, a receiver that stopped reading (or a firmware still booting) loses bytes.
 //! * **Line clocks.** Each direction counts the bytes that have passed on its line (toward the
 //!   device: delivered plus lost). Latencies can so be measured in bytes on the line, which do
 //!   not depend on the host's speed: [`RelayStream::wait_sent`] gives the clocks of both

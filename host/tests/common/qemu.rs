@@ -1,6 +1,7 @@
 //! QEMU helpers shared by the firmware's end-to-end tests (`qemu_e2e.rs`, `qemu_soak.rs`):
 //! build the firmware once, boot it in `qemu-system-arm -M mps2-an386` with UART0 on a free
-//! local TCP port (or a pty), connect a [`Link`], build broken frames, and compute what the
+//! local TCP port (or a pty; or behind the pacing relay at a real baud rate: [`boot_paced`]),
+//! connect a [`Link`], build broken frames, and compute what the
 //! device must answer with the protocol's own reader and decoder, and what its plans must be
 //! with the host's copy of the core.
 //!
