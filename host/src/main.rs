@@ -45,6 +45,9 @@ enum Command {
     /// Run as a ROS 2 node: /map, /goal_pose, /initialpose in, /plan and Nav2's
     /// compute_path_to_pose out (host core or a device)
     Ros(Box<cmd::ros::Args>),
+    /// Boot the firmware in QEMU behind a real serial line (--baud 8N1) and serve it on a TCP
+    /// port, one client at a time
+    Relay(cmd::relay::Args),
     /// Check a path in metres (JSON [[x, y], ...]) against a map: start, goal, free segments
     Check(cmd::check::Args),
 }
@@ -61,6 +64,7 @@ fn main() -> ExitCode {
         Command::Send(args) => cmd::send::run(&args),
         Command::Replan(args) => cmd::replan::run(&args),
         Command::Ros(args) => cmd::ros::run(&args),
+        Command::Relay(args) => cmd::relay::run(&args),
         Command::Check(args) => cmd::check::run(&args),
     };
     ExitCode::from(code)

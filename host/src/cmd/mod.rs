@@ -3,6 +3,7 @@
 pub mod check;
 pub mod experiment;
 pub mod plan;
+pub mod relay;
 pub mod render;
 pub mod replan;
 pub mod ros;

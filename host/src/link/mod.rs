@@ -37,6 +37,7 @@
 //! | `wire.rs` | what travels: [`MapCode`] (raw or run-length map uploads), the owned replies ([`Response`], [`DeviceInfo`], [`DevicePath`]) and request names |
 //! | `session.rs` | [`Link`]: ids, framing of requests and replies, waiting, strays, uploads, plans |
 //! | `errors.rs` | [`LinkError`] and [`Stray`]: every way a call fails, and the frames nobody waited for |
+//! | `relay.rs` | [`relay::Relay`]: a paced serial line (115200 8N1 by default) between a client and QEMU's UART, with its line clocks |
 
 use std::collections::{BTreeMap, HashMap, HashSet, VecDeque};
 use std::io::{self, Read, Write};
@@ -55,6 +56,8 @@ use ohaca::{Params, Point};
 use crate::map::Map;
 
 mod errors;
+#[cfg(unix)]
+pub mod relay;
 mod session;
 #[cfg(test)]
 mod tests;

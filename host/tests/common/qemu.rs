@@ -1,6 +1,7 @@
 //! QEMU helpers shared by the firmware's end-to-end tests (`qemu_e2e.rs`, `qemu_soak.rs`):
 //! build the firmware once, boot it in `qemu-system-arm -M mps2-an386` with UART0 on a free
-//! local TCP port (or a pty), connect a [`Link`], build broken frames, and compute what the
+//! local TCP port (or a pty; or behind the pacing relay at a real baud rate: [`boot_paced`]),
+//! connect a [`Link`], build broken frames, and compute what the
 //! device must answer with the protocol's own reader and decoder, and what its plans must be
 //! with the host's copy of the core.
 //!
@@ -12,13 +13,14 @@ use std::io::{BufRead, BufReader, Read};
 use std::net::{TcpListener, TcpStream};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
-use std::sync::OnceLock;
+use std::sync::{Arc, OnceLock};
 use std::time::{Duration, Instant};
 
 use ohaca::protocol::{
     crc32, decode_request, ErrorCode, ErrorReply, RequestReader, MAX_REQUEST_WIRE,
 };
 use ohaca::{Params, Point};
+use ohaca_host::link::relay::{Counters, Relay, RelayStream};
 use ohaca_host::link::{DevicePath, Link};
 use ohaca_host::{HeapStorage, Map};
 
@@ -279,6 +281,71 @@ impl Qemu {
             }
         }
     }
+}
+
+/// A running QEMU whose UART0 is behind a pacing relay (`ohaca_host::link::relay`: a real
+/// serial line, `baud` 8N1, between the test and the emulated UART); QEMU is killed on drop,
+/// then the relay stops.
+pub struct PacedQemu {
+    child: Child,
+    /// The relay (its counters: [`Relay::counters`]; more clients: [`Relay::client`]).
+    pub relay: Relay,
+}
+
+impl Drop for PacedQemu {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+impl PacedQemu {
+    /// True while QEMU runs.
+    pub fn is_running(&mut self) -> bool {
+        matches!(self.child.try_wait(), Ok(None))
+    }
+}
+
+/// How long a [`boot_paced`] link waits for each reply.
+pub const PACED_TIMEOUT: Duration = Duration::from_secs(30);
+
+/// Boot the firmware ([`firmware`]) with UART0 behind a relay at `baud`: the QEMU, a [`Link`]
+/// over the relay's in-process client (its line clocks: `link.transport().wait_sent(..)` and
+/// `.take_arrivals()`), and the relay's counters.
+pub fn boot_paced(baud: u32) -> (PacedQemu, Link<RelayStream>, Arc<Counters>) {
+    boot_paced_with(firmware(), baud)
+}
+
+/// [`boot_paced`] with another firmware ELF.
+pub fn boot_paced_with(elf: &Path, baud: u32) -> (PacedQemu, Link<RelayStream>, Arc<Counters>) {
+    let mut c = Command::new("qemu-system-arm");
+    c.args(["-M", "mps2-an386", "-display", "none", "-monitor", "none"])
+        .args(["-semihosting-config", "enable=on,target=native"])
+        .arg("-kernel")
+        .arg(elf)
+        .stdin(Stdio::null())
+        .stdout(defmt_log())
+        .stderr(Stdio::inherit());
+    let (child, relay) = Relay::spawn_qemu(&mut c, baud).expect("start QEMU behind the relay");
+    let counters = relay.counters();
+    let q = PacedQemu { child, relay };
+    let mut link = Link::new(q.relay.client(), TIMEOUT).expect("a link over the relay");
+    // As on a real board, bytes sent before the firmware takes them are lost (QEMU reads its
+    // socket only once the UART receives, and the socket holds a few bytes): say Hello until the
+    // device answers, then forget the strays of the partial frames.
+    link.set_timeout(Duration::from_millis(300));
+    let t0 = Instant::now();
+    while link.hello().is_err() {
+        assert!(
+            t0.elapsed() < Duration::from_secs(60),
+            "the firmware never answered Hello"
+        );
+        let _ = link.send_raw(&[0]);
+    }
+    // Every reply the paced tests wait for comes within seconds: fail in 30 s, not 120.
+    link.set_timeout(PACED_TIMEOUT);
+    link.take_strays();
+    (q, link, counters)
 }
 
 // ---- frames --------------------------------------------------------------------------------

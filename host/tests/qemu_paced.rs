@@ -1,0 +1,340 @@
+//! The firmware under QEMU behind a real serial line: the pacing relay
+//! (`ohaca_host::link::relay`) between the host and QEMU's emulated UART, which otherwise moves
+//! bytes instantly and buffers megabytes.
+//!
+//! What is asserted does not depend on the host's speed: lower bounds on time that the relay
+//! itself enforces (`n` bytes take at least `n * 10 / baud`), byte counts, and line clocks (bytes
+//! that passed on the line). Latencies in wall time are only printed (`-- --nocapture`; they are
+//! BENCHMARKS.md's "link" numbers).
+//!
+//! Like `qemu_e2e.rs`, each test boots its own QEMU; `OHACA_SKIP_QEMU=1` skips them when
+//! `qemu-system-arm` is missing.
+
+#[macro_use]
+#[path = "common/qemu.rs"]
+mod qemu;
+
+use std::time::{Duration, Instant};
+
+use ohaca::protocol::{decode_reply, ReplyReader, Request, MAX_REPLY_WIRE};
+use ohaca::{Params, Point};
+use ohaca_host::link::relay::{byte_time, Arrival, Counters, RelayStream, Stamp, MAX_CATCH_UP};
+use ohaca_host::link::{Link, Response};
+use ohaca_host::Map;
+use qemu::{boot_paced, have_qemu, longest_scenario, maps, TIMEOUT};
+
+const BAUD: u32 = 115_200;
+
+/// The most bytes QEMU may have written that the line has not delivered: the socket's few
+/// (QEMU's end has the kernel's smallest send buffer) plus the byte on the line. Without the
+/// relay's minimal buffers it would be the whole reply.
+const MAX_BACKLOG: u64 = 32;
+
+fn load(name: &str) -> Map {
+    Map::load(maps().join(name)).expect("map")
+}
+
+/// One reply frame as it arrived: its id, its length on the wire (with the delimiter), and the
+/// clocks of its first and last byte.
+#[derive(Debug)]
+struct Frame {
+    id: u32,
+    kind: &'static str,
+    len: u64,
+    first: Stamp,
+    last: Stamp,
+}
+
+/// Split what arrived into reply frames (the protocol's own reader and decoder).
+fn frames(arrivals: &[Arrival]) -> Vec<Frame> {
+    let mut reader = Box::new(ReplyReader::new());
+    let mut out = Vec::new();
+    let mut start = 0;
+    for (i, a) in arrivals.iter().enumerate() {
+        if a.byte == 0 && start == i {
+            // A delimiter with no frame before it.
+            start = i + 1;
+            let _ = reader.push(0);
+            continue;
+        }
+        if let Some(f) = reader.push(a.byte).into_frame(MAX_REPLY_WIRE) {
+            let (id, kind) = match f.and_then(decode_reply) {
+                Ok((id, r)) => (id, Response::from(&r).kind()),
+                Err(_) => (0, "undecodable"),
+            };
+            out.push(Frame {
+                id,
+                kind,
+                len: (i + 1 - start) as u64,
+                first: arrivals[start].stamp,
+                last: a.stamp,
+            });
+            start = i + 1;
+        }
+    }
+    out
+}
+
+/// The least time `bytes` bytes take on the line, from the first's start to the last's end.
+fn line_time(bytes: u64, baud: u32) -> Duration {
+    byte_time(baud) * u32::try_from(bytes).expect("bytes")
+}
+
+fn ms(d: Duration) -> f64 {
+    d.as_secs_f64() * 1e3
+}
+
+/// Set the maze and its longest scenario (1,380 raw cells: a Path reply of ~2.5 KB).
+fn maze(link: &mut Link<RelayStream>) -> (Point, Point) {
+    let lost = link.transport().counters().to_device_dropped();
+    if let Err(e) = link.set_map(&load("large/maze-128-128-2.map")) {
+        let c = link.transport().counters().snapshot();
+        panic!(
+            "upload the maze: {e}; {c} ({lost} lost before); strays {:?}",
+            link.take_strays()
+        );
+    }
+    longest_scenario("large/maze-128-128-2-random-1.scen")
+}
+
+/// An upload is delivered to the device no faster than the line: every byte of it passed the
+/// line, none lost, and its first to last byte took at least `(n - 1) * 10 / baud`.
+#[test]
+fn an_upload_is_paced_toward_the_device() {
+    need_qemu!();
+    let (_q, mut link, counters) = boot_paced(BAUD);
+    link.hello().expect("hello");
+    let before = counters.snapshot();
+    let t0 = Instant::now();
+    let map = load("large/maze-128-128-2.map");
+    if let Err(e) = link.set_map(&map) {
+        panic!("upload: {e}; {}", counters.snapshot());
+    }
+    let took = t0.elapsed();
+    let last = link.transport().wait_sent(TIMEOUT).expect("sent");
+    let sent = counters.snapshot().since(&before);
+    let first = counters
+        .stamp_of(before.to_device + 1)
+        .expect("the upload's first byte's stamp");
+    assert_eq!(sent.to_device_dropped, 0, "{sent}");
+    assert_eq!(last.to_device - first.to_device + 1, sent.to_device);
+    assert!(sent.to_device > 1000, "{sent}");
+    let least = line_time(sent.to_device - 1, BAUD);
+    let span = last.at - first.at;
+    assert!(
+        span + MAX_CATCH_UP >= least,
+        "{} bytes in {span:?} < {least:?}",
+        sent.to_device
+    );
+    // From the first write to the last byte's delivery: the whole upload's line time at least.
+    assert!(last.at - t0 >= line_time(sent.to_device, BAUD));
+    assert!(took >= line_time(sent.to_device, BAUD));
+    println!(
+        "upload of maze-128-128-2 at {BAUD}: {} bytes to the device in {:.1} ms on the line \
+         (least {:.1} ms), {:.1} ms with the Acks; {} bytes back",
+        sent.to_device,
+        ms(span),
+        ms(least),
+        ms(took),
+        sent.to_host
+    );
+}
+
+/// A long Path reply takes the line's time, and the guest's transmitter waits for the line:
+/// QEMU never has more than a few bytes written ahead of it.
+#[test]
+fn a_long_path_reply_is_paced_and_the_transmitter_waits() {
+    need_qemu!();
+    let (_q, mut link, counters) = boot_paced(BAUD);
+    link.hello().expect("hello");
+    let (start, goal) = maze(&mut link);
+    link.transport().take_arrivals();
+    counters.reset_backlog_max();
+    let id = link
+        .send(&Request::Plan {
+            start,
+            goal,
+            seed: Some(1),
+        })
+        .expect("send the plan");
+    let sent = link.transport().wait_sent(TIMEOUT).expect("plan sent");
+    let reply = link.wait_for(id, "Plan").expect("the path");
+    let Response::Path(path) = reply else {
+        panic!("not a path: {reply:?}")
+    };
+    assert_eq!(path.raw_cells, 1380);
+    let backlog = counters.backlog_max();
+    let fs = frames(&link.transport().take_arrivals());
+    let bytes: u64 = fs.iter().map(|f| f.len).sum();
+    let (first, last) = (fs[0].first, fs[fs.len() - 1].last);
+    assert!(fs.iter().all(|f| f.id == id), "{fs:?}");
+    assert!(bytes > 2000, "{bytes} bytes");
+    assert!(last.to_host - first.to_host + 1 >= bytes);
+    let least = line_time(bytes - 1, BAUD);
+    assert!(
+        last.at - first.at + MAX_CATCH_UP >= least,
+        "{:?} < {least:?}",
+        last.at - first.at
+    );
+    // The reply cannot start before the request is in: its whole line time after that.
+    assert!(last.at - sent.at >= line_time(bytes, BAUD));
+    assert!(
+        backlog <= MAX_BACKLOG,
+        "QEMU had {backlog} bytes written ahead of the line"
+    );
+    println!(
+        "maze-128-128-2 path reply at {BAUD}: {bytes} bytes in {} frame(s), {:.1} ms on the line \
+         (least {:.1} ms); at most {backlog} bytes written by QEMU ahead of the line",
+        fs.len(),
+        ms(last.at - first.at),
+        ms(least)
+    );
+}
+
+/// The drop model: while the firmware plans, a burst larger than its 1 KiB receive ring: what is
+/// lost is counted (by the relay when the device stops taking bytes, or by the device in
+/// `rx_overruns` when it drops them itself), every other byte is received (`rx_bytes`), and the
+/// device keeps serving afterwards. Today's firmware keeps reading its ring while it plans
+/// (every plan step yields to the receiver), so at 115200 nothing is lost: the count is printed.
+#[test]
+fn a_burst_beyond_the_receive_ring_is_lost_counted_and_survived() {
+    need_qemu!();
+    let (mut q, mut link, counters) = boot_paced(BAUD);
+    let info = link.hello().expect("hello");
+    let (start, goal) = maze(&mut link);
+    let before = link.stats().expect("stats");
+    let line0 = counters.snapshot();
+    let strays = link.stray_count();
+    let slow = Params {
+        iterations: 400,
+        patience: 0,
+        refine_patience: 0,
+        seed: 1,
+        ..info.defaults
+    };
+    link.set_params(&slow).expect("params");
+    let plan = link
+        .send(&Request::Plan {
+            start,
+            goal,
+            seed: Some(1),
+        })
+        .expect("send the plan");
+    // Let the plan start before the burst (its bytes are ahead of the burst on the line).
+    link.transport().wait_sent(TIMEOUT).expect("plan sent");
+    std::thread::sleep(Duration::from_millis(50));
+    // Empty frames (zero bytes) only: whatever the device keeps of them, it answers nothing.
+    let burst = vec![0u8; 4096];
+    let t0 = Instant::now();
+    link.send_raw(&burst).expect("burst");
+    link.transport().wait_sent(TIMEOUT).expect("burst sent");
+    let burst_time = t0.elapsed();
+    let reply = link.wait_for(plan, "Plan").expect("the plan's reply");
+    let planned = t0.elapsed();
+    let hello = link.hello().expect("hello after the burst");
+    assert_eq!(hello.board, info.board);
+    let after = link.stats().expect("stats");
+    let line = counters.snapshot().since(&line0);
+    let relay_lost = line.to_device_dropped;
+    let device_lost = u64::from(after.rx_overruns - before.rx_overruns);
+    let device_got = u64::from(after.rx_bytes - before.rx_bytes);
+    println!(
+        "burst of {} bytes at {BAUD} during a plan ({:.0} ms on the line, plan answered {:.0} ms \
+         after the burst began: {}): relay lost {relay_lost}, device counted {device_lost} \
+         overruns, received {device_got} of {} bytes on the line",
+        burst.len(),
+        ms(burst_time),
+        ms(planned),
+        reply.kind(),
+        line.to_device
+    );
+    // Every byte that crossed the line was received, or lost and counted by one side.
+    assert!(
+        device_got + device_lost + relay_lost >= line.to_device,
+        "{line}: {device_got} received"
+    );
+    assert!(device_got <= line.to_device_delivered(), "{line}");
+    assert!(q.is_running());
+    assert_eq!(link.stray_count(), strays, "{:?}", link.take_strays());
+}
+
+/// The numbers of BENCHMARKS.md's link section, at 115200 and 921600: Hello's round trip, the
+/// maze's Path reply on the line, and a Stats sent just after the Path reply starts: how long
+/// until its answer (today: after the whole reply). Printed; only line-enforced bounds asserted.
+#[test]
+fn link_latencies_at_115200_and_921600() {
+    need_qemu!();
+    for baud in [115_200, 921_600] {
+        latencies(baud);
+    }
+}
+
+fn latencies(baud: u32) {
+    let (_q, mut link, counters) = boot_paced(baud);
+    link.hello().expect("hello");
+    // Hello's round trip, the best of 5.
+    let mut rtt = Duration::MAX;
+    let mut line_bytes = 0;
+    for _ in 0..5 {
+        let s0 = counters.snapshot();
+        let t0 = Instant::now();
+        link.hello().expect("hello");
+        let t = t0.elapsed();
+        let d = counters.snapshot().since(&s0);
+        line_bytes = d.to_device + d.to_host;
+        assert!(t >= line_time(line_bytes, baud));
+        rtt = rtt.min(t);
+    }
+    let (start, goal) = maze(&mut link);
+    link.transport().take_arrivals();
+    let base = counters.to_host_line();
+    let plan = link
+        .send(&Request::Plan {
+            start,
+            goal,
+            seed: Some(1),
+        })
+        .expect("send the plan");
+    let t_plan = Instant::now();
+    while counters.to_host_line() == base {
+        assert!(t_plan.elapsed() < TIMEOUT, "no reply");
+        std::thread::sleep(Duration::from_micros(200));
+    }
+    let stats = link.send(&Request::Stats).expect("send Stats");
+    let sent = link.transport().wait_sent(TIMEOUT).expect("Stats sent");
+    link.wait_for(plan, "Plan").expect("path");
+    link.wait_for(stats, "Stats").expect("stats");
+    let fs = frames(&link.transport().take_arrivals());
+    let path: Vec<&Frame> = fs.iter().filter(|f| f.id == plan).collect();
+    let answer = fs.iter().find(|f| f.id == stats).expect("the Stats frame");
+    let path_bytes: u64 = path.iter().map(|f| f.len).sum();
+    let (p0, p1) = (path[0].first, path[path.len() - 1].last);
+    assert!(p1.at - p0.at + MAX_CATCH_UP >= line_time(path_bytes - 1, baud));
+    let wait_bytes = answer.first.to_host.saturating_sub(sent.to_host);
+    let wait = answer.first.at.saturating_duration_since(sent.at);
+    println!(
+        "{baud} baud: Hello round trip {:.2} ms ({line_bytes} bytes on the line, least {:.2} ms); \
+         maze-128-128-2 Path reply {path_bytes} bytes in {} frame(s), {:.1} ms on the line; \
+         Stats sent {} bytes into it: answered after {wait_bytes} more host-bound bytes, \
+         {:.1} ms ({} {} bytes)",
+        ms(rtt),
+        ms(line_time(line_bytes, baud)),
+        path.len(),
+        ms(p1.at - p0.at),
+        sent.to_host - p0.to_host + 1,
+        ms(wait),
+        answer.kind,
+        answer.len,
+    );
+    assert_eq!(counters.to_device_dropped(), 0);
+    check_counters(&counters);
+}
+
+fn check_counters(c: &Counters) {
+    assert!(
+        c.backlog_max() <= MAX_BACKLOG,
+        "backlog {}",
+        c.backlog_max()
+    );
+    assert!(!c.device_closed());
+}
