@@ -338,3 +338,225 @@ fn check_counters(c: &Counters) {
     );
     assert!(!c.device_closed());
 }
+
+// ---- long paths in parts: nothing waits behind them (protocol 10) -----------------------------
+
+/// 50 ms of the line at 115,200 baud, in bytes: the most host-bound bytes a small reply may wait
+/// behind once its request is in (issue 30: "a Cancel answered within 50 ms of its last byte").
+const FIFTY_MS: u64 = 576;
+
+/// A serpentine of corridors 62 cells long: its one way from the top-left corner to the end of
+/// the last corridor is 2,014 steps, near the F411's 2,047; its reply is about 2.6 KB in 14
+/// parts (14 x 18.5 ms at 115,200 baud).
+fn serpentine() -> (Map, Point, Point) {
+    let (w, h) = (62u16, 63u16);
+    let map = Map::from_fn(w, h, |x, y| {
+        // Odd rows are walls with a gap at the right end, then the left, then the right...
+        y % 2 == 1 && x != if (y / 2) % 2 == 0 { w - 1 } else { 0 }
+    });
+    (map, Point::new(0, 0), Point::new(w - 1, h - 1))
+}
+
+/// Plan the serpentine's way and wait for the first byte of its reply on the line; returns the
+/// plan's id and the parameters it was planned with.
+fn long_path_streaming(link: &mut Link<RelayStream>, counters: &Counters) -> (u32, Params, Map) {
+    let info = link.info().expect("hello first").clone();
+    let (map, start, goal) = serpentine();
+    link.set_map(&map).expect("upload the serpentine");
+    link.transport().take_arrivals();
+    let base = counters.to_host_line();
+    let plan = link
+        .send(&Request::Plan {
+            start,
+            goal,
+            seed: Some(1),
+        })
+        .expect("send the plan");
+    let t = Instant::now();
+    while counters.to_host_line() == base {
+        assert!(t.elapsed() < TIMEOUT, "no reply to the plan");
+        std::thread::sleep(Duration::from_micros(200));
+    }
+    (
+        plan,
+        Params {
+            seed: 1,
+            ..info.defaults
+        },
+        map,
+    )
+}
+
+/// Host-bound bytes between a request's last byte reaching the device and its answer's first.
+fn waited(frames: &[Frame], id: u32, sent: Stamp) -> u64 {
+    let f = frames
+        .iter()
+        .find(|f| f.id == id)
+        .unwrap_or_else(|| panic!("no reply to {id}: {frames:?}"));
+    f.first.to_host.saturating_sub(sent.to_host)
+}
+
+/// A Stats and a SetCells sent while a 2,014-step path goes out in parts are answered between
+/// its parts, within 50 ms of the line each; the cell update does not stop the path, which is
+/// the host core's, bit for bit.
+#[test]
+fn stats_and_a_cell_update_pass_a_long_path() {
+    need_qemu!();
+    let (_q, mut link, counters) = boot_paced(BAUD);
+    link.hello().expect("hello");
+    let (plan, params, map) = long_path_streaming(&mut link, &counters);
+    let stats = link.send(&Request::Stats).expect("send Stats");
+    let s1 = link.transport().wait_sent(TIMEOUT).expect("Stats sent");
+    // A cell away from the way: the top-left corner's corridor end is on it, (30, 62) is too;
+    // a wall cell blocked again changes nothing of the path (row 1 is a wall).
+    let cells = [Point::new(5, 1)];
+    let update = link
+        .send(&Request::SetCells {
+            blocked: true,
+            cells: ohaca::protocol::Waypoints::Points(&cells),
+        })
+        .expect("send SetCells");
+    let s2 = link.transport().wait_sent(TIMEOUT).expect("SetCells sent");
+    let path = link.wait_for(plan, "Plan").expect("the path");
+    assert_eq!(
+        link.wait_for(stats, "Stats").expect("stats").kind(),
+        "Stats"
+    );
+    assert_eq!(
+        link.wait_for(update, "SetCells").expect("ack"),
+        Response::Ack
+    );
+    let fs = frames(&link.transport().take_arrivals());
+    let parts = fs.iter().filter(|f| f.id == plan).count();
+    let (w1, w2) = (waited(&fs, stats, s1), waited(&fs, update, s2));
+    println!(
+        "2,014-step path in {parts} parts at {BAUD}: Stats answered after {w1} host-bound bytes, \
+         SetCells after {w2} (50 ms = {FIFTY_MS})"
+    );
+    assert!(parts >= 10, "{fs:?}");
+    assert!(w1 <= FIFTY_MS && w2 <= FIFTY_MS, "{w1}, {w2}: {fs:?}");
+    // Both answers came between the parts: some of the path arrived after each.
+    let last_part = fs
+        .iter()
+        .filter(|f| f.id == plan)
+        .map(|f| f.last.to_host)
+        .max();
+    for id in [stats, update] {
+        let f = fs.iter().find(|f| f.id == id).expect("answer");
+        assert!(
+            Some(f.last.to_host) < last_part,
+            "{id} after the whole path"
+        );
+    }
+    let Response::Path(path) = path else {
+        panic!("not a path: {path:?}")
+    };
+    let (_, start, goal) = serpentine();
+    let core = qemu::core_plan(&map, start, goal, &params).expect("the core plans it");
+    qemu::assert_core_path("serpentine", &core, &path);
+    assert_eq!(path.raw_cells, 2015);
+    let s = link.stats().expect("stats");
+    assert_eq!((s.parted, s.replies_dropped, s.rx_overruns), (1, 0, 0));
+}
+
+/// A Cancel sent while a long path goes out is answered within 50 ms of the line, the path stops
+/// (no part after the Cancel's answer but the one on the wire) and its plan gets `Cancelled`;
+/// the device then plans and answers as before.
+#[test]
+fn a_cancel_stops_a_long_path_at_once() {
+    need_qemu!();
+    let (_q, mut link, counters) = boot_paced(BAUD);
+    link.hello().expect("hello");
+    let (plan, _, _) = long_path_streaming(&mut link, &counters);
+    let cancel = link.send(&Request::Cancel).expect("send Cancel");
+    let sent = link.transport().wait_sent(TIMEOUT).expect("Cancel sent");
+    assert_eq!(link.wait_for(cancel, "Cancel").expect("ack"), Response::Ack);
+    let r = link.wait_for(plan, "Plan").expect("the plan's answer");
+    assert_eq!(
+        r,
+        Response::Error(ohaca::protocol::ErrorReply::new(
+            ohaca::protocol::ErrorCode::Cancelled
+        ))
+    );
+    let fs = frames(&link.transport().take_arrivals());
+    let w = waited(&fs, cancel, sent);
+    let ack = fs.iter().find(|f| f.id == cancel).expect("the Ack");
+    let after: Vec<&Frame> = fs
+        .iter()
+        .filter(|f| f.id == plan && f.kind == "PathPart" && f.first.to_host > ack.last.to_host)
+        .collect();
+    let parts = fs.iter().filter(|f| f.kind == "PathPart").count();
+    println!(
+        "Cancel during a 2,014-step path at {BAUD}: answered after {w} host-bound bytes \
+         (50 ms = {FIFTY_MS}); {parts} parts sent, {} after the Ack",
+        after.len()
+    );
+    assert!(w <= FIFTY_MS, "{w}: {fs:?}");
+    assert!(after.len() <= 1, "{after:?}");
+    assert!(parts < 14, "the whole path went out: {fs:?}");
+    let s = link.stats().expect("stats");
+    assert_eq!((s.cancelled, s.replies_dropped, s.rx_overruns), (1, 0, 0));
+    // It serves on: the same plan again, whole.
+    let (_, start, goal) = serpentine();
+    let again = link.plan(start, goal, Some(1)).expect("plan again");
+    assert_eq!(again.raw_cells, 2015);
+}
+
+/// Within the window nothing is lost; beyond it the device keeps serving and counts what it
+/// dropped. 8 Stats at once are all answered; 160 at once (1,120 bytes in 97 ms at 115,200,
+/// their replies 1.4 s) overflow the 8-deep reply queue: every one is answered or counted in
+/// `replies_dropped`, exactly, and Hello is answered after.
+#[test]
+fn the_window_holds_and_beyond_it_drops_are_counted() {
+    need_qemu!();
+    let (_q, mut link, counters) = boot_paced(BAUD);
+    let info = link.hello().expect("hello");
+    assert_eq!(
+        (info.capacity.window, info.capacity.window_bytes),
+        (8, 1024)
+    );
+    let before = link.stats().expect("stats");
+    // Within the window: 8 at once, every one answered.
+    let ids: Vec<u32> = (0..8)
+        .map(|_| link.send(&Request::Stats).expect("send"))
+        .collect();
+    for id in ids {
+        assert_eq!(link.wait_for(id, "Stats").expect("stats").kind(), "Stats");
+    }
+    let mid = link.stats().expect("stats");
+    assert_eq!(mid.replies_dropped, before.replies_dropped);
+    // Beyond it: 160 Stats in one write, ids 1000.. (raw: `Link::send` would keep the window).
+    let mut burst = Vec::new();
+    for id in 1000..1160u32 {
+        let mut buf = [0u8; ohaca::protocol::MAX_REQUEST_WIRE];
+        let n = ohaca::protocol::encode_request(id, &Request::Stats, &mut buf).expect("encode");
+        burst.extend_from_slice(&buf[..n]);
+    }
+    let strays = link.stray_count();
+    link.send_raw(&burst).expect("burst");
+    link.transport().wait_sent(TIMEOUT).expect("burst sent");
+    // Wait until the line back is quiet (the queued replies are out), so the next request's
+    // reply finds room; how long that takes decides nothing asserted.
+    let mut quiet = (counters.to_host_line(), Instant::now());
+    while quiet.1.elapsed() < Duration::from_millis(300) {
+        std::thread::sleep(Duration::from_millis(20));
+        if counters.to_host_line() != quiet.0 {
+            quiet = (counters.to_host_line(), Instant::now());
+        }
+    }
+    link.hello().expect("hello after the burst");
+    assert!(link.take_strays().iter().all(
+        |s| matches!(s, ohaca_host::link::Stray::Reply { id, .. } if (1000..1160).contains(id))
+    ));
+    let answered = (link.stray_count() - strays) as u32;
+    let after = link.stats().expect("stats");
+    let dropped = after.replies_dropped - mid.replies_dropped;
+    let lost = after.rx_overruns - mid.rx_overruns;
+    println!(
+        "160 Stats in one burst at {BAUD}: {answered} answered, {dropped} replies dropped, \
+         {lost} bytes lost"
+    );
+    assert_eq!(lost, 0, "the receiver kept up with the line");
+    assert!(dropped > 0, "160 replies of 100 bytes cannot all queue");
+    assert_eq!(answered + dropped, 160);
+}
