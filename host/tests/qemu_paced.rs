@@ -258,9 +258,10 @@ fn a_burst_beyond_the_receive_ring_is_lost_counted_and_survived() {
     assert_eq!(link.stray_count(), strays, "{:?}", link.take_strays());
 }
 
-/// The numbers of BENCHMARKS.md's link section, at 115200 and 921600: Hello's round trip, the
-/// maze's Path reply on the line, and a Stats sent just after the Path reply starts: how long
-/// until its answer (today: after the whole reply). Printed; only line-enforced bounds asserted.
+/// The numbers of BENCHMARKS.md's link section and PROTOCOL.md's times, at 115200 and 921600:
+/// Hello's round trip, the maze's upload, its Path reply on the line (in parts), a Stats sent
+/// just after the reply starts and a Cancel during the serpentine's: how long until their
+/// answers. Printed; only line-enforced bounds asserted.
 #[test]
 fn link_latencies_at_115200_and_921600() {
     need_qemu!();
@@ -285,7 +286,9 @@ fn latencies(baud: u32) {
         assert!(t >= line_time(line_bytes, baud));
         rtt = rtt.min(t);
     }
+    let t_up = Instant::now();
     let (start, goal) = maze(&mut link);
+    let upload = t_up.elapsed();
     link.transport().take_arrivals();
     let base = counters.to_host_line();
     let plan = link
@@ -325,6 +328,21 @@ fn latencies(baud: u32) {
         ms(wait),
         answer.kind,
         answer.len,
+    );
+    // A Cancel while the serpentine's 2,014-step path goes out in parts.
+    let (plan, _, _) = long_path_streaming(&mut link, &counters);
+    let cancel = link.send(&Request::Cancel).expect("send Cancel");
+    let sent = link.transport().wait_sent(TIMEOUT).expect("Cancel sent");
+    link.wait_for(cancel, "Cancel").expect("ack");
+    link.wait_for(plan, "Plan").expect("cancelled");
+    let fs = frames(&link.transport().take_arrivals());
+    let ack = fs.iter().find(|f| f.id == cancel).expect("the Ack");
+    println!(
+        "{baud} baud: maze-128-128-2 upload with its Acks {:.1} ms; Cancel \
+         during a 2,014-step path in parts answered after {} host-bound bytes, {:.1} ms",
+        ms(upload),
+        ack.first.to_host.saturating_sub(sent.to_host),
+        ms(ack.last.at.saturating_duration_since(sent.at)),
     );
     assert_eq!(counters.to_device_dropped(), 0);
     check_counters(&counters);

@@ -479,3 +479,64 @@ fn print_protocol_doc_example() {
         print_frame("<= ", "<< ", reply_fields(id, &rep), &enc_rep(id, &rep));
     }
 }
+
+/// The example path's body cut into parts of 16 bytes, as a device would send it if `PART_BYTES`
+/// were 16: docs/PROTOCOL.md shows the frames, and that their bytes put together are the body of
+/// request 3's `Path` reply.
+fn example_parts() -> Vec<Vec<u8>> {
+    let body = PathBody::new(&example_path()).unwrap();
+    let mut bytes = vec![0u8; body.len()];
+    assert_eq!(body.read(0, &mut bytes), body.len());
+    bytes
+        .chunks(16)
+        .enumerate()
+        .map(|(k, c)| {
+            enc_rep(
+                3,
+                &Reply::PathPart(PathPart {
+                    offset: (k * 16) as u32,
+                    total_len: bytes.len() as u32,
+                    bytes: c,
+                }),
+            )
+        })
+        .collect()
+}
+
+fn hex(b: &[u8]) -> String {
+    b.iter()
+        .map(|x| format!("{x:02x}"))
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+#[test]
+fn protocol_doc_path_parts_are_exact() {
+    let doc = include_str!("../../../docs/PROTOCOL.md");
+    for (k, f) in example_parts().iter().enumerate() {
+        let line = format!("<- {}", hex(f));
+        assert!(
+            doc.contains(&line),
+            "docs/PROTOCOL.md lacks part {k} of the parts example: {line}"
+        );
+    }
+    // Put together, they decode as request 3's reply.
+    let mut body = Vec::new();
+    for f in example_parts() {
+        let mut f = f[..f.len() - 1].to_vec();
+        let (id, r) = decode_reply(&mut f).unwrap();
+        assert_eq!(id, 3);
+        let Reply::PathPart(p) = r else { panic!() };
+        assert_eq!(p.offset as usize, body.len());
+        body.extend_from_slice(p.bytes);
+    }
+    assert_eq!(decode_path_body(&body), Some(example_path()));
+}
+
+#[test]
+#[ignore = "prints docs/PROTOCOL.md's parts example"]
+fn print_path_parts_example() {
+    for f in example_parts() {
+        println!("<- {}", hex(&f));
+    }
+}
