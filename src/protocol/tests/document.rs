@@ -514,7 +514,7 @@ fn hex(b: &[u8]) -> String {
 fn protocol_doc_path_parts_are_exact() {
     let doc = include_str!("../../../docs/PROTOCOL.md");
     for (k, f) in example_parts().iter().enumerate() {
-        let line = format!("<- {}", hex(f));
+        let line = format!("<~ {}", hex(f));
         assert!(
             doc.contains(&line),
             "docs/PROTOCOL.md lacks part {k} of the parts example: {line}"
@@ -537,6 +537,6 @@ fn protocol_doc_path_parts_are_exact() {
 #[ignore = "prints docs/PROTOCOL.md's parts example"]
 fn print_path_parts_example() {
     for f in example_parts() {
-        println!("<- {}", hex(&f));
+        println!("<~ {}", hex(&f));
     }
 }
