@@ -298,8 +298,8 @@ impl Region {
 /// symmetric, so the north, west and north-west/-east links are these seen from the other end),
 /// when they are in the region. A move crossing a side of a region's block starts (at its north
 /// or west end) in the region's cells or one cell north, west or east of them: those are the
-/// cells scanned. The result is the per-cell rule of [`block_links`] for every block of the
-/// region, bit for bit (the tests `links_match_the_per_cell_rule` and
+/// cells scanned. The result is the per-cell rule of `block_links` (the tests' reference) for
+/// every block of the region, bit for bit (the tests `links_match_the_per_cell_rule` and
 /// `links_of_a_region_match_the_per_cell_rule` compare them on random maps, block sizes and
 /// regions); on the Cortex-M4 it takes a tenth of the per-cell pass it replaced (7 M
 /// instructions of a 256 x 256 plan; issue 27).
