@@ -25,7 +25,7 @@
 //! whose free cells do not connect) costs moves, never a path. Memory: one `u32` per block (the
 //! links, the next block and the distance) plus scratch for the heap (two `u32` per block).
 
-use crate::grid::{Dir, Moves, Point, DX, DY};
+use crate::grid::{Moves, Point, DX, DY};
 use crate::pheromone::Blocks;
 
 /// Most blocks of the route: a map with more cells than this is cut into blocks of `2^k x 2^k`
@@ -121,7 +121,7 @@ pub fn build(
     let (Some(words), Some(heap)) = (words.get_mut(..n), heap.get_mut(..n)) else {
         return false;
     };
-    links(moves, blocks, dead, words);
+    links(moves, blocks, dead, words, None);
     for w in words.iter_mut() {
         *w = (*w & 0xFF) | (NONE << 8) | (UNREACHED << DIST_SHIFT);
     }
@@ -154,22 +154,16 @@ pub fn repair(
     let grid = *moves.grid();
     let (w, h) = (grid.width(), grid.height());
     if let (Some((lo, hi)), true) = (area, w > 0 && h > 0) {
-        // A block's links read its border cells and the cells one move beyond them.
+        // A block's links read its border cells and the cells one move beyond them: the blocks
+        // within one cell of `area`.
         let s = blocks.shift();
-        let (x0, y0) = (lo.x.saturating_sub(1) >> s, lo.y.saturating_sub(1) >> s);
-        let x1 = hi.x.saturating_add(1).min(w.wrapping_sub(1)) >> s;
-        let y1 = hi.y.saturating_add(1).min(h.wrapping_sub(1)) >> s;
-        for by in y0..=y1 {
-            for bx in x0..=x1 {
-                let b = usize::from(by)
-                    .wrapping_mul(blocks.across())
-                    .wrapping_add(usize::from(bx));
-                let l = block_links(moves, blocks, dead, bx, by);
-                if let Some(wd) = words.get_mut(b) {
-                    *wd = u32::from(l);
-                }
-            }
-        }
+        let region = Region {
+            x0: usize::from(lo.x.saturating_sub(1) >> s),
+            y0: usize::from(lo.y.saturating_sub(1) >> s),
+            x1: usize::from(hi.x.saturating_add(1).min(w.wrapping_sub(1)) >> s),
+            y1: usize::from(hi.y.saturating_add(1).min(h.wrapping_sub(1)) >> s),
+        };
+        links(moves, blocks, dead, words, Some(region));
     }
     for w in words.iter_mut() {
         *w = (*w & 0xFF) | (NONE << 8) | (UNREACHED << DIST_SHIFT);
@@ -218,7 +212,9 @@ pub fn unstash(blocks: Blocks, kept: &[f32], words: &mut [u32]) -> bool {
     true
 }
 
-/// The links of block `(bx, by)`: [`links`] for one block.
+/// The links of block `(bx, by)`, cell by cell: the rule [`links`] computes 32 cells at a time,
+/// kept as the tests' reference.
+#[cfg(test)]
 fn block_links(moves: &Moves<'_>, blocks: Blocks, dead: &[u32], bx: u16, by: u16) -> u8 {
     let grid = *moves.grid();
     let (w, h) = (grid.width(), grid.height());
@@ -259,7 +255,7 @@ fn block_links(moves: &Moves<'_>, blocks: Blocks, dead: &[u32], bx: u16, by: u16
                     if crate::bitmap::marked(dead, ni) {
                         continue;
                     }
-                    let q = crate::grid::neighbour(p, d as Dir);
+                    let q = crate::grid::neighbour(p, d as crate::grid::Dir);
                     out |= 1 << block_dir(p, q, s);
                 }
             }
@@ -274,43 +270,110 @@ fn block_links(moves: &Moves<'_>, blocks: Blocks, dead: &[u32], bx: u16, by: u16
     out
 }
 
-/// Bits 0-7 of each block's word: the neighbour blocks one allowed move away.
+/// A rectangle of blocks, corners included (block coordinates).
+#[derive(Clone, Copy, Debug)]
+struct Region {
+    x0: usize,
+    y0: usize,
+    x1: usize,
+    y1: usize,
+}
+
+impl Region {
+    #[inline]
+    fn holds(&self, bx: usize, by: usize) -> bool {
+        (self.x0..=self.x1).contains(&bx) && (self.y0..=self.y1).contains(&by)
+    }
+}
+
+/// Bits 0-7 of each block's word in `region` (`None`: every block): the neighbour blocks one
+/// allowed move away. The words of the region's blocks are overwritten (the bits above 7
+/// cleared), every other word is left as it is.
 ///
 /// Thirty-two cells at a time: for each pair of rows `y`, `y + 1` and each run of 32 columns, the
 /// live cells (free, not pruned) and the free cells of both rows as bit windows, from which one
 /// AND each gives every cell with a move east, south, south-east or south-west (both ends live;
 /// a diagonal also needs the two cells beside it free: the no-corner-cutting rule). Only the
 /// moves that cross a block side count, and each sets the link in both blocks (moves are
-/// symmetric, so the north, west and north-west/-east links are these seen from the other end).
-/// The result is the per-cell rule of [`block_links`] for every block, bit for bit (the test
-/// `links_match_the_per_cell_rule` compares them on random maps and block sizes); on the
-/// Cortex-M4 it takes a tenth of the per-cell pass it replaced (7 M instructions of a 256 x 256
-/// plan; issue 27).
-fn links(moves: &Moves<'_>, blocks: Blocks, dead: &[u32], words: &mut [u32]) {
-    words.fill(0);
+/// symmetric, so the north, west and north-west/-east links are these seen from the other end),
+/// when they are in the region. A move crossing a side of a region's block starts (at its north
+/// or west end) in the region's cells or one cell north, west or east of them: those are the
+/// cells scanned. The result is the per-cell rule of `block_links` (the tests' reference) for
+/// every block of the region, bit for bit (the tests `links_match_the_per_cell_rule` and
+/// `links_of_a_region_match_the_per_cell_rule` compare them on random maps, block sizes and
+/// regions); on the Cortex-M4 it takes a tenth of the per-cell pass it replaced (7 M
+/// instructions of a 256 x 256 plan; issue 27).
+fn links(
+    moves: &Moves<'_>,
+    blocks: Blocks,
+    dead: &[u32],
+    words: &mut [u32],
+    region: Option<Region>,
+) {
     let grid = *moves.grid();
     let (w, h) = (usize::from(grid.width()), usize::from(grid.height()));
     let s = u32::from(blocks.shift());
     let last = (1usize << s).wrapping_sub(1);
     let across = blocks.across();
-    // The links of the block of cell (x, y) gain `d`, and the neighbour block's `d + 4`.
+    let down = blocks.count().checked_div(across).unwrap_or(0);
+    if w == 0 || h == 0 || across == 0 || down == 0 {
+        return;
+    }
+    let whole = Region {
+        x0: 0,
+        y0: 0,
+        x1: across.wrapping_sub(1),
+        y1: down.wrapping_sub(1),
+    };
+    let r = match region {
+        Some(r) => Region {
+            x0: r.x0,
+            y0: r.y0,
+            x1: r.x1.min(whole.x1),
+            y1: r.y1.min(whole.y1),
+        },
+        None => whole,
+    };
+    if r.x0 > r.x1 || r.y0 > r.y1 {
+        return;
+    }
+    for by in r.y0..=r.y1 {
+        let row = by.wrapping_mul(across);
+        if let Some(ws) =
+            words.get_mut(row.wrapping_add(r.x0)..row.wrapping_add(r.x1).wrapping_add(1))
+        {
+            ws.fill(0);
+        }
+    }
+    // The cells scanned: the region's, one more column on each side and one more row north.
+    let (x_lo, x_hi) = (
+        (r.x0 << s).saturating_sub(1),
+        (r.x1.wrapping_add(1) << s).min(w.wrapping_sub(1)),
+    );
+    let (y_lo, y_hi) = (
+        (r.y0 << s).saturating_sub(1),
+        ((r.y1.wrapping_add(1) << s).wrapping_sub(1)).min(h.wrapping_sub(1)),
+    );
+    // The links of the block of cell (x, y) gain `d`, and the neighbour block's `d + 4`, if
+    // they are in the region.
     let mut link = |x: usize, y: usize, d: u32| {
         let (dx, dy) = match d {
-            0 => (1isize, 0isize),
+            0 => (1isize, 0usize),
             1 => (1, 1),
             2 => (0, 1),
             _ => (-1, 1),
         };
         let (bx, by) = (x >> s, y >> s);
-        let b = by.wrapping_mul(across).wrapping_add(bx);
-        let nb = b
-            .wrapping_add_signed(dy.wrapping_mul(across as isize))
-            .wrapping_add_signed(dx);
-        if let Some(wd) = words.get_mut(b) {
-            *wd |= 1 << d;
+        if r.holds(bx, by) {
+            if let Some(wd) = words.get_mut(by.wrapping_mul(across).wrapping_add(bx)) {
+                *wd |= 1 << d;
+            }
         }
-        if let Some(wd) = words.get_mut(nb) {
-            *wd |= 1 << (d.wrapping_add(4) & 7);
+        let (nx, ny) = (bx.wrapping_add_signed(dx), by.wrapping_add(dy));
+        if r.holds(nx, ny) {
+            if let Some(wd) = words.get_mut(ny.wrapping_mul(across).wrapping_add(nx)) {
+                *wd |= 1 << (d.wrapping_add(4) & 7);
+            }
         }
     };
     // Bit j of a window is cell x0 - 1 + j of its row; cells off the row read as blocked.
@@ -328,11 +391,12 @@ fn links(moves: &Moves<'_>, blocks: Blocks, dead: &[u32], words: &mut [u32]) {
     };
     // Blocks of at most 32 columns start at multiples of 32 in every run: the same bits in all.
     let columns = block_columns(0, last);
-    for y in 0..h {
+    for y in y_lo..=y_hi {
         let below = y.wrapping_add(1) < h;
         let y_crosses = below && y & last == last;
-        let mut x0 = 0usize;
-        while x0 < w {
+        // Runs start at multiples of 32 (where `columns` holds).
+        let mut x0 = x_lo & !31;
+        while x0 <= x_hi {
             let (free, live) = window(y, x0);
             let (free1, live1) = if below {
                 window(y.wrapping_add(1), x0)
@@ -344,7 +408,7 @@ fn links(moves: &Moves<'_>, blocks: Blocks, dead: &[u32], words: &mut [u32]) {
             let south = live & live1;
             let south_east = live & (live1 >> 1) & (free >> 1) & free1;
             let south_west = live & (live1 << 1) & (free << 1) & free1;
-            let run = grid.run_bits(x0);
+            let run = grid.run_bits(x0) & span_bits(x0, x_lo, x_hi);
             // The cell of bit j: x0 - 1 + j (j >= 1).
             let cell = |j: usize| x0.wrapping_add(j).wrapping_sub(1);
             // The bits of the run's cells in a block's last column (x & last == last) and in its
@@ -369,7 +433,8 @@ fn links(moves: &Moves<'_>, blocks: Blocks, dead: &[u32], words: &mut [u32]) {
             } else {
                 // The block row's last row: south, and the diagonals that stay in the block
                 // column, give the south link; one bit a block is enough, so each block's bits
-                // are folded onto its first column before the loop.
+                // are folded onto its first column before the loop (a first column outside
+                // the cells scanned is one of a block outside the region: no link to set).
                 let mut down = (south | south_east & !ends | south_west & !starts) & run;
                 if last < 32 {
                     let mut k = 1usize;
@@ -392,6 +457,18 @@ fn links(moves: &Moves<'_>, blocks: Blocks, dead: &[u32], words: &mut [u32]) {
             x0 = x0.wrapping_add(32);
         }
     }
+}
+
+/// The bits j (1..=32) of the run of cells starting at column `x0` (bit j = column x0 - 1 + j)
+/// whose columns lie in `lo..=hi`.
+fn span_bits(x0: usize, lo: usize, hi: usize) -> u64 {
+    let first = lo.wrapping_add(1).saturating_sub(x0).max(1);
+    let end = hi.wrapping_add(1).saturating_sub(x0).min(32);
+    if first > end {
+        return 0;
+    }
+    // 1 <= first <= end <= 32: shifts below 64.
+    (u64::MAX >> (63usize.wrapping_sub(end.wrapping_sub(first)) & 63)) << (first & 63)
 }
 
 /// For the run of cells starting at column `x0` (bit j = column x0 - 1 + j, j in 1..=32): the bits
@@ -422,7 +499,8 @@ impl Iterator for Ones {
     }
 }
 
-/// The direction from `p`'s block to `q`'s block (adjacent blocks).
+/// The direction from `p`'s block to `q`'s block (adjacent blocks): [`block_links`]'s.
+#[cfg(test)]
 fn block_dir(p: Point, q: Point, s: u8) -> u32 {
     // Block offsets are -1, 0 or 1 on each axis: index (dy + 1) * 3 + (dx + 1).
     const DIR: [u8; 9] = [5, 6, 7, 4, 0, 0, 3, 2, 1];
@@ -649,14 +727,14 @@ mod tests {
                     } else {
                         &dead[..]
                     };
-                    links(&moves, blocks, short, &mut words);
+                    links(&moves, blocks, short, &mut words, None);
                     for by in 0..down {
                         for bx in 0..across {
                             let want = block_links(&moves, blocks, short, bx as u16, by as u16);
                             assert_eq!(words[by * across + bx], u32::from(want), "short marks");
                         }
                     }
-                    links(&moves, blocks, &dead, &mut words);
+                    links(&moves, blocks, &dead, &mut words, None);
                     for by in 0..down {
                         for bx in 0..across {
                             let want = block_links(&moves, blocks, &dead, bx as u16, by as u16);
@@ -670,6 +748,90 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn links_of_a_region_match_the_per_cell_rule() {
+        // Random maps (some wider than two runs of 32 columns), block sizes from one cell to
+        // 64 x 64, pruning marks (none, random, cut short) and rectangles of blocks (at the map's
+        // edges, one block, the whole map, wider than 32 columns or not aligned to 32): `links`
+        // on the region gives each of its blocks the per-cell rule's links and leaves every
+        // other word as it was.
+        let mut rng = crate::rng::Xoshiro128pp::from_u64(29);
+        let mut pick = |n: u32| rng.next_word() % n.max(1);
+        let mut seen = [0u32; 4];
+        for round in 0..600 {
+            let (w, h) = (1 + pick(300) as u16, 1 + pick(120) as u16);
+            let cells = usize::from(w) * usize::from(h);
+            let density = [5u32, 20, 40][round % 3];
+            let mut b = vec![0u8; cells.div_ceil(8)];
+            for i in 0..cells {
+                if pick(100) < density {
+                    b[i / 8] |= 1 << (i % 8);
+                }
+            }
+            let g = Grid::new(w, h, &b).unwrap();
+            let moves = Moves::new(g, &[]);
+            let mut dead: Vec<u32> = match round % 4 {
+                0 => Vec::new(),
+                _ => (0..crate::bitmap::words(cells))
+                    .map(|_| pick(u32::MAX) & pick(u32::MAX) & pick(u32::MAX))
+                    .collect(),
+            };
+            if round % 4 == 3 {
+                // Cut short: the cells beyond read as pruned.
+                dead.truncate(dead.len() / 2);
+            }
+            let s = pick(7);
+            let budget = usize::from(w).div_ceil(1 << s) * usize::from(h).div_ceil(1 << s);
+            let blocks = Blocks::with_budget(w, h, budget);
+            let across = blocks.across();
+            let down = blocks.count() / across;
+            let (a, d) = (across as u32, down as u32);
+            // A corner, then the other one at or beyond it (sometimes past the map: clamped).
+            let edge = |v: u32, n: u32, r: u32| match r % 4 {
+                0 => 0,
+                1 => n - 1,
+                _ => v,
+            };
+            let x0 = edge(pick(a), a, pick(8)) as usize;
+            let y0 = edge(pick(d), d, pick(8)) as usize;
+            let x1 = match pick(4) {
+                0 => across - 1,
+                1 => across + 3,
+                _ => x0 + pick(a - x0 as u32) as usize,
+            };
+            let y1 = match pick(4) {
+                0 => down - 1,
+                _ => y0 + pick(d - y0 as u32) as usize,
+            };
+            let region = Region { x0, y0, x1, y1 };
+            let cols = (x1.min(across - 1) + 1 - x0) << blocks.shift();
+            seen[0] += u32::from(x0 == 0 || y0 == 0 || x1 >= across - 1 || y1 == down - 1);
+            seen[1] += u32::from(cols > 32);
+            seen[2] += u32::from((x0 << blocks.shift()) % 32 != 0);
+            seen[3] += u32::from(blocks.shift() >= 6);
+            let before: Vec<u32> = (0..blocks.count()).map(|_| pick(u32::MAX)).collect();
+            let mut words = before.clone();
+            links(&moves, blocks, &dead, &mut words, Some(region));
+            for by in 0..down {
+                for bx in 0..across {
+                    let i = by * across + bx;
+                    let want = if region.holds(bx, by) {
+                        u32::from(block_links(&moves, blocks, &dead, bx as u16, by as u16))
+                    } else {
+                        before[i]
+                    };
+                    assert_eq!(
+                        words[i],
+                        want,
+                        "round {round}: {w} x {h}, shift {}, {region:?}, block ({bx}, {by})",
+                        blocks.shift()
+                    );
+                }
+            }
+        }
+        assert!(seen.iter().all(|&n| n > 30), "{seen:?}");
     }
 
     #[test]
