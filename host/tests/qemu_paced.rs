@@ -367,20 +367,34 @@ const FIFTY_MS: u64 = 576;
 /// the last corridor is 2,014 steps, near the F411's 2,047; its reply is about 2.4 KB in 13
 /// parts (13 x 18.5 ms at 115,200 baud).
 fn serpentine() -> (Map, Point, Point) {
-    let (w, h) = (62u16, 63u16);
+    serpentine_of(62, 63)
+}
+
+/// Corridors `w` cells long, in the odd rows' walls a gap at alternate ends: a way of
+/// `(h + 1) / 2 * (w - 1) + h - 1` steps from (0, 0) to the end of the last corridor (`h` odd).
+fn serpentine_of(w: u16, h: u16) -> (Map, Point, Point) {
     let map = Map::from_fn(w, h, |x, y| {
         // Odd rows are walls with a gap at the right end, then the left, then the right...
         y % 2 == 1 && x != if (y / 2) % 2 == 0 { w - 1 } else { 0 }
     });
-    // 32 corridors, the last (row 62) run right to left: its end is (0, 62).
-    (map, Point::new(0, 0), Point::new(0, h - 1))
+    // The corridors run right, left, right...: the last ends at x = 0 if their count is even.
+    let end = if (h / 2) % 2 == 1 { 0 } else { w - 1 };
+    (map, Point::new(0, 0), Point::new(end, h - 1))
 }
 
 /// Plan the serpentine's way and wait for the first byte of its reply on the line; returns the
 /// plan's id and the parameters it was planned with.
 fn long_path_streaming(link: &mut Link<RelayStream>, counters: &Counters) -> (u32, Params, Map) {
+    long_path_on(link, counters, serpentine())
+}
+
+/// [`long_path_streaming`] on another serpentine.
+fn long_path_on(
+    link: &mut Link<RelayStream>,
+    counters: &Counters,
+    (map, start, goal): (Map, Point, Point),
+) -> (u32, Params, Map) {
     let info = link.info().expect("hello first").clone();
-    let (map, start, goal) = serpentine();
     link.set_map(&map).expect("upload the serpentine");
     link.transport().take_arrivals();
     let base = counters.to_host_line();
@@ -577,4 +591,74 @@ fn the_window_holds_and_beyond_it_drops_are_counted() {
     assert_eq!(lost, 0, "the receiver kept up with the line");
     assert!(dropped > 0, "160 replies of 100 bytes cannot all queue");
     assert_eq!(answered + dropped, 160);
+}
+
+/// The STM32H743's twin sends a 16,318-step path (a serpentine of 64 corridors of 254 cells,
+/// near its 16,384): about 19 KB in 100 parts. A Stats and a SetCells sent during it are answered
+/// within 50 ms of the line each and the path is the host core's (`--board h743`); then a Cancel
+/// during the same plan again stops it at once.
+#[test]
+fn the_twins_16000_step_path_lets_replies_pass_and_stops_at_a_cancel() {
+    need_qemu!();
+    let (_q, mut link, counters) = qemu::boot_paced_with(qemu::twin_firmware(), BAUD);
+    let info = link.hello().expect("hello");
+    assert_eq!(info.capacity.max_steps, 16_384);
+    let (w, h) = (254u16, 127u16);
+    let (plan, params, map) = long_path_on(&mut link, &counters, serpentine_of(w, h));
+    let stats = link.send(&Request::Stats).expect("send Stats");
+    let s1 = link.transport().wait_sent(TIMEOUT).expect("Stats sent");
+    let cells = [Point::new(5, 1)];
+    let update = link
+        .send(&Request::SetCells {
+            blocked: true,
+            cells: ohaca::protocol::Waypoints::Points(&cells),
+        })
+        .expect("send SetCells");
+    let s2 = link.transport().wait_sent(TIMEOUT).expect("SetCells sent");
+    link.set_timeout(TIMEOUT);
+    let path = link.wait_for(plan, "Plan").expect("the path");
+    link.wait_for(stats, "Stats").expect("stats");
+    assert_eq!(
+        link.wait_for(update, "SetCells").expect("ack"),
+        Response::Ack
+    );
+    let fs = frames(&link.transport().take_arrivals());
+    let parts = fs.iter().filter(|f| f.id == plan).count();
+    let bytes: u64 = fs.iter().filter(|f| f.id == plan).map(|f| f.len).sum();
+    let (w1, w2) = (waited(&fs, stats, s1), waited(&fs, update, s2));
+    let Response::Path(path) = path else {
+        panic!("not a path: {path:?}")
+    };
+    println!(
+        "twin: {}-step path in {parts} parts ({bytes} bytes) at {BAUD}: Stats answered after \
+         {w1} host-bound bytes, SetCells after {w2} (50 ms = {FIFTY_MS})",
+        path.raw_cells - 1
+    );
+    assert_eq!(
+        path.raw_cells as usize,
+        (h as usize + 1) / 2 * (w as usize - 1) + h as usize
+    );
+    assert!(w1 <= FIFTY_MS && w2 <= FIFTY_MS, "{w1}, {w2}");
+    let (_, start, goal) = serpentine_of(w, h);
+    let core = qemu::core_plan_on(ohaca::board::H743, &map, start, goal, &params)
+        .expect("the core plans it");
+    qemu::assert_core_path("the twin's serpentine", &core, &path);
+    // The same plan again, cancelled while it goes out.
+    link.set_cells(&cells, false).expect("clear the cell");
+    let (plan, _, _) = long_path_on(&mut link, &counters, serpentine_of(w, h));
+    let cancel = link.send(&Request::Cancel).expect("send Cancel");
+    let sent = link.transport().wait_sent(TIMEOUT).expect("Cancel sent");
+    assert_eq!(link.wait_for(cancel, "Cancel").expect("ack"), Response::Ack);
+    assert_eq!(
+        link.wait_for(plan, "Plan").expect("cancelled"),
+        Response::Error(ohaca::protocol::ErrorReply::new(
+            ohaca::protocol::ErrorCode::Cancelled
+        ))
+    );
+    let fs = frames(&link.transport().take_arrivals());
+    let w3 = waited(&fs, cancel, sent);
+    println!("twin: Cancel during it answered after {w3} host-bound bytes");
+    assert!(w3 <= FIFTY_MS, "{w3}");
+    let s = link.stats().expect("stats");
+    assert_eq!((s.parted, s.cancelled, s.replies_dropped), (2, 1, 0));
 }
