@@ -8,7 +8,7 @@
 #     QEMU's instant TCP socket: about 2 ms a frame on a 2-core machine (QEMU feeds its UART 10 to
 #     16 KB/s), 100000 frames in 3 to 4 minutes. With --baud BAUD (e.g. 115200) it goes through
 #     the pacing relay (ohaca_host::link::relay: a real 8N1 line at BAUD) and also prints the
-#     relay's counters; see BENCHMARKS.md section 8b for its wall time.
+#     relay's counters; see BENCHMARKS.md section 8 for wall times.
 #  2. faults at scale, on the STM32H743's capacity twin (`--features twin-h743`) and on the F411
 #     build (which holds these maps in its arena): host/tests/qemu_soak_twin.rs with ROUNDS rounds (default 10; the
 #     test's own default is 1), each uploading a 512 x 512 and a 604 x 307 map raw and run-length
