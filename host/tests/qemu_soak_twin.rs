@@ -22,7 +22,11 @@
 //! the model knows when no reply is due). After each upload: `Stats` has the map's size, and a
 //! plan on it is the host core's, bit for bit, on the map the host meant to send (so no accepted
 //! byte was lost or changed). At the end, `Stats`' `frames_ok`, `frames_bad` and `rx_bytes` are
-//! exactly the model's, `rx_overruns` 0, `boots` 1.
+//! exactly the model's, `rx_overruns` and `replies_dropped` 0, `boots` 1.
+//!
+//! It keeps within the device's window (protocol 10: 8 requests and 1,024 bytes outstanding)
+//! without trying: every write is at most three chunk frames and a `00`, and its replies are
+//! read before the next write (asserted per write).
 //!
 //! `OHACA_SOAK_SCALE_ROUNDS` rounds (default 1: about 30 s), seed `OHACA_SOAK_SEED`;
 //! `scripts/soak.sh` runs more rounds as its second phase. A summary is printed
@@ -58,6 +62,11 @@ const LIMITS: MapLimits = MapLimits {
 };
 /// Chunk frames in flight.
 const WINDOW: usize = 3;
+/// The device's window (`Capacity::window`, `window_bytes`: 8 requests and 1,024 bytes on every
+/// board). Every write's replies are read before the next write, and a write is at most
+/// [`WINDOW`] chunk frames (at most 164 bytes each with inserted garbage) and a lone `00`: well
+/// within it, so nothing may be lost (`rx_overruns`, `replies_dropped` 0). Asserted per write.
+const DEVICE_WINDOW: (usize, usize) = (8, 1024);
 /// How long one reply may take (a plan on 512 x 512 without `-icount` takes a second or two).
 const REPLY_TIMEOUT: Duration = Duration::from_secs(120);
 
@@ -199,6 +208,11 @@ impl Device {
 
     /// Write `bytes` and return the replies they call for, in order, from the model.
     fn write(&mut self, bytes: &[u8]) -> Vec<Want> {
+        assert!(
+            bytes.len() <= DEVICE_WINDOW.1,
+            "a write beyond the window: {} bytes",
+            bytes.len()
+        );
         self.out.write_all(bytes).expect("write to the device");
         self.rx_bytes += bytes.len() as u64;
         let mut want = Vec::new();
@@ -217,6 +231,11 @@ impl Device {
                 }
             }
         }
+        assert!(
+            want.len() <= DEVICE_WINDOW.0,
+            "a write beyond the window: {} requests",
+            want.len()
+        );
         want
     }
 
@@ -568,7 +587,11 @@ fn soak_at_scale(
     assert_eq!(st.frames_ok, dev.frames_ok, "{st:?}");
     assert_eq!(st.frames_bad, dev.frames_bad, "{st:?}");
     assert_eq!(u64::from(st.rx_bytes), dev.rx_bytes, "{st:?}");
-    assert_eq!((st.rx_overruns, st.boots, st.queued), (0, 1, 0), "{st:?}");
+    assert_eq!(
+        (st.rx_overruns, st.replies_dropped, st.boots, st.queued),
+        (0, 0, 1, 0),
+        "{st:?}"
+    );
     assert!(q.is_running(), "QEMU exited: the firmware crashed");
     let faults: Vec<String> = FAULTS
         .iter()

@@ -34,7 +34,7 @@ pub struct Placed {
 fn index_of<T>(base: usize, part: &[T]) -> Option<usize> {
     let bytes = (part.as_ptr() as usize).checked_sub(base)?;
     let size = core::mem::size_of::<T>().max(1);
-    (bytes % size == 0).then_some(bytes / size)
+    (bytes.checked_rem(size)? == 0).then_some(bytes.checked_div(size)?)
 }
 
 impl Workspace<'_> {

@@ -563,11 +563,33 @@ pub fn assert_core_path(what: &str, core: &CorePath, dev: &DevicePath) {
 /// why the link failed.
 pub type Incoming = Result<(u32, ohaca_host::link::Response), String>;
 
-/// Read reply frames until the connection closes; every reply goes to `tx`, decoded, the parts of
-/// a long path as one `Path` ([`ohaca_host::link::Assembler`]).
-pub fn read_replies(mut s: TcpStream, tx: std::sync::mpsc::Sender<Incoming>) {
+/// Reply frames that were parts of long paths, the paths begun in parts (first parts: the
+/// device's `parted` counts them, cancelled ones included), and the paths put together from
+/// them, as a [`read_replies_counting`] thread counts them.
+#[derive(Debug, Default)]
+pub struct PartCounts {
+    pub frames: std::sync::atomic::AtomicU64,
+    pub begun: std::sync::atomic::AtomicU64,
+    pub paths: std::sync::atomic::AtomicU64,
+}
+
+/// Read reply frames until the connection closes (a TCP socket to QEMU, or a relay client:
+/// [`PacedQemu::relay`]); every reply goes to `tx`, decoded, the parts of a long path as one
+/// `Path` ([`ohaca_host::link::Assembler`]).
+pub fn read_replies(s: impl Read, tx: std::sync::mpsc::Sender<Incoming>) {
+    read_replies_counting(s, tx, &PartCounts::default());
+}
+
+/// [`read_replies`], counting the part frames and the paths made of them in `counts` (the
+/// device's `tx_frames` counts every frame, so each parted path adds its parts less one).
+pub fn read_replies_counting(
+    mut s: impl Read,
+    tx: std::sync::mpsc::Sender<Incoming>,
+    counts: &PartCounts,
+) {
     use ohaca::protocol::{decode_reply, ReplyReader, MAX_REPLY_WIRE};
     use ohaca_host::link::{Assembler, Response};
+    use std::sync::atomic::Ordering;
     let mut reader = Box::new(ReplyReader::new());
     let mut parts = Assembler::default();
     let mut buf = vec![0u8; 8192];
@@ -586,13 +608,29 @@ pub fn read_replies(mut s: TcpStream, tx: std::sync::mpsc::Sender<Incoming>) {
         };
         for &b in &buf[..n] {
             if let Some(f) = reader.push(b).into_frame(MAX_REPLY_WIRE) {
+                let mut part = false;
                 let r = f
                     .and_then(decode_reply)
-                    .and_then(|(id, r)| Ok((id, parts.push(id, Response::from(&r))?)))
+                    .and_then(|(id, r)| {
+                        let resp = Response::from(&r);
+                        part = matches!(resp, Response::Part(_));
+                        if matches!(&resp, Response::Part(p) if p.offset == 0) {
+                            counts.begun.fetch_add(1, Ordering::AcqRel);
+                        }
+                        Ok((id, parts.push(id, resp)?))
+                    })
                     .map_err(|e| format!("undecodable reply frame: {e}"));
+                if part {
+                    counts.frames.fetch_add(1, Ordering::AcqRel);
+                }
                 let r = match r {
                     Ok((_, None)) => continue, // a part; the path comes with its last
-                    Ok((id, Some(resp))) => Ok((id, resp)),
+                    Ok((id, Some(resp))) => {
+                        if part {
+                            counts.paths.fetch_add(1, Ordering::AcqRel);
+                        }
+                        Ok((id, resp))
+                    }
                     Err(e) => Err(e),
                 };
                 if tx.send(r).is_err() {
