@@ -289,20 +289,7 @@ fn latencies(baud: u32) {
     let t_up = Instant::now();
     let (start, goal) = maze(&mut link);
     let upload = t_up.elapsed();
-    link.transport().take_arrivals();
-    let base = counters.to_host_line();
-    let plan = link
-        .send(&Request::Plan {
-            start,
-            goal,
-            seed: Some(1),
-        })
-        .expect("send the plan");
-    let t_plan = Instant::now();
-    while counters.to_host_line() == base {
-        assert!(t_plan.elapsed() < TIMEOUT, "no reply");
-        std::thread::sleep(Duration::from_micros(200));
-    }
+    let plan = plan_until_it_answers(&mut link, &counters, start, goal);
     let stats = link.send(&Request::Stats).expect("send Stats");
     let sent = link.transport().wait_sent(TIMEOUT).expect("Stats sent");
     link.wait_for(plan, "Plan").expect("path");
@@ -396,6 +383,25 @@ fn long_path_on(
 ) -> (u32, Params, Map) {
     let info = link.info().expect("hello first").clone();
     link.set_map(&map).expect("upload the serpentine");
+    let plan = plan_until_it_answers(link, counters, start, goal);
+    (
+        plan,
+        Params {
+            seed: 1,
+            ..info.defaults
+        },
+        map,
+    )
+}
+
+/// Send a plan (seed 1) and wait for the first byte of its answer on the line (what arrived
+/// before is dropped); returns its id.
+fn plan_until_it_answers(
+    link: &mut Link<RelayStream>,
+    counters: &Counters,
+    start: Point,
+    goal: Point,
+) -> u32 {
     link.transport().take_arrivals();
     let base = counters.to_host_line();
     let plan = link
@@ -410,14 +416,7 @@ fn long_path_on(
         assert!(t.elapsed() < TIMEOUT, "no reply to the plan");
         std::thread::sleep(Duration::from_micros(200));
     }
-    (
-        plan,
-        Params {
-            seed: 1,
-            ..info.defaults
-        },
-        map,
-    )
+    plan
 }
 
 /// Host-bound bytes between a request's last byte reaching the device and its answer's first.

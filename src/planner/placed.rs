@@ -77,14 +77,7 @@ mod tests {
 
     #[test]
     fn a_plan_is_read_back_from_a_workspace_lent_again() {
-        let (bits, w, h) = crate::testutil::bits(&[
-            "........", //
-            ".####...", //
-            "....#.#.", //
-            ".##.#.#.", //
-            "......#.", //
-            "........", //
-        ]);
+        let (bits, w, h) = crate::testutil::bits(&crate::planner::tests::ROWS);
         let g = Grid::new(w, h, &bits).unwrap();
         let mut s: Storage<2, 64, 128, 64> = Storage::new();
         let (placed, tour, waypoints) = {

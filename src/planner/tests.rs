@@ -15,7 +15,8 @@ fn grid(rows: &[&str]) -> (Vec<u8>, u16, u16) {
     crate::testutil::bits(rows)
 }
 
-const ROWS: [&str; 6] = [
+/// A small map with walls (also `super::placed`'s test).
+pub(super) const ROWS: [&str; 6] = [
     "........", //
     ".####...", //
     "....#.#.", //

@@ -503,13 +503,6 @@ fn example_parts() -> Vec<Vec<u8>> {
         .collect()
 }
 
-fn hex(b: &[u8]) -> String {
-    b.iter()
-        .map(|x| format!("{x:02x}"))
-        .collect::<Vec<_>>()
-        .join(" ")
-}
-
 #[test]
 fn protocol_doc_path_parts_are_exact() {
     let doc = include_str!("../../../docs/PROTOCOL.md");
