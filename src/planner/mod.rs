@@ -20,6 +20,7 @@
 //! | `workspace` | [`Workspace`], [`Buffers`], [`Storage`]: every buffer, one layout |
 //! | `run` | [`Run`]: the loop as a state machine (setup, walk + update + record, polish) |
 //! | `plan` | [`Plan`], [`RawPath`], [`CurvePoint`]: the result |
+//! | `placed` | [`Placed`], [`Bases`]: where a plan lies in its workspace, to read it again later (the firmware's path parts) |
 //! | `warm` | [`Memory`], [`Area`]: warm starts after map changes, and the pheromone repair |
 //! | `reuse` | [`reuse`]: a replan answered with the rest of the last answer, when no change can block or shorten it |
 //! | `repair` | the rest of the last answer with an exact detour around what blocks it ([`longest_detour`]), reached through [`reuse`] |

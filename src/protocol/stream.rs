@@ -45,7 +45,7 @@ enum Stage {
     Done,
 }
 
-/// A [`Reply::Path`] frame, encoded on demand by [`PathStream::fill`].
+/// A [`super::Reply::Path`] frame, encoded on demand by [`PathStream::fill`].
 ///
 /// ```
 /// use ohaca::protocol::{decode_reply, encode_reply, PathReply, PathStream, Reply, Waypoints,
