@@ -419,6 +419,24 @@ fn plan_until_it_answers(
     plan
 }
 
+/// A wall cell of every serpentine (row 1 is a wall): blocking it again changes the map's bits
+/// nothing, so the path in flight stays the answer.
+const WALL_CELL: Point = Point::new(5, 1);
+
+/// Send a Stats, then a SetCells blocking [`WALL_CELL`]; their ids and when each was delivered.
+fn stats_and_a_cell_update(link: &mut Link<RelayStream>) -> (u32, Stamp, u32, Stamp) {
+    let stats = link.send(&Request::Stats).expect("send Stats");
+    let s1 = link.transport().wait_sent(TIMEOUT).expect("Stats sent");
+    let update = link
+        .send(&Request::SetCells {
+            blocked: true,
+            cells: ohaca::protocol::Waypoints::Points(&[WALL_CELL]),
+        })
+        .expect("send SetCells");
+    let s2 = link.transport().wait_sent(TIMEOUT).expect("SetCells sent");
+    (stats, s1, update, s2)
+}
+
 /// Host-bound bytes between a request's last byte reaching the device and its answer's first.
 fn waited(frames: &[Frame], id: u32, sent: Stamp) -> u64 {
     let f = frames
@@ -437,18 +455,7 @@ fn stats_and_a_cell_update_pass_a_long_path() {
     let (_q, mut link, counters) = boot_paced(BAUD);
     link.hello().expect("hello");
     let (plan, params, map) = long_path_streaming(&mut link, &counters);
-    let stats = link.send(&Request::Stats).expect("send Stats");
-    let s1 = link.transport().wait_sent(TIMEOUT).expect("Stats sent");
-    // A cell away from the way: the top-left corner's corridor end is on it, (30, 62) is too;
-    // a wall cell blocked again changes nothing of the path (row 1 is a wall).
-    let cells = [Point::new(5, 1)];
-    let update = link
-        .send(&Request::SetCells {
-            blocked: true,
-            cells: ohaca::protocol::Waypoints::Points(&cells),
-        })
-        .expect("send SetCells");
-    let s2 = link.transport().wait_sent(TIMEOUT).expect("SetCells sent");
+    let (stats, s1, update, s2) = stats_and_a_cell_update(&mut link);
     let path = link.wait_for(plan, "Plan").expect("the path");
     assert_eq!(
         link.wait_for(stats, "Stats").expect("stats").kind(),
@@ -604,16 +611,7 @@ fn the_twins_16000_step_path_lets_replies_pass_and_stops_at_a_cancel() {
     assert_eq!(info.capacity.max_steps, 16_384);
     let (w, h) = (254u16, 127u16);
     let (plan, params, map) = long_path_on(&mut link, &counters, serpentine_of(w, h));
-    let stats = link.send(&Request::Stats).expect("send Stats");
-    let s1 = link.transport().wait_sent(TIMEOUT).expect("Stats sent");
-    let cells = [Point::new(5, 1)];
-    let update = link
-        .send(&Request::SetCells {
-            blocked: true,
-            cells: ohaca::protocol::Waypoints::Points(&cells),
-        })
-        .expect("send SetCells");
-    let s2 = link.transport().wait_sent(TIMEOUT).expect("SetCells sent");
+    let (stats, s1, update, s2) = stats_and_a_cell_update(&mut link);
     link.set_timeout(TIMEOUT);
     let path = link.wait_for(plan, "Plan").expect("the path");
     link.wait_for(stats, "Stats").expect("stats");
@@ -643,7 +641,7 @@ fn the_twins_16000_step_path_lets_replies_pass_and_stops_at_a_cancel() {
         .expect("the core plans it");
     qemu::assert_core_path("the twin's serpentine", &core, &path);
     // The same plan again, cancelled while it goes out.
-    link.set_cells(&cells, false).expect("clear the cell");
+    link.set_cells(&[WALL_CELL], false).expect("clear the cell");
     let (plan, _, _) = long_path_on(&mut link, &counters, serpentine_of(w, h));
     let cancel = link.send(&Request::Cancel).expect("send Cancel");
     let sent = link.transport().wait_sent(TIMEOUT).expect("Cancel sent");

@@ -3,7 +3,7 @@
 #[cfg(test)]
 mod fake_device {
     use crate::link::*;
-    use ohaca::protocol::{decode_request, encode_reply, RequestReader, Waypoints};
+    use ohaca::protocol::{decode_request, encode_reply, RequestReader};
 
     /// The fake device's script: the replies to one request.
     type Answer = dyn FnMut(u32, Request<'_>) -> Vec<(u32, Response)>;
@@ -33,19 +33,7 @@ mod fake_device {
             Response::Ack => Reply::Ack,
             Response::Path(p) => {
                 pts = p.clone();
-                Reply::Path(PathReply {
-                    raw_length: pts.raw_length,
-                    length: pts.length,
-                    turns: pts.turns,
-                    iterations: pts.iterations,
-                    best_iteration: pts.best_iteration,
-                    moves: pts.moves,
-                    ticks: pts.ticks,
-                    raw_cells: pts.raw_cells,
-                    origin: pts.origin,
-                    waypoints: Waypoints::Points(&pts.waypoints),
-                    directions: &pts.directions,
-                })
+                Reply::Path(pts.reply())
             }
             Response::Error(e) => Reply::Error(*e),
             Response::Stats(s) => Reply::Stats(*s),
@@ -148,20 +136,7 @@ mod fake_device {
 
     /// `p`'s body in parts of `size` bytes, as a device sends a long path.
     fn parts(p: &DevicePath, size: usize) -> Vec<Response> {
-        let reply = PathReply {
-            raw_length: p.raw_length,
-            length: p.length,
-            turns: p.turns,
-            iterations: p.iterations,
-            best_iteration: p.best_iteration,
-            moves: p.moves,
-            ticks: p.ticks,
-            raw_cells: p.raw_cells,
-            origin: p.origin,
-            waypoints: Waypoints::Points(&p.waypoints),
-            directions: &p.directions,
-        };
-        let body = ohaca::protocol::PathBody::new(&reply).unwrap();
+        let body = ohaca::protocol::PathBody::new(&p.reply()).unwrap();
         let mut bytes = vec![0u8; body.len()];
         assert_eq!(body.read(0, &mut bytes), body.len());
         bytes

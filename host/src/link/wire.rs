@@ -117,6 +117,25 @@ pub struct DevicePath {
     pub directions: Vec<u8>,
 }
 
+impl DevicePath {
+    /// The reply it came in, borrowing its points and directions (to encode it again).
+    pub fn reply(&self) -> PathReply<'_> {
+        PathReply {
+            raw_length: self.raw_length,
+            length: self.length,
+            turns: self.turns,
+            iterations: self.iterations,
+            best_iteration: self.best_iteration,
+            moves: self.moves,
+            ticks: self.ticks,
+            raw_cells: self.raw_cells,
+            origin: self.origin,
+            waypoints: Waypoints::Points(&self.waypoints),
+            directions: &self.directions,
+        }
+    }
+}
+
 impl From<&PathReply<'_>> for DevicePath {
     fn from(p: &PathReply<'_>) -> Self {
         DevicePath {
