@@ -633,7 +633,7 @@ fn the_twins_16000_step_path_lets_replies_pass_and_stops_at_a_cancel() {
     );
     assert_eq!(
         path.raw_cells as usize,
-        (h as usize + 1) / 2 * (w as usize - 1) + h as usize
+        usize::from(h).div_ceil(2) * (usize::from(w) - 1) + usize::from(h)
     );
     assert!(w1 <= FIFTY_MS && w2 <= FIFTY_MS, "{w1}, {w2}");
     let (_, start, goal) = serpentine_of(w, h);
