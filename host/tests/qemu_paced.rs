@@ -150,13 +150,7 @@ fn a_long_path_reply_is_paced_and_the_transmitter_waits() {
     let (start, goal) = maze(&mut link);
     link.transport().take_arrivals();
     counters.reset_backlog_max();
-    let id = link
-        .send(&Request::Plan {
-            start,
-            goal,
-            seed: Some(1),
-        })
-        .expect("send the plan");
+    let id = send_plan(&mut link, start, goal);
     let sent = link.transport().wait_sent(TIMEOUT).expect("plan sent");
     let reply = link.wait_for(id, "Plan").expect("the path");
     let Response::Path(path) = reply else {
@@ -213,13 +207,7 @@ fn a_burst_beyond_the_receive_ring_is_lost_counted_and_survived() {
         ..info.defaults
     };
     link.set_params(&slow).expect("params");
-    let plan = link
-        .send(&Request::Plan {
-            start,
-            goal,
-            seed: Some(1),
-        })
-        .expect("send the plan");
+    let plan = send_plan(&mut link, start, goal);
     // Let the plan start before the burst (its bytes are ahead of the burst on the line).
     link.transport().wait_sent(TIMEOUT).expect("plan sent");
     std::thread::sleep(Duration::from_millis(50));
@@ -394,6 +382,16 @@ fn long_path_on(
     )
 }
 
+/// Send a plan (seed 1) without waiting; returns its id.
+fn send_plan(link: &mut Link<RelayStream>, start: Point, goal: Point) -> u32 {
+    link.send(&Request::Plan {
+        start,
+        goal,
+        seed: Some(1),
+    })
+    .expect("send the plan")
+}
+
 /// Send a plan (seed 1) and wait for the first byte of its answer on the line (what arrived
 /// before is dropped); returns its id.
 fn plan_until_it_answers(
@@ -404,13 +402,7 @@ fn plan_until_it_answers(
 ) -> u32 {
     link.transport().take_arrivals();
     let base = counters.to_host_line();
-    let plan = link
-        .send(&Request::Plan {
-            start,
-            goal,
-            seed: Some(1),
-        })
-        .expect("send the plan");
+    let plan = send_plan(link, start, goal);
     let t = Instant::now();
     while counters.to_host_line() == base {
         assert!(t.elapsed() < TIMEOUT, "no reply to the plan");

@@ -149,14 +149,21 @@ fn qemu_command(serial: &str) -> Command {
     qemu_command_for(serial, firmware())
 }
 
-fn qemu_command_for(serial: &str, elf: &Path) -> Command {
+/// `qemu-system-arm` for the mps2-an386 board booting `elf` (semihosting for its logs), its
+/// UART not chosen yet.
+fn qemu_base(elf: &Path) -> Command {
     let mut c = Command::new("qemu-system-arm");
     c.args(["-M", "mps2-an386", "-display", "none", "-monitor", "none"])
         .args(["-semihosting-config", "enable=on,target=native"])
-        .args(["-serial", serial])
         .arg("-kernel")
         .arg(elf)
         .stdin(Stdio::null());
+    c
+}
+
+fn qemu_command_for(serial: &str, elf: &Path) -> Command {
+    let mut c = qemu_base(elf);
+    c.args(["-serial", serial]);
     c
 }
 
@@ -318,14 +325,8 @@ pub fn boot_paced(baud: u32) -> (PacedQemu, Link<RelayStream>, Arc<Counters>) {
 
 /// [`boot_paced`] with another firmware ELF.
 pub fn boot_paced_with(elf: &Path, baud: u32) -> (PacedQemu, Link<RelayStream>, Arc<Counters>) {
-    let mut c = Command::new("qemu-system-arm");
-    c.args(["-M", "mps2-an386", "-display", "none", "-monitor", "none"])
-        .args(["-semihosting-config", "enable=on,target=native"])
-        .arg("-kernel")
-        .arg(elf)
-        .stdin(Stdio::null())
-        .stdout(defmt_log())
-        .stderr(Stdio::inherit());
+    let mut c = qemu_base(elf);
+    c.stdout(defmt_log()).stderr(Stdio::inherit());
     let (child, relay) = Relay::spawn_qemu(&mut c, baud).expect("start QEMU behind the relay");
     let counters = relay.counters();
     let q = PacedQemu { child, relay };
