@@ -3,7 +3,8 @@
 //!
 //! Owns [`tighten`] and the cell -> path-position index it needs (a per-cell array, or an
 //! open-addressing hash table over the path's cells when the workspace has fewer links than the
-//! map has cells; both give the same result). Like the rest of the core it has no panic path:
+//! map has cells, of positions or, with fewer links still, of packed (cell, position) keys in
+//! the links and the path cells' words; all give the same result). Like the rest of the core it has no panic path:
 //! every index is checked, and a path it cannot index is returned unchanged.
 
 use crate::ant::Walk;
@@ -23,8 +24,11 @@ use crate::grid::{is_diagonal, neighbour, opposite, Dir, Moves, Point};
 /// with one entry per map cell it is indexed by cell; shorter, it is an open-addressing hash
 /// table over the path's cells, which needs a power of two of at least twice the path's cells as
 /// slots, or if that does not fit, of at least one and a half times (load factor 2/3), two 16-bit
-/// slots a word for paths of fewer than 65,535 cells (a longer path is returned untightened:
-/// [`hash_words`]). Every one gives the same result.
+/// slots a word for paths of fewer than 65,535 cells ([`hash_words`]). When `pos` is shorter
+/// still, the table holds packed (cell, position) keys over `pos` and `cells`' own words, which
+/// then need not be laid out: at least `3 (steps + 1) / 2` slots together ([`keyed_words`], and
+/// `cells` aligned to a word, as an arena's are). A path no index holds is returned
+/// untightened. Every one gives the same result (the tests compare them).
 ///
 /// `visited` is the walk's tabu set (every cell of the path is in it): a neighbour outside it is
 /// not on the path and is not looked up. An empty set looks up every neighbour; same result.
@@ -42,30 +46,53 @@ pub fn tighten(
     // below would fail and the walk come back unchanged.
     let n = walk.steps.wrapping_add(1);
     let offsets = grid.offsets();
-    let (Some(cells), Some(path)) = (cells.get_mut(..n), tour.get(..walk.steps)) else {
+    if cells.len() < n {
+        return walk;
+    }
+    let Some(path) = tour.get(..walk.steps) else {
         return walk;
     };
-    let mut index = match PathIndex::new(pos, grid.cells(), n) {
-        Some(ix) => ix,
-        None => return walk,
-    };
-    // Lay the path out as cells and remember each cell's position on it.
-    let mut p = start;
-    for (i, slot) in cells.iter_mut().enumerate() {
-        *slot = p;
-        index.insert(grid.index(p), i as u32);
-        if let Some(&d) = path.get(i) {
-            p = neighbour(p, d);
+    // The index: positions in `pos` (a per-cell array, or a hash table) checked against the path
+    // laid out in `cells`, or, when `pos` is too short for that, a table of packed
+    // (cell, position) keys over `pos` and `cells`' words together ([`Keyed`]).
+    let index = if PathIndex::fits(pos.len(), grid.cells(), n) {
+        let Some(mut ix) = PathIndex::new(pos, grid.cells(), n) else {
+            return walk;
+        };
+        let laid = cells.get_mut(..n).unwrap_or_default();
+        // Lay the path out as cells and remember each cell's position on it.
+        let mut p = start;
+        for (i, slot) in laid.iter_mut().enumerate() {
+            *slot = p;
+            ix.insert(grid.index(p), i as u32);
+            if let Some(&d) = path.get(i) {
+                p = neighbour(p, d);
+            }
         }
-    }
+        Index::Laid(ix, laid)
+    } else {
+        let Some(mut k) = Keyed::new(pos, cells, grid.cells(), n) else {
+            return walk;
+        };
+        let mut p = start;
+        for i in 0..n {
+            k.insert(grid.index(p), i as u32);
+            if let Some(&d) = path.get(i) {
+                p = neighbour(p, d);
+            }
+        }
+        Index::Keyed(k)
+    };
     let mut i = 0usize;
     let mut out = 0usize;
     let (mut straight, mut diagonal) = (0u32, 0u32);
     let (width, height) = (usize::from(grid.width()), usize::from(grid.height()));
-    // `i < n` throughout (it only ever becomes a valid index into `cells`), so no `wrapping_` below
-    // wraps: `out <= i` and `straight + diagonal == out`.
+    // The cell at position `i`, followed along the path (a jump to `j` by move `d` lands on the
+    // cell at `j`: that is how `j` was found).
+    let mut cp = start;
+    // `i < n` throughout (it only ever becomes a valid position on the path), so no `wrapping_`
+    // below wraps: `out <= i` and `straight + diagonal == out`.
     while i.wrapping_add(1) < n {
-        let Some(&cp) = cells.get(i) else { break };
         let ci = grid.index(cp);
         // Fast path, away from the map's border: when no neighbour but the path's previous and
         // next cells was visited, the next cell is the furthest. `tour[i]` still holds the step
@@ -89,18 +116,20 @@ pub fn tighten(
                         straight = straight.wrapping_add(1);
                     }
                     i = i.wrapping_add(1);
+                    cp = neighbour(cp, next_d);
                     continue;
                 }
             }
         }
-        // The path's cells before and after this one are known without a look-up.
-        let prev = match i.checked_sub(1).and_then(|k| cells.get(k)) {
-            Some(&q) => grid.index(q),
+        // The path's cells before and after this one are known without a look-up: `tour[i]` is
+        // the step out of this cell and `tour[i - 1]` the step into it (see above).
+        let prev = match i.checked_sub(1).and_then(|k| tour.get(k)) {
+            Some(&d) => grid.index(neighbour(cp, opposite(d))),
             None => usize::MAX,
         };
-        let next = cells
-            .get(i.wrapping_add(1))
-            .map_or(usize::MAX, |&q| grid.index(q));
+        let next = tour
+            .get(i)
+            .map_or(usize::MAX, |&d| grid.index(neighbour(cp, d)));
         let mut mask = moves.at(ci, cp);
         // Furthest later path cell one allowed move away (the next cell always qualifies).
         let mut best = (i, 0u8);
@@ -119,7 +148,7 @@ pub fn tighten(
                 }
                 continue;
             }
-            if let Some(j) = index.find(nb, |j| cells.get(j).map(|&q| grid.index(q))) {
+            if let Some(j) = index.find(nb, grid) {
                 if j > best.0 {
                     best = (j, d);
                 }
@@ -140,6 +169,7 @@ pub fn tighten(
             straight = straight.wrapping_add(1);
         }
         i = j;
+        cp = neighbour(cp, d);
     }
     Walk {
         steps: out,
@@ -194,6 +224,129 @@ pub const fn hash_words(n: usize) -> usize {
     }
 }
 
+/// The fewest words of `pos` with which [`tighten`] tightens every path of up to `n` cells on a
+/// map of up to 2^(32 - bits(n)) cells when `cells` lends its `n` words too: a table of packed
+/// (cell, position) keys over both ([`Keyed`]), of at least `3n / 2` slots. The compact arena
+/// ([`crate::planner::arena`]) sizes its links so: half the words of [`hash_words`].
+pub const fn keyed_words(n: usize) -> usize {
+    n.div_ceil(2)
+}
+
+/// Where [`tighten`] finds a cell's position on the path.
+enum Index<'a> {
+    /// Positions in `pos`, checked against the path laid out in these cells.
+    Laid(PathIndex<'a>, &'a [Point]),
+    /// Packed (cell, position) keys: nothing laid out.
+    Keyed(Keyed<'a>),
+}
+
+impl Index<'_> {
+    /// The position of map cell `cell` on the path, if it is on it.
+    #[inline]
+    fn find(&self, cell: usize, grid: &crate::grid::Grid<'_>) -> Option<usize> {
+        match self {
+            Index::Laid(ix, cells) => ix.find(cell, |j| cells.get(j).map(|&q| grid.index(q))),
+            Index::Keyed(k) => k.find(cell),
+        }
+    }
+}
+
+/// An open-addressing table of `(cell << bits) | (position + 1)` keys (0 = empty) over two
+/// slices of words, slot `k` in the first while `k` is below its length, then in the second: the
+/// links and the path cells' own words, which [`tighten`] does not need laid out when the key
+/// carries the cell. Any number of slots (at least `3n / 2`, a load of at most 2/3): the home
+/// slot is the Fibonacci hash scaled onto them (a multiply and a shift). Only when the cell
+/// index and the position fit 32 bits together (`bits(cells - 1) + bits(n) <= 32`: 262,144
+/// cells with paths of up to 16,383 steps).
+struct Keyed<'a> {
+    a: &'a mut [u32],
+    b: &'a mut [u32],
+    /// Slots in all: `a.len() + b.len()`, below 2^32.
+    len: usize,
+    /// Bits of `position + 1`.
+    bits: u32,
+}
+
+impl<'a> Keyed<'a> {
+    fn new(a: &'a mut [u32], cells: &'a mut [Point], map_cells: usize, n: usize) -> Option<Self> {
+        let bits = usize::BITS.wrapping_sub(n.leading_zeros());
+        let cell_bits = usize::BITS.wrapping_sub(map_cells.saturating_sub(1).leading_zeros());
+        if bits.saturating_add(cell_bits) > 32 || bits >= 32 {
+            return None;
+        }
+        let b: &mut [u32] = bytemuck::try_cast_slice_mut(cells).ok()?;
+        let len = a.len().checked_add(b.len())?;
+        if len < n.checked_add(n.div_ceil(2))? || u32::try_from(len).is_err() {
+            return None;
+        }
+        a.fill(0);
+        b.fill(0);
+        Some(Keyed { a, b, len, bits })
+    }
+
+    #[inline]
+    fn home(&self, cell: usize) -> usize {
+        // Fibonacci hashing, scaled onto `len` slots.
+        let h = u64::from((cell as u32).wrapping_mul(0x9E37_79B9));
+        (h.wrapping_mul(self.len as u64) >> 32) as usize
+    }
+
+    #[inline]
+    fn slot(&self, k: usize) -> Option<u32> {
+        match k.checked_sub(self.a.len()) {
+            None => self.a.get(k).copied(),
+            Some(j) => self.b.get(j).copied(),
+        }
+    }
+
+    #[inline]
+    fn next(&self, k: usize) -> usize {
+        let k = k.wrapping_add(1);
+        if k >= self.len {
+            0
+        } else {
+            k
+        }
+    }
+
+    fn insert(&mut self, cell: usize, i: u32) {
+        // `bits < 32` (`new`: a position and a cell bit at least, or no path).
+        let key = (cell as u32).wrapping_shl(self.bits) | i.wrapping_add(1);
+        let mut k = self.home(cell);
+        // At most n entries in at least 3n/2 slots: an empty slot is always found.
+        for _ in 0..self.len {
+            if self.slot(k) == Some(0) {
+                let s = match k.checked_sub(self.a.len()) {
+                    None => self.a.get_mut(k),
+                    Some(j) => self.b.get_mut(j),
+                };
+                if let Some(s) = s {
+                    *s = key;
+                }
+                return;
+            }
+            k = self.next(k);
+        }
+    }
+
+    #[inline]
+    fn find(&self, cell: usize) -> Option<usize> {
+        let mut k = self.home(cell);
+        for _ in 0..self.len {
+            let v = self.slot(k)?;
+            if v == 0 {
+                return None;
+            }
+            if v.wrapping_shr(self.bits) as usize == cell {
+                let mask = 1u32.wrapping_shl(self.bits).wrapping_sub(1);
+                return Some((v & mask).wrapping_sub(1) as usize);
+            }
+            k = self.next(k);
+        }
+        None
+    }
+}
+
 /// Cell -> position on a path: a per-cell array, or a hash table over the path's cells.
 struct PathIndex<'a> {
     slots: &'a mut [u32],
@@ -206,6 +359,12 @@ struct PathIndex<'a> {
 }
 
 impl<'a> PathIndex<'a> {
+    /// Whether [`PathIndex::new`] has room in `words` words for a path of `n` cells on a map of
+    /// `cells` cells.
+    fn fits(words: usize, cells: usize, n: usize) -> bool {
+        words >= cells || hash_slots(n, words).is_some()
+    }
+
     fn new(pos: &'a mut [u32], cells: usize, n: usize) -> Option<Self> {
         if pos.len() >= cells {
             return Some(PathIndex {
@@ -433,15 +592,17 @@ mod tests {
             let direct = run(cells);
             assert_eq!(run(words), direct, "seed {seed}");
             // One word too few for a load factor of 1/2: the table half its size if that keeps
-            // the load factor at most 2/3 (the next test), else the walk comes back untightened.
+            // the load factor at most 2/3 (the next test), else the keyed table over the links
+            // and the cells' words; with fewer words than that, the walk comes back untightened.
             if words < n + n.div_ceil(2) {
                 assert_eq!(hash_words(n), words, "seed {seed}");
-                let (short, path) = run(words - 1);
-                assert_eq!((short, path.as_slice()), (walk, &tour[..walk.steps]));
             } else {
                 assert_eq!(hash_words(n), words / 2, "seed {seed}");
-                assert_eq!(run(words - 1), direct, "seed {seed}");
             }
+            assert_eq!(run(words - 1), direct, "seed {seed}");
+            assert_eq!(run(keyed_words(n)), direct, "seed {seed}");
+            let (short, path) = run(keyed_words(n) - 1);
+            assert_eq!((short, path.as_slice()), (walk, &tour[..walk.steps]));
             changed += usize::from(direct.0.steps < walk.steps);
         }
         assert!(changed >= 10, "{changed}");
@@ -452,7 +613,7 @@ mod tests {
         // The same wandering walks, on maps of several sizes so that their lengths fall both
         // just above a power of two (where half the load-1/2 table still holds 3n/2 slots) and
         // below: with the words of that smaller table, each walk is tightened exactly as with the
-        // per-cell index; with one word fewer, it comes back untightened.
+        // per-cell index; with one word fewer, as the keyed table over links and cells does it.
         let (mut smaller, mut shortened) = (0, 0);
         for (w, h) in [(48u16, 40u16), (64, 24), (30, 30), (80, 60)] {
             for seed in 0..40u64 {
@@ -476,8 +637,7 @@ mod tests {
                 let direct = run(usize::from(w) * usize::from(h));
                 assert_eq!(run(words), direct, "{w}x{h} seed {seed}");
                 shortened += usize::from(direct.0.steps < walk.steps);
-                let (short, path) = run(words - 1);
-                assert_eq!((short, path.as_slice()), (walk, &tour[..walk.steps]));
+                assert_eq!(run(words - 1), direct, "{w}x{h} seed {seed}");
                 smaller += 1;
             }
         }
@@ -522,5 +682,79 @@ mod tests {
         }
         let mut fewer = vec![0u32; 16_383];
         assert!(PathIndex::new(&mut fewer, 1 << 22, n).is_none());
+    }
+
+    #[test]
+    fn the_keyed_table_finds_a_4096_cell_path_in_6144_words() {
+        // The compact arena's longest path (4,095 steps) on a 512 x 512 map: its 2,048 links and
+        // the path cells' 4,096 words hold 6,144 slots of packed keys (18 bits of cell, 13 of
+        // position). Every cell is found at its position, cells not on the path are not, and a
+        // map of 2^20 cells (20 + 13 bits) or one word fewer gets no table.
+        let n = 4096;
+        let map = 512 * 512;
+        let cell = |i: usize| (i * 193 + 7) % map;
+        let mut links = vec![0u32; keyed_words(n)];
+        let mut cells = vec![Point::default(); n];
+        let mut k = Keyed::new(&mut links, &mut cells, map, n).expect("a table");
+        assert_eq!((k.len, k.bits), (6144, 13));
+        for i in 0..n {
+            k.insert(cell(i), i as u32);
+        }
+        for i in 0..n {
+            assert_eq!(k.find(cell(i)), Some(i));
+        }
+        for i in n..n + 2000 {
+            assert_eq!(k.find(cell(i)), None);
+        }
+        let mut links = vec![0u32; keyed_words(n) - 1];
+        assert!(Keyed::new(&mut links, &mut cells, map, n).is_none());
+        let mut links = vec![0u32; keyed_words(n)];
+        assert!(Keyed::new(&mut links, &mut cells, 1 << 20, n).is_none());
+    }
+
+    #[test]
+    fn the_keyed_table_tightens_long_walks_as_the_per_cell_index_does() {
+        // Wandering walks on maps large enough for walks of hundreds of cells: the keyed table
+        // with as few links as it needs, and with many more, tightens each as the per-cell index.
+        let mut shortened = 0;
+        for (w, h) in [(120u16, 90u16), (200, 40)] {
+            for seed in 0..12u64 {
+                let Some(Wandering {
+                    bits,
+                    walk,
+                    tour,
+                    tabu,
+                }) = wandering_walk(w, h, seed)
+                else {
+                    continue;
+                };
+                let n = walk.steps + 1;
+                let run = |links: usize| tightened((w, h, &bits), walk, &tour, &tabu, links);
+                let direct = run(usize::from(w) * usize::from(h));
+                assert_eq!(run(keyed_words(n)), direct, "{w}x{h} seed {seed}");
+                assert_eq!(run(keyed_words(n) + 1), direct, "{w}x{h} seed {seed}");
+                // Without the tabu set's filter every neighbour is looked up: the same path.
+                let g = Grid::new(w, h, &bits).unwrap();
+                let mut t = tour.clone();
+                let mut cells = vec![Point::default(); n];
+                let mut pos = vec![0u32; keyed_words(n)];
+                let out = tighten(
+                    &Moves::new(g, &[]),
+                    Point::new(0, 0),
+                    walk,
+                    &mut t,
+                    &mut cells,
+                    &mut pos,
+                    &[],
+                );
+                assert_eq!(
+                    (out, t[..out.steps].to_vec()),
+                    direct,
+                    "{w}x{h} seed {seed}"
+                );
+                shortened += usize::from(direct.0.steps < walk.steps);
+            }
+        }
+        assert!(shortened >= 6, "{shortened}");
     }
 }
