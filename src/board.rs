@@ -78,7 +78,7 @@ pub const F411: Board = Board {
     name: "f411",
     cells: 262_144,
     max_side: 4096,
-    max_steps: 2047,
+    max_steps: 4095,
     layout: Layout::Arena { words: 25_856 },
     rx_ring: 1024,
     window: 8,
@@ -169,25 +169,30 @@ mod tests {
     fn the_layouts_of_the_f411s_arena() {
         // The former `Storage` had the 1,024-byte move table (256 words) whatever the map.
         assert_eq!(full_words(65_536, 2047) + 256, WORDS);
-        assert_eq!(steps_for(WORDS, 65_536, 2047), Some((2047, false)));
-        // Without the move table the full layout holds a little more.
-        assert_eq!(steps_for(WORDS, 68_256, 2047), Some((2047, false)));
-        assert_eq!(steps_for(WORDS, 68_257, 2047), Some((2047, true)));
-        assert_eq!(steps_for(WORDS, 604 * 307, 2047), Some((2047, true)));
-        assert_eq!(steps_for(WORDS, 512 * 512, 2047), Some((1876, true)));
-        // The compact layout keeps the full 2,047 steps up to 258,048 cells, then fewer.
-        assert_eq!(steps_for(WORDS, 258_048, 2047), Some((2047, true)));
-        assert_eq!(steps_for(WORDS, 258_049, 2047), Some((2045, true)));
-        assert_eq!(steps_for(WORDS, 512 * 506, 2047), Some((2004, true)));
-        assert_eq!(compact_words(512 * 512, 1876), WORDS);
+        assert_eq!(steps_for(WORDS, 65_536, 4095), Some((2047, false)));
+        // Without the move table the full layout holds a little more; it keeps its 2,047 steps
+        // (`FULL_STEPS`) whatever the bound, so those maps plan as they always did.
+        assert_eq!(steps_for(WORDS, 68_256, 4095), Some((2047, false)));
+        assert_eq!(steps_for(WORDS, 68_257, 4095), Some((4095, true)));
+        assert_eq!(steps_for(WORDS, 604 * 307, 4095), Some((4095, true)));
+        // Every compact map keeps 4,095 steps: the tabu set lends what the links do not hold
+        // (the route's words and heap, the local search's scratch, the smoothing's links), and
+        // tightening's keyed table takes the path cells' words. The largest map, 512 x 512:
+        assert_eq!(steps_for(WORDS, 512 * 512, 4095), Some((4095, true)));
+        assert_eq!(compact_words(512 * 512, 4095), 25_600);
+        // Where the tabu set halved lends the local search a window of 48 to 51 cells a side.
+        assert_eq!(steps_for(WORDS, 258_048, 4095), Some((4095, true)));
+        assert_eq!(compact_words(258_048, 4095), 25_344);
+        // One step more would not fit at 512 x 512 (the keyed table grows by half a word).
+        assert!(compact_words(512 * 512, 4096 + 170) > WORDS);
         let cap = capacity(WORDS);
-        assert_eq!(cap, 299_008);
+        assert_eq!(cap, 364_544);
         assert!(F411.cells <= cap);
-        assert!(steps_for(WORDS, cap, 2047).is_some_and(|(s, c)| c && s >= MIN_STEPS));
-        assert_eq!(steps_for(WORDS, cap + 32, 2047), None);
+        assert!(steps_for(WORDS, cap, 4095).is_some_and(|(s, c)| c && s >= MIN_STEPS));
+        assert_eq!(steps_for(WORDS, cap + 32, 4095), None);
         // Every map size between: a layout that fits, the compact one leaving at least MIN_STEPS.
         for cells in (1..=cap).step_by(997) {
-            let (s, compact) = steps_for(WORDS, cells, 2047).unwrap();
+            let (s, compact) = steps_for(WORDS, cells, 4095).unwrap();
             let words = if compact {
                 compact_words(cells, s)
             } else {
@@ -195,16 +200,18 @@ mod tests {
             };
             assert!(words <= WORDS && s >= MIN_STEPS, "{cells}: {s} {compact}");
             let mut arena = vec![0u32; WORDS];
-            let c = carve(&mut arena, cells, 2047).unwrap();
+            let c = carve(&mut arena, cells, 4095).unwrap();
             assert_eq!((c.workspace.steps(), c.compact), (s, compact), "{cells}");
+            // Up to the board's 262,144 cells, every compact map keeps the board's bound.
+            assert!(!compact || cells > F411.cells || s == 4095, "{cells}: {s}");
             assert!(c.workspace.capacity() >= cells && c.map.len() * 8 >= cells);
         }
         let mut arena = vec![0u32; WORDS];
         assert_eq!(
-            carve(&mut arena, cap + 32, 2047).unwrap_err(),
+            carve(&mut arena, cap + 32, 4095).unwrap_err(),
             Error::MapTooLarge {
-                cells: 299_040,
-                capacity: 299_008
+                cells: 364_576,
+                capacity: 364_544
             }
         );
     }
@@ -213,8 +220,8 @@ mod tests {
     fn each_board_says_how_it_plans_a_map() {
         let f = |cells| F411.plans(cells).map(|l| (l.steps, l.compact));
         assert_eq!(f(68_256), Some((2047, false)));
-        assert_eq!(f(68_257), Some((2047, true)));
-        assert_eq!(f(512 * 512), Some((1876, true)));
+        assert_eq!(f(68_257), Some((4095, true)));
+        assert_eq!(f(512 * 512), Some((4095, true)));
         assert_eq!(f(512 * 512 + 1), None, "more than the board takes");
         let h = |cells| H743.plans(cells).map(|l| (l.steps, l.compact));
         assert_eq!(h(512 * 512), Some((16_384, false)));
@@ -234,7 +241,12 @@ mod tests {
         assert_eq!(Board::named("F411"), Some(F411));
         assert_eq!(Board::named("h743"), Some(H743));
         assert_eq!(Board::named("h7"), None);
-        assert_eq!(Board::with_capacity(262_144, 2047), Some(F411));
+        assert_eq!(Board::with_capacity(262_144, 4095), Some(F411));
+        assert_eq!(
+            Board::with_capacity(262_144, 2047),
+            None,
+            "protocol 10's F411 said 2,047"
+        );
         assert_eq!(Board::with_capacity(2_097_152, 16_384), Some(H743));
         assert_eq!(Board::with_capacity(262_144, 16_384), None);
     }

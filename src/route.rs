@@ -41,11 +41,14 @@ const NONE: u32 = 8;
 const DIST_SHIFT: u32 = 12;
 const UNREACHED: u32 = u32::MAX >> DIST_SHIFT;
 
-/// The coarse route of a run: the per-block words and what reads them.
+/// The coarse route of a run: the per-block words (or their [`pack`]ed next blocks) and what
+/// reads them.
 #[derive(Clone, Copy, Debug)]
 pub struct Route<'a> {
     blocks: Blocks,
     words: &'a [u32],
+    /// `words` holds four bits a block ([`pack`]), not a word.
+    packed: bool,
     goal: Point,
     width: u16,
     height: u16,
@@ -57,9 +60,35 @@ impl<'a> Route<'a> {
         Route {
             blocks,
             words,
+            packed: false,
             goal,
             width,
             height,
+        }
+    }
+
+    /// A route over the next blocks [`pack`] kept of [`build`]'s words: the same targets.
+    pub fn packed(
+        blocks: Blocks,
+        nibbles: &'a [u32],
+        goal: Point,
+        width: u16,
+        height: u16,
+    ) -> Self {
+        Route {
+            packed: true,
+            ..Route::new(blocks, nibbles, goal, width, height)
+        }
+    }
+
+    /// The next block's direction from block `b` (`NONE`: the goal's block or no route).
+    #[inline]
+    fn next(&self, b: usize) -> u32 {
+        if self.packed {
+            let shift = ((b & 7) as u32).wrapping_mul(4);
+            self.words.get(b >> 3).map_or(NONE, |w| (w >> shift) & 15)
+        } else {
+            self.words.get(b).map_or(NONE, |w| (w >> 8) & 15)
         }
     }
 
@@ -78,7 +107,7 @@ impl<'a> Route<'a> {
         for _ in 0..LOOKAHEAD {
             // Block coordinates are below 2^16: the index fits.
             let b = (by as usize).wrapping_mul(across).wrapping_add(bx as usize);
-            let next = self.words.get(b).map_or(NONE, |w| (w >> 8) & 15);
+            let next = self.next(b);
             if next >= NONE {
                 return self.goal;
             }
@@ -169,6 +198,31 @@ pub fn repair(
         *w = (*w & 0xFF) | (NONE << 8) | (UNREACHED << DIST_SHIFT);
     }
     dijkstra(blocks, blocks.block(goal), words, Heap { w: heap, len: 0 });
+    true
+}
+
+/// Words [`pack`] needs for a route of `count` blocks: four bits a block.
+pub const fn packed_words(count: usize) -> usize {
+    count.div_ceil(8)
+}
+
+/// Keep of [`build`]'s `words` only what the ants read, each block's next block (four bits a
+/// block, eight a word, block `b` in bits `4 (b % 8)` of word `b / 8`), in `out`: a route
+/// ([`Route::packed`]) in an eighth of the words, whose full words (and heap) were scratch
+/// (the compact arena builds them in its tabu bit set, idle before the first ant). The links
+/// and distances are gone: such a route is built again, never [`repair`]ed. Returns false if
+/// a buffer is too short.
+pub fn pack(blocks: Blocks, words: &[u32], out: &mut [u32]) -> bool {
+    let n = blocks.count();
+    let (Some(words), Some(out)) = (words.get(..n), out.get_mut(..packed_words(n))) else {
+        return false;
+    };
+    for (o, eight) in out.iter_mut().zip(words.chunks(8)) {
+        *o = eight
+            .iter()
+            .enumerate()
+            .fold(0, |acc, (k, w)| acc | ((w >> 8) & 15) << (4 * k as u32));
+    }
     true
 }
 
@@ -863,6 +917,49 @@ mod tests {
         assert_eq!(route.target(p), goal);
         // Next to the goal, the goal itself.
         assert_eq!(route.target(Point::new(101, 3)), goal);
+    }
+
+    #[test]
+    fn a_packed_route_pulls_where_its_words_do() {
+        // Random maps and goals: every cell's target is the same from the packed next blocks
+        // as from the words they were packed from, and a buffer one word short packs nothing.
+        let mut rng = crate::rng::Xoshiro128pp::from_u64(5);
+        let mut routed = 0;
+        for (w, h) in [(300u16, 200u16), (512, 64), (97, 131)] {
+            for _ in 0..3 {
+                let mut b = vec![0u8; (usize::from(w) * usize::from(h)).div_ceil(8)];
+                for byte in b.iter_mut() {
+                    for bit in 0..8 {
+                        if rng.next_unit() < 0.3 {
+                            *byte |= 1 << bit;
+                        }
+                    }
+                }
+                let g = Grid::new(w, h, &b).unwrap();
+                let blocks = blocks(w, h);
+                let moves = Moves::new(g, &[]);
+                let goal = Point::new(
+                    (rng.next_unit() * f32::from(w - 1)) as u16,
+                    (rng.next_unit() * f32::from(h - 1)) as u16,
+                );
+                let mut words = vec![0u32; GUIDE_BLOCKS];
+                let mut heap = vec![0u32; GUIDE_BLOCKS];
+                assert!(build(&moves, blocks, goal, &[], &mut words, &mut heap));
+                let mut nibbles = vec![0u32; packed_words(blocks.count())];
+                assert!(!pack(blocks, &words, &mut nibbles[1..]));
+                assert!(pack(blocks, &words, &mut nibbles));
+                let full = Route::new(blocks, &words, goal, w, h);
+                let packed = Route::packed(blocks, &nibbles, goal, w, h);
+                for y in 0..h {
+                    for x in 0..w {
+                        let p = Point::new(x, y);
+                        assert_eq!(packed.target(p), full.target(p), "{w}x{h} {p:?}");
+                        routed += usize::from(full.target(p) != goal);
+                    }
+                }
+            }
+        }
+        assert!(routed > 100_000, "{routed}");
     }
 
     #[test]

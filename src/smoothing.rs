@@ -140,6 +140,11 @@ impl Smoother {
         }
     }
 
+    /// Cells of the raw path it smooths.
+    pub fn cells(&self) -> usize {
+        self.n
+    }
+
     /// Advance the DP by at most `cells` raw cells; returns `true` while some remain.
     pub fn resume(
         &mut self,

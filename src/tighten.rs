@@ -232,6 +232,14 @@ pub const fn keyed_words(n: usize) -> usize {
     n.div_ceil(2)
 }
 
+/// Whether a [`keyed_words`] table holds paths of `n` cells on a map of `cells` cells: a cell
+/// index and a position fit 32 bits together.
+pub const fn keyed_fits(cells: usize, n: usize) -> bool {
+    let bits = usize::BITS - n.leading_zeros();
+    let cell_bits = usize::BITS - cells.saturating_sub(1).leading_zeros();
+    bits < 32 && bits + cell_bits <= 32
+}
+
 /// Where [`tighten`] finds a cell's position on the path.
 enum Index<'a> {
     /// Positions in `pos`, checked against the path laid out in these cells.
@@ -269,11 +277,10 @@ struct Keyed<'a> {
 
 impl<'a> Keyed<'a> {
     fn new(a: &'a mut [u32], cells: &'a mut [Point], map_cells: usize, n: usize) -> Option<Self> {
-        let bits = usize::BITS.wrapping_sub(n.leading_zeros());
-        let cell_bits = usize::BITS.wrapping_sub(map_cells.saturating_sub(1).leading_zeros());
-        if bits.saturating_add(cell_bits) > 32 || bits >= 32 {
+        if !keyed_fits(map_cells, n) {
             return None;
         }
+        let bits = usize::BITS.wrapping_sub(n.leading_zeros());
         let b: &mut [u32] = bytemuck::try_cast_slice_mut(cells).ok()?;
         let len = a.len().checked_add(b.len())?;
         if len < n.checked_add(n.div_ceil(2))? || u32::try_from(len).is_err() {

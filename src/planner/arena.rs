@@ -36,16 +36,25 @@ use crate::grid::{Dir, Point};
 use crate::pheromone::BLOCKS;
 use crate::route::GUIDE_BLOCKS;
 
-use super::run::REFINE_WORDS;
+use crate::route::packed_words;
+use crate::tighten::{hash_words, keyed_fits, keyed_words};
+
+use super::lend;
+use super::run::{REFINE_WORDS, SHORT_REFINE_WORDS};
 use super::workspace::{Buffers, Workspace};
 
 /// Most pheromone entries of the compact layout: 64 (on a 512 x 512 map, 64 blocks of 64 x 64
 /// cells). Measured: `BENCHMARKS.md`, section 1b, "Compact layout".
 pub const COMPACT_BLOCKS: usize = 64;
-/// Links of both layouts: tightening's hash table (`2 (steps + 1)` slots), the coarse route's
-/// heap, the flood fill's ring, the smoothing's links and one half of the local search's
+/// Links of the full layout: tightening's hash table (`2 (steps + 1)` slots), the coarse
+/// route's heap, the flood fill's ring, the smoothing's links and one half of the local search's
 /// scratch.
 pub const LINKS: usize = 4096;
+/// Longest path of the full layout: as many cells as its [`LINKS`] hold at a load of 1/2 in
+/// tightening's table (the buffers of the `Storage` the STM32F411 had, 2,047 steps). A larger
+/// step bound goes to the compact layout only, so a map that fits the full layout plans as it
+/// always did.
+pub const FULL_STEPS: usize = LINKS / 2 - 1;
 /// The fewest path steps a layout may leave: a map whose compact layout leaves fewer is too
 /// large for the arena.
 pub const MIN_STEPS: usize = 1023;
@@ -83,28 +92,44 @@ pub const fn compact_words(cells: usize, steps: usize) -> usize {
     words(cells)
         .saturating_mul(2)
         .saturating_add(COMPACT_BLOCKS.saturating_mul(8))
-        .saturating_add(GUIDE_BLOCKS)
+        .saturating_add(packed_words(GUIDE_BLOCKS))
         .saturating_add(compact_links(cells, steps))
         .saturating_add(path_words(steps))
 }
 
-/// Links of the compact layout: tightening's hash table (two 16-bit slots a word, at least
-/// `2 (steps + 1)` slots, a power of two: so at least the smoothing's `steps + 1` links too), and
-/// on a map whose tabu bit set is shorter than one slice of the local search's scratch
-/// (4,056 words, on maps of fewer than 129,792 cells), that slice.
+/// Links of the compact layout: the most any phase borrows beside the tabu set
+/// ([`super::lend`]): tightening's keyed table over the links and the path cells' words
+/// ([`keyed_words`]: `(steps + 1) / 2`; [`hash_words`] on maps too large for its keys), the
+/// smoothing's `steps + 1` links where the tabu set is shorter, the local search's two slices of
+/// [`REFINE_WORDS`] and the packed route's words and heap (a word a block) as far as the tabu
+/// set does not hold them.
 const fn compact_links(cells: usize, steps: usize) -> usize {
-    let hash = match steps
-        .saturating_add(1)
-        .saturating_mul(2)
-        .checked_next_power_of_two()
-    {
-        Some(slots) => slots / 2,
-        None => usize::MAX,
-    };
-    if words(cells) < REFINE_WORDS && hash < REFINE_WORDS {
-        REFINE_WORDS
+    let n = steps.saturating_add(1);
+    let w = words(cells);
+    let table = if keyed_fits(cells, n) {
+        keyed_words(n)
     } else {
-        hash
+        hash_words(n)
+    };
+    let blocks = if cells < GUIDE_BLOCKS {
+        cells
+    } else {
+        GUIDE_BLOCKS
+    };
+    max(
+        max(table, lend::smoothing_links(w, n)),
+        max(
+            lend::refine_links(w, REFINE_WORDS, SHORT_REFINE_WORDS),
+            lend::route_links(w, n, blocks),
+        ),
+    )
+}
+
+const fn max(a: usize, b: usize) -> usize {
+    if a > b {
+        a
+    } else {
+        b
     }
 }
 
@@ -119,50 +144,102 @@ const fn path_words(steps: usize) -> usize {
 /// many cells (a multiple of 32) has a layout leaving at least [`MIN_STEPS`] steps. 0 when not
 /// even the compact layout fits the arena (small maps may still get the full layout there).
 ///
-/// The compact layout's size grows with the map but for one step down: a map whose tabu bit set
-/// is shorter than one slice of the local search's scratch (4,056 words) needs that many links
-/// for it, a larger one lends its tabu set instead. So the largest map with a short tabu set must
-/// fit before the formula for larger ones applies.
+/// The compact layout's size grows with the map but for a few steps down: its links lend what a
+/// short tabu set cannot ([`super::lend`]), so a larger map may need fewer words than a smaller
+/// one. Between those steps its size grows two words per 32 cells; the capacity is where it first
+/// exceeds the arena.
 pub const fn capacity(arena: usize) -> usize {
-    let fixed = COMPACT_BLOCKS
-        .saturating_mul(8)
-        .saturating_add(GUIDE_BLOCKS)
-        .saturating_add(path_words(MIN_STEPS));
-    let small_links = compact_links(0, MIN_STEPS);
-    let large_links = compact_links(usize::MAX / 64, MIN_STEPS);
-    // Maps with a short tabu set: words(cells) < REFINE_WORDS.
-    let small = match arena.checked_sub(fixed.saturating_add(small_links)) {
-        Some(left) => left / 2,
-        None => return 0,
-    };
-    if small < REFINE_WORDS {
-        return small.saturating_mul(32);
+    // Tabu-set lengths at which the links' share changes, in increasing order (at the first
+    // of each, the share is the next piece's).
+    let n = MIN_STEPS + 1;
+    let mut cuts = [
+        REFINE_WORDS,
+        2 * REFINE_WORDS,
+        GUIDE_BLOCKS,
+        2 * GUIDE_BLOCKS,
+        n,
+        keyed_words(0), // 0: the first piece starts at an empty map
+    ];
+    // Sort (six entries).
+    let mut i = 0;
+    while i < cuts.len() {
+        let mut j = i + 1;
+        while j < cuts.len() {
+            if cuts[j] < cuts[i] {
+                let t = cuts[i];
+                cuts[i] = cuts[j];
+                cuts[j] = t;
+            }
+            j += 1;
+        }
+        i += 1;
     }
-    match arena.checked_sub(fixed.saturating_add(large_links)) {
-        Some(left) => (left / 2).saturating_mul(32),
-        None => REFINE_WORDS.saturating_sub(1).saturating_mul(32),
+    // Each piece [lo, hi) of tabu words: the layout's words grow with the map; find the first
+    // length that does not fit.
+    let mut k = 0;
+    while k < cuts.len() {
+        let lo = cuts[k];
+        let hi = if k + 1 < cuts.len() {
+            cuts[k + 1]
+        } else {
+            usize::MAX / 64
+        };
+        if hi > lo {
+            // The largest tabu length in [lo, hi) that fits, if the piece's last one does not.
+            let last = hi - 1;
+            if compact_words(last.saturating_mul(32), MIN_STEPS) > arena {
+                if compact_words(lo.saturating_mul(32), MIN_STEPS) > arena {
+                    return lo.saturating_sub(1).saturating_mul(32);
+                }
+                // Binary search: fits at `a`, not at `b`.
+                let (mut a, mut b) = (lo, last);
+                while b - a > 1 {
+                    let m = a + (b - a) / 2;
+                    if compact_words(m.saturating_mul(32), MIN_STEPS) <= arena {
+                        a = m;
+                    } else {
+                        b = m;
+                    }
+                }
+                return a.saturating_mul(32);
+            }
+        }
+        k += 1;
     }
+    (usize::MAX / 64).saturating_mul(32)
 }
 
 /// The longest path a map of `cells` cells gets in an arena of `arena` words with paths bounded
 /// to `max_steps`, and whether its layout is the compact one; `None`: the map is too large.
 pub const fn steps_for(arena: usize, cells: usize, max_steps: usize) -> Option<(usize, bool)> {
-    if full_words(cells, max_steps) <= arena {
-        return Some((max_steps, false));
-    }
-    // Each step costs at least a word: start at what that leaves, then step down (a few
-    // hundred steps at most on the F411's maps).
-    let Some(left) = arena.checked_sub(compact_words(cells, 0)) else {
-        return None;
+    let full = if max_steps < FULL_STEPS {
+        max_steps
+    } else {
+        FULL_STEPS
     };
-    let mut s = if left < max_steps { left } else { max_steps };
-    while s > 0 && compact_words(cells, s) > arena {
-        s = s.wrapping_sub(1); // s > 0
+    if full_words(cells, full) <= arena {
+        return Some((full, false));
     }
-    if s < MIN_STEPS && s < max_steps {
+    // The compact layout's size grows with the steps: the most that fit, by bisection.
+    if compact_words(cells, 0) > arena {
         return None;
     }
-    Some((s, true))
+    let (mut a, mut b) = (0usize, max_steps);
+    if compact_words(cells, b) <= arena {
+        a = b;
+    }
+    while b > a.saturating_add(1) {
+        let m = a + (b - a) / 2;
+        if compact_words(cells, m) <= arena {
+            a = m;
+        } else {
+            b = m;
+        }
+    }
+    if a < MIN_STEPS && a < max_steps {
+        return None;
+    }
+    Some((a, true))
 }
 
 /// Take the next `n` words of `rest`.
@@ -199,14 +276,20 @@ fn lay(mut rest: &mut [u32], cells: usize, steps: usize, compact: bool) -> Optio
     let w = words(cells);
     let map = take_as::<u8>(&mut rest, w.checked_mul(4)?)?;
     let tabu = take(&mut rest, w)?;
-    let (dead, blocks, links) = if compact {
-        (&mut [][..], COMPACT_BLOCKS, compact_links(cells, steps))
+    let (dead, blocks, links, guide) = if compact {
+        let guide = packed_words(GUIDE_BLOCKS);
+        (
+            &mut [][..],
+            COMPACT_BLOCKS,
+            compact_links(cells, steps),
+            guide,
+        )
     } else {
-        (take(&mut rest, w)?, cells.min(BLOCKS), LINKS)
+        (take(&mut rest, w)?, cells.min(BLOCKS), LINKS, GUIDE_BLOCKS)
     };
     let tau = take_as::<[f32; 4]>(&mut rest, blocks)?;
     let delta = take_as::<[f32; 4]>(&mut rest, blocks)?;
-    let guide = take(&mut rest, GUIDE_BLOCKS)?;
+    let guide = take(&mut rest, guide)?;
     let links = take(&mut rest, links)?;
     let points = take_as::<Point>(&mut rest, n)?;
     let tours = take_as::<Dir>(&mut rest, n.checked_mul(2)?)?;
@@ -216,20 +299,21 @@ fn lay(mut rest: &mut [u32], cells: usize, steps: usize, compact: bool) -> Optio
     } else {
         &mut []
     };
+    let ws = Workspace::new(Buffers {
+        tau,
+        delta,
+        tabu,
+        dead,
+        moves,
+        tours: [tour, &mut [], &mut [], best],
+        points,
+        links,
+        curve: &mut [],
+        guide,
+    });
     Some(Carved {
         map,
-        workspace: Workspace::new(Buffers {
-            tau,
-            delta,
-            tabu,
-            dead,
-            moves,
-            tours: [tour, &mut [], &mut [], best],
-            points,
-            links,
-            curve: &mut [],
-            guide,
-        }),
+        workspace: if compact { ws.with_packed_route() } else { ws },
         compact,
     })
 }

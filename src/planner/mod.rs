@@ -30,6 +30,7 @@
 //! and cancel a plan by dropping (or finishing) the run. [`plan`] runs it to the end.
 
 pub mod arena;
+mod lend;
 mod params;
 mod placed;
 mod plan;

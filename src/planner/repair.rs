@@ -42,7 +42,7 @@ use crate::smoothing::{Smoother, SmoothingKind};
 
 use super::params::{Algorithm, Params};
 use super::plan::{Origin, Plan};
-use super::run::REFINE_WORDS;
+use super::run::{REFINE_WORDS, SHORT_REFINE_WORDS};
 use super::warm::{Answer, Memory};
 use super::workspace::Workspace;
 
@@ -186,7 +186,7 @@ pub(super) fn repair<'a>(
         ..
     } = ws;
     let cap = points.len();
-    let (sa, sb) = Workspace::refine_scratch(links, guide, tabu, REFINE_WORDS)?;
+    let (sa, sb) = super::lend::refine(links, guide, tabu, REFINE_WORDS, SHORT_REFINE_WORDS)?;
     let mut scratch = Scratch::new(sa, sb);
     let room = cap.checked_sub(end)?;
     let tail = points.get_mut(end..)?;
@@ -260,7 +260,10 @@ pub(super) fn repair<'a>(
     let ks = {
         let dist = delta.as_flattened_mut();
         let input = points.get_mut(ns_at..)?;
-        Smoother::new(kind, ns, dist, links).finish(grid, input, dist, links)
+        {
+            let links = super::lend::smoothing(links, tabu, ns);
+            Smoother::new(kind, ns, dist, links).finish(grid, input, dist, links)
+        }
     };
     if ks < 2
         || points.get(ns_at) != Some(&li)

@@ -53,6 +53,9 @@ pub struct Workspace<'a> {
     pub(super) links: &'a mut [u32],
     pub(super) curve: &'a mut [CurvePoint],
     pub(super) guide: &'a mut [u32],
+    /// `guide` holds a packed route ([`crate::route::pack`]: four bits a block, built in scratch
+    /// the setup borrows, [`super::lend`]), not a word a block.
+    pub(super) packed_route: bool,
 }
 
 /// The caller's buffers, by name, for [`Workspace::new`].
@@ -132,6 +135,17 @@ impl<'a> Workspace<'a> {
             links: b.links,
             curve: b.curve,
             guide: b.guide,
+            packed_route: false,
+        }
+    }
+
+    /// The same workspace keeping its coarse route packed in `guide`, four bits a block
+    /// ([`crate::route::pack`]): [`GUIDE_BLOCKS`]` / 8` words for the finest route, its words
+    /// and heap built in the tabu set or the links before the first ant ([`super::lend`]).
+    pub fn with_packed_route(self) -> Self {
+        Workspace {
+            packed_route: true,
+            ..self
         }
     }
 
@@ -189,27 +203,6 @@ impl<'a> Workspace<'a> {
         .unwrap_or(0)
     }
 
-    /// The local search's scratch on large maps, two slices of `words` words, from buffers free
-    /// once the iterations are over: the links and the coarse route's words (every storage but a
-    /// compact one), else the tabu bit set in place of whichever is too short, or split in two
-    /// (a compact workspace, [`crate::planner::arena`]). `None`: not enough.
-    pub(super) fn refine_scratch<'x>(
-        links: &'x mut [u32],
-        guide: &'x mut [u32],
-        tabu: &'x mut [u32],
-        words: usize,
-    ) -> Option<(&'x mut [u32], &'x mut [u32])> {
-        match (links.len() >= words, guide.len() >= words) {
-            (true, true) => Some((links.get_mut(..words)?, guide.get_mut(..words)?)),
-            (true, false) => Some((links.get_mut(..words)?, tabu.get_mut(..words)?)),
-            (false, true) => Some((tabu.get_mut(..words)?, guide.get_mut(..words)?)),
-            (false, false) => {
-                let (a, b) = tabu.split_at_mut_checked(words)?;
-                Some((a, b.get_mut(..words)?))
-            }
-        }
-    }
-
     /// Cut every buffer to what a `cells`-cell map with pheromone layout `blocks` uses, or fail
     /// with [`Error::MapTooLarge`].
     pub(super) fn fit(self, cells: usize, blocks: Blocks) -> Result<Self, Error> {
@@ -240,6 +233,7 @@ impl<'a> Workspace<'a> {
             links,
             curve,
             guide,
+            packed_route,
         } = self;
         let (tau, _) = tau.split_at_mut(n.min(tau.len()));
         let (delta, _) = delta.split_at_mut(n.min(delta.len()));
@@ -262,6 +256,7 @@ impl<'a> Workspace<'a> {
             links,
             curve,
             guide,
+            packed_route,
         })
     }
 

@@ -190,16 +190,16 @@ impl Run<'_, '_> {
             points,
             links,
             guide,
+            packed_route,
             ..
         } = &mut self.ws;
         let moves = Moves::new(*self.grid, moves);
-        let route = Route::new(
-            self.guide_blocks,
-            guide,
-            self.goal,
-            self.grid.width(),
-            self.grid.height(),
-        );
+        let (width, height) = (self.grid.width(), self.grid.height());
+        let route = if *packed_route {
+            Route::packed(self.guide_blocks, guide, self.goal, width, height)
+        } else {
+            Route::new(self.guide_blocks, guide, self.goal, width, height)
+        };
         let tau = Table::new(self.blocks, tau);
         let mut delta = Table::new(self.blocks, delta);
         let mut ant = Ant {

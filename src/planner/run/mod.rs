@@ -19,7 +19,7 @@ mod polish;
 mod setup;
 
 pub use colony::REFINE_GAIN;
-pub(crate) use polish::REFINE_WORDS;
+pub(crate) use polish::{REFINE_WORDS, SHORT_REFINE_WORDS};
 
 use crate::error::{Endpoint, Error};
 use crate::geometry::{polyline_length, turns};
@@ -241,6 +241,8 @@ impl<'g, 'a> Run<'g, 'a> {
         }
         Moves::fill(grid, ws.moves);
         let guide_blocks = match ws.guide.len() {
+            // A packed route keeps four bits a block: the finest route in an eighth of the words.
+            _ if ws.packed_route => route::blocks(width, height),
             // A workspace with fewer route words than `GUIDE_BLOCKS` routes on larger blocks.
             n @ 1..route::GUIDE_BLOCKS => Blocks::with_budget(width, height, n),
             _ => route::blocks(width, height),
@@ -285,7 +287,14 @@ impl<'g, 'a> Run<'g, 'a> {
         // `Storage` with at least 4,096 links, and `HeapStorage`; on large maps like the coarse
         // route, on small ones from the links alone).
         let scratch = if blocks.shift() > 0 {
-            Workspace::refine_scratch(ws.links, ws.guide, ws.tabu, REFINE_WORDS).is_some()
+            super::lend::refine(
+                ws.links,
+                ws.guide,
+                ws.tabu,
+                REFINE_WORDS,
+                SHORT_REFINE_WORDS,
+            )
+            .is_some()
         } else {
             ws.links.len() >= SMALL_REFINE_LINKS
         };

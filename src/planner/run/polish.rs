@@ -14,7 +14,7 @@ use crate::planner::plan::RawPath;
 
 use super::colony::Best;
 use super::Run;
-use crate::planner::workspace::Workspace;
+use crate::planner::lend;
 
 /// Window side of the local search ([`Params::refine`]). Its scratch is the links and the coarse
 /// route's words, free after the last iteration: two slices of [`Scratch::words`]`(52)` = 4,056
@@ -23,6 +23,13 @@ use crate::planner::workspace::Workspace;
 /// AI maps (`refine_large` example): mean raw/opt8 1.0009 at 52, 1.0011 at 48, 1.0007 at 64.
 pub const REFINE_SIDE: usize = 52;
 pub(crate) const REFINE_WORDS: usize = Scratch::words(REFINE_SIDE);
+/// The smallest window side the local search takes on a large map when the workspace cannot
+/// lend two slices of [`REFINE_WORDS`] but its tabu set halved gives two of at least
+/// [`Scratch::words`]`(48)` (the compact arena on maps of 221,184 to 259,583 cells,
+/// [`crate::planner::arena`]): 48, measured at 1.0011 of the optimum against 1.0009 at 52
+/// (`REFINE_SIDE`).
+pub const SHORT_REFINE_SIDE: usize = 48;
+pub(crate) const SHORT_REFINE_WORDS: usize = Scratch::words(SHORT_REFINE_SIDE);
 const _: () = assert!(REFINE_WORDS <= GUIDE_BLOCKS);
 /// Window side of the local search on small maps (at most [`crate::pheromone::BLOCKS`] = 1,024
 /// cells, which have no coarse route to lend): 32, a window of 1,024 cells, as large as the map.
@@ -89,7 +96,7 @@ impl Run<'_, '_> {
                 // before the local search takes the route's words as scratch: in the last
                 // slots of the pheromone increments, which the smoothing leaves alone (it uses
                 // a ring of at most `LOOKBACK + 1` from the front).
-                if self.routed {
+                if self.routed && !ws.packed_route {
                     let dist = ws.delta.as_flattened_mut();
                     let n = route::stash_len(self.guide_blocks);
                     let room = dist.len().saturating_sub(LOOKBACK.wrapping_add(1));
@@ -109,7 +116,7 @@ impl Run<'_, '_> {
                         kind,
                         n,
                         ws.delta.as_flattened_mut(),
-                        ws.links,
+                        lend::smoothing(ws.links, ws.tabu, n),
                     )),
                 }
             }
@@ -117,8 +124,14 @@ impl Run<'_, '_> {
                 // Large maps: the links and the coarse route's words; small maps: two halves of
                 // the links (see `SMALL_REFINE_SIDE`).
                 let (a, b) = if self.blocks.shift() > 0 {
-                    Workspace::refine_scratch(ws.links, ws.guide, ws.tabu, REFINE_WORDS)
-                        .unwrap_or((&mut [], &mut []))
+                    lend::refine(
+                        ws.links,
+                        ws.guide,
+                        ws.tabu,
+                        REFINE_WORDS,
+                        SHORT_REFINE_WORDS,
+                    )
+                    .unwrap_or((&mut [], &mut []))
                 } else {
                     let (a, rest) = ws
                         .links
@@ -154,7 +167,7 @@ impl Run<'_, '_> {
                         kind,
                         n,
                         ws.delta.as_flattened_mut(),
-                        ws.links,
+                        lend::smoothing(ws.links, ws.tabu, n),
                     ))
                 } else {
                     Polish::Refine(r)
@@ -162,10 +175,11 @@ impl Run<'_, '_> {
             }
             Polish::Smooth(mut sm) => {
                 let dist = ws.delta.as_flattened_mut();
-                if sm.resume(grid, ws.points, dist, ws.links, SMOOTH_SLICE) {
+                let links = lend::smoothing(ws.links, ws.tabu, sm.cells());
+                if sm.resume(grid, ws.points, dist, links, SMOOTH_SLICE) {
                     Polish::Smooth(sm)
                 } else {
-                    let k = sm.finish(grid, ws.points, dist, ws.links);
+                    let k = sm.finish(grid, ws.points, dist, links);
                     let waypoints = if corridor {
                         crate::corridor::shortest(
                             grid,

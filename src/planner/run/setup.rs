@@ -7,6 +7,7 @@ use crate::grid::{Moves, Reach};
 use crate::prune::{self, prune};
 use crate::route;
 
+use super::super::lend;
 use super::{Area, Run, Setup};
 
 impl Run<'_, '_> {
@@ -76,37 +77,38 @@ impl Run<'_, '_> {
             Setup::Route => {
                 // Large maps: the potential field pulls along a coarse route (not for ACA, which
                 // has no attraction).
-                self.routed = self.blocks.shift() > 0 && p.algorithm.attracts() && {
-                    let moves = Moves::new(*grid, ws.moves);
-                    // The heap: the links, or the tabu bit set (free until the first ant) on a
-                    // compact workspace, whose links are fewer than the route's blocks.
-                    let heap = if ws.links.len() >= self.guide_blocks.count() {
-                        &mut *ws.links
+                let wanted = self.blocks.shift() > 0 && p.algorithm.attracts();
+                let (goal, blocks) = (self.goal, self.guide_blocks);
+                let moves = Moves::new(*grid, ws.moves);
+                self.routed = wanted
+                    && if ws.packed_route {
+                        // Built in words the tabu set or the links lend (idle until the first
+                        // ant), then packed into `guide`: built again each run, never repaired
+                        // (a packed route is kept only by workspaces without pruning marks).
+                        let points =
+                            bytemuck::try_cast_slice_mut(&mut *ws.points).unwrap_or_default();
+                        match lend::route(ws.tabu, points, ws.links, blocks.count()) {
+                            Some((words, heap)) => {
+                                route::build(&moves, blocks, goal, ws.dead, words, heap)
+                                    && route::pack(blocks, words, ws.guide)
+                            }
+                            None => false,
+                        }
                     } else {
-                        &mut *ws.tabu
+                        // The heap: the links, or the tabu bit set (free until the first ant).
+                        let heap = if ws.links.len() >= blocks.count() {
+                            &mut *ws.links
+                        } else {
+                            &mut *ws.tabu
+                        };
+                        if self.relinked && self.marks {
+                            // The last run's links, repaired where the map or the marks changed.
+                            let area = self.touched.map(Area::corners);
+                            route::repair(&moves, blocks, goal, ws.dead, ws.guide, heap, area)
+                        } else {
+                            route::build(&moves, blocks, goal, ws.dead, ws.guide, heap)
+                        }
                     };
-                    if self.relinked && self.marks {
-                        // The last run's links, repaired where the map or the marks changed.
-                        route::repair(
-                            &moves,
-                            self.guide_blocks,
-                            self.goal,
-                            ws.dead,
-                            ws.guide,
-                            heap,
-                            self.touched.map(Area::corners),
-                        )
-                    } else {
-                        route::build(
-                            &moves,
-                            self.guide_blocks,
-                            self.goal,
-                            ws.dead,
-                            ws.guide,
-                            heap,
-                        )
-                    }
-                };
                 crate::fmt::debug!("plan: {} cells pruned", self.pruned);
                 self.setup = Setup::Done;
             }

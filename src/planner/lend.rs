@@ -1,0 +1,166 @@
+//! What each phase of a run borrows from buffers that are idle at that point: the one place
+//! where a buffer takes a second role, so two phases never write the same words unknowingly.
+//!
+//! | phase | needs | lent from, in order of preference |
+//! | --- | --- | --- |
+//! | setup: the coarse route, full words (a [`route::Route::new`] workspace) | a heap of a word a block | the links, else the tabu bit set (free until the first ant) |
+//! | setup: the coarse route, packed ([`route::pack`], the compact arena) | the route's words and its heap, a word a block each | the tabu bit set halved, else the tabu set and the links, else the links halved |
+//! | colony: tightening ([`crate::tighten`]) | a cell -> position index | the links (a per-cell array or a hash table), else the links and the path cells' words together (packed keys) |
+//! | polish: the local search ([`crate::refine`]) | two slices of [`super::run::REFINE_WORDS`] | the links and the route's words, the links and the tabu set, the tabu set and the route's words, the tabu set halved, the links halved |
+//! | polish: the smoothing ([`crate::smoothing`]) | `n` links for its shortest-path rule (fewer: the greedy rule) | the links, else the tabu set (free after the last ant and the local search) |
+//! | a reused answer's repair ([`super::repair`]) | the local search's scratch, then the smoothing's links | as in the polish |
+//!
+//! Every choice depends only on the buffers' lengths (never on their contents or addresses), so
+//! a host that lays out a device's arena plans exactly what the device plans, and a choice made
+//! at the start of a phase is the same at each of its pieces. None of these buffers is kept
+//! between runs except the answer's (`best`, `points`) and the pheromone: the tabu set, the links
+//! and the route's words are scratch once the colony is done ([`super::Memory`] keeps nothing of
+//! them, or stashes what it keeps in the pheromone increments first).
+
+#[cfg(doc)]
+use crate::route;
+
+/// Two slices of `words` words from `a` and `b`: one of each, else both from `a`, else both
+/// from `b`; `None` if neither way fits.
+fn two<'x>(
+    a: &'x mut [u32],
+    b: &'x mut [u32],
+    words: usize,
+) -> Option<(&'x mut [u32], &'x mut [u32])> {
+    if a.len() >= words && b.len() >= words {
+        return Some((a.get_mut(..words)?, b.get_mut(..words)?));
+    }
+    let from = if a.len() >= words { a } else { b };
+    let (x, y) = from.split_at_mut_checked(words)?;
+    Some((x, y.get_mut(..words)?))
+}
+
+/// The local search's scratch after the last ant, two slices of `words` words (the table
+/// above), else the tabu set halved when each half holds at least `fewest` words (a smaller
+/// window, [`crate::refine::Scratch::side`]); `None`: not enough.
+pub(super) fn refine<'x>(
+    links: &'x mut [u32],
+    guide: &'x mut [u32],
+    tabu: &'x mut [u32],
+    words: usize,
+    fewest: usize,
+) -> Option<(&'x mut [u32], &'x mut [u32])> {
+    let fits = |a: usize, b: usize| {
+        a >= words && b >= words || a >= words.saturating_mul(2) || b >= words.saturating_mul(2)
+    };
+    match (links.len() >= words, guide.len() >= words) {
+        (true, true) => return Some((links.get_mut(..words)?, guide.get_mut(..words)?)),
+        (false, true) if tabu.len() >= words => {
+            return Some((tabu.get_mut(..words)?, guide.get_mut(..words)?))
+        }
+        _ if fits(links.len(), tabu.len()) => return two(links, tabu, words),
+        _ => {}
+    }
+    let half = tabu.len() / 2;
+    if half < fewest {
+        return None;
+    }
+    let (a, b) = tabu.split_at_mut_checked(half)?;
+    Some((a, b.get_mut(..half)?))
+}
+
+/// Words [`refine`] needs in the links beside a tabu set of `tabu` words (and a route of fewer
+/// than `words` words).
+pub(super) const fn refine_links(tabu: usize, words: usize, fewest: usize) -> usize {
+    if tabu >= words.saturating_mul(2) || tabu / 2 >= fewest {
+        0
+    } else if tabu >= words {
+        words
+    } else {
+        words.saturating_mul(2)
+    }
+}
+
+/// The words and the heap of a packed route of `count` blocks, built before the first ant (the
+/// table above), from the tabu set, the path cells' words (`points`, idle before the first ant)
+/// and the links; `None`: not enough.
+pub(super) fn route<'x>(
+    tabu: &'x mut [u32],
+    points: &'x mut [u32],
+    links: &'x mut [u32],
+    count: usize,
+) -> Option<(&'x mut [u32], &'x mut [u32])> {
+    let (t, p) = (tabu.len() >= count, points.len() >= count);
+    if tabu.len() >= count.checked_mul(2)? {
+        let (a, b) = tabu.split_at_mut_checked(count)?;
+        return Some((a, b.get_mut(..count)?));
+    }
+    match (t, p) {
+        (true, true) => Some((tabu.get_mut(..count)?, points.get_mut(..count)?)),
+        (true, false) => Some((tabu.get_mut(..count)?, links.get_mut(..count)?)),
+        (false, true) => Some((points.get_mut(..count)?, links.get_mut(..count)?)),
+        (false, false) => {
+            let (a, b) = links.split_at_mut_checked(count)?;
+            Some((a, b.get_mut(..count)?))
+        }
+    }
+}
+
+/// Words [`route`] needs in the links beside a tabu set of `tabu` words and `points` words of
+/// path cells for a route of `count` blocks.
+pub(super) const fn route_links(tabu: usize, points: usize, count: usize) -> usize {
+    let (t, p) = (tabu >= count, points >= count);
+    if tabu >= count.saturating_mul(2) || t && p {
+        0
+    } else if t || p {
+        count
+    } else {
+        count.saturating_mul(2)
+    }
+}
+
+/// The smoothing's links for a raw path of `n` cells: the links when they hold `n`, else the
+/// tabu set when it does, else the links (the greedy rule).
+pub(super) fn smoothing<'x>(links: &'x mut [u32], tabu: &'x mut [u32], n: usize) -> &'x mut [u32] {
+    if links.len() < n && tabu.len() >= n {
+        tabu
+    } else {
+        links
+    }
+}
+
+/// Words [`smoothing`] needs in the links beside a tabu set of `tabu` words for `n` cells.
+pub(super) const fn smoothing_links(tabu: usize, n: usize) -> usize {
+    if tabu >= n {
+        0
+    } else {
+        n
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_lending_fits_what_its_size_says() {
+        // For lengths around the boundaries, `route` and `refine` find their slices exactly
+        // when the sizes say the links suffice, and never return overlapping or short slices.
+        for tabu in [0usize, 10, 99, 100, 150, 199, 200, 500] {
+            for links in [0usize, 50, 99, 100, 199, 200, 300] {
+                let (mut t, mut l) = (vec![0u32; tabu], vec![0u32; links]);
+                let need = route_links(tabu, 0, 100);
+                let got = route(&mut t, &mut [], &mut l, 100);
+                assert_eq!(got.is_some(), links >= need, "tabu {tabu} links {links}");
+                if let Some((a, b)) = got {
+                    assert_eq!((a.len(), b.len()), (100, 100));
+                }
+                let mut g = vec![0u32; 7];
+                let got = refine(&mut l, &mut g, &mut t, 100, 60);
+                assert_eq!(
+                    got.is_some(),
+                    links >= refine_links(tabu, 100, 60),
+                    "{tabu} {links}"
+                );
+                let n = 120;
+                let s = smoothing(&mut l, &mut t, n).len();
+                assert_eq!(s >= n, links >= smoothing_links(tabu, n), "{tabu} {links}");
+            }
+        }
+    }
+}
