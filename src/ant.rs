@@ -64,7 +64,9 @@ pub struct Walk {
 pub enum Lost {
     /// [`DeadEnd::Die`]: the ant died at a dead end.
     Died,
-    /// The path grew longer than the tour buffer holds; the ant is dropped.
+    /// The path would grow longer than the tour buffer holds: a dying ant is dropped there; a
+    /// backtracking one takes each cell it cannot step into for that reason for a wall and ends
+    /// with this only when it found no way within the tour's length (nothing proved).
     Overflow,
     /// [`DeadEnd::Backtrack`]: the ant backed out of every branch to the start: the goal is not
     /// reachable (a proof, since pruned cells never disconnect the start from the goal).
@@ -158,6 +160,8 @@ impl Ant<'_, '_, '_> {
         let mut steps = 0usize;
         let mut moves = 0u32;
         let mut may_tighten = false;
+        // A cell was refused because the path would have outgrown the tour.
+        let mut clipped = false;
         bitmap::set(tabu, ci);
         // The sub-goal changes only when the ant enters another block.
         let mut block = usize::MAX;
@@ -256,7 +260,13 @@ impl Ant<'_, '_, '_> {
                 match self.dead_end {
                     DeadEnd::Die => return Err(Lost::Died),
                     DeadEnd::Backtrack => {
-                        steps = steps.checked_sub(1).ok_or(Lost::Exhausted)?;
+                        // Back at the start with nothing left: no path, unless the tour's
+                        // length cut some ways off (then nothing is proved).
+                        steps = steps.checked_sub(1).ok_or(if clipped {
+                            Lost::Overflow
+                        } else {
+                            Lost::Exhausted
+                        })?;
                         let back = opposite(tour.get(steps).copied().ok_or(Lost::Overflow)?);
                         ci = ci.wrapping_add_signed(
                             offsets.get(usize::from(back)).copied().unwrap_or(0),
@@ -271,7 +281,22 @@ impl Ant<'_, '_, '_> {
                 let k = roulette(rng, cand_w.get(..n).unwrap_or(&[]), total);
                 cand_dir.get(k).copied().unwrap_or(0)
             };
-            let slot = tour.get_mut(steps).ok_or(Lost::Overflow)?;
+            let Some(slot) = tour.get_mut(steps) else {
+                // The path would outgrow the tour. A dying ant is dropped; a backtracking one
+                // takes that cell for a wall (tabu for the rest of its walk) and goes on, so a
+                // long dead-end branch of a maze costs it the branch, not the walk. Not a move.
+                match self.dead_end {
+                    DeadEnd::Die => return Err(Lost::Overflow),
+                    DeadEnd::Backtrack => {
+                        let ni = ci
+                            .wrapping_add_signed(offsets.get(usize::from(d)).copied().unwrap_or(0));
+                        bitmap::set(tabu, ni);
+                        clipped = true;
+                        moves = moves.wrapping_sub(1); // counted above: at least 1
+                        continue;
+                    }
+                }
+            };
             *slot = d;
             steps = steps.wrapping_add(1); // < tour.len() + 1: the slot existed
             ci = ci.wrapping_add_signed(offsets.get(usize::from(d)).copied().unwrap_or(0));

@@ -493,4 +493,65 @@ mod tests {
         let ratio = ratio / f64::from(planned);
         assert!(ratio < 1.01, "{ratio}");
     }
+
+    /// A Moving AI map (`@`, `T`, `O`, `W` blocked) as the core's bits.
+    fn moving_ai(text: &str) -> (Vec<u8>, u16, u16) {
+        let mut lines = text.lines();
+        let (mut w, mut h) = (0u16, 0u16);
+        for l in lines.by_ref() {
+            if let Some(v) = l.strip_prefix("width ") {
+                w = v.trim().parse().unwrap();
+            } else if let Some(v) = l.strip_prefix("height ") {
+                h = v.trim().parse().unwrap();
+            } else if l.trim() == "map" {
+                break;
+            }
+        }
+        let mut b = vec![0u8; (usize::from(w) * usize::from(h)).div_ceil(8)];
+        for (y, row) in lines.take(usize::from(h)).enumerate() {
+            for (x, c) in row.bytes().take(usize::from(w)).enumerate() {
+                if matches!(c, b'@' | b'T' | b'O' | b'W') {
+                    let i = y * usize::from(w) + x;
+                    b[i / 8] |= 1 << (i % 8);
+                }
+            }
+        }
+        (b, w, h)
+    }
+
+    #[test]
+    fn the_f411s_arena_plans_a_4000_step_path_at_512_x_512() {
+        // `maze512-1-0` (Moving AI: 512 x 512, corridors one cell wide), the scenario from
+        // (40, 125) to (502, 437) whose optimum is 4,000 steps: in the STM32F411's arena the
+        // compact layout keeps paths of 4,095 steps, and the plan is that optimum. Before the
+        // packed route and the keyed table it kept 1,876: every ant was dropped.
+        let (bits, w, h) = moving_ai(include_str!("../../maps/large/maze512-1-0.map"));
+        let g = Grid::new(w, h, &bits).unwrap();
+        let board = crate::board::F411;
+        let mut arena = vec![0u32; ARENA];
+        let c = carve(&mut arena, g.cells(), board.max_steps).unwrap();
+        assert!(c.compact);
+        assert_eq!(c.workspace.steps(), 4095);
+        let (s, goal) = (Point::new(40, 125), Point::new(502, 437));
+        let p = Params::default();
+        let plan = plan(&g, s, goal, &p, c.workspace).unwrap();
+        let raw: Vec<Point> = plan.raw().collect();
+        assert_eq!((raw[0], *raw.last().unwrap()), (s, goal));
+        for (pair, &d) in raw.windows(2).zip(plan.directions()) {
+            assert_eq!(g.step(pair[0], d), Some(pair[1]));
+        }
+        assert_eq!(plan.directions().len(), 4000);
+        assert!(
+            (plan.raw_length - 4000.0).abs() < 1e-3,
+            "{}",
+            plan.raw_length
+        );
+        // With the bound of protocol 10's F411 (2,047 steps) no ant arrives.
+        let mut arena = vec![0u32; ARENA];
+        let c = carve(&mut arena, g.cells(), 2047).unwrap();
+        assert!(matches!(
+            crate::planner::plan(&g, s, goal, &p, c.workspace),
+            Err(crate::Error::PathTooLong { .. })
+        ));
+    }
 }
