@@ -1,4 +1,5 @@
-//! One plan as the device makes it (ant paths bounded to the STM32F411 firmware's 2,047 steps, or
+//! One plan as the device makes it (ant paths bounded to the STM32F411 firmware's 2,047 steps of its
+//! full layout, or
 //! `--steps N`, e.g. the STM32H743's 16384; no move table on maps of more than 1,024 cells; the
 //! iteration's best and worst ants walked again instead of kept), for profiling the core on the
 //! host with callgrind, whose instruction counts follow the device's: the phases are the
@@ -22,8 +23,9 @@ use ohaca::planner::Run;
 use ohaca::Params;
 use ohaca_host_tests::maps::Map;
 
-/// The firmware's `PLAN_STEPS` on the STM32F411 and the default QEMU board.
-const STEPS: usize = 2047;
+/// The STM32F411's bound in its full layout (maps of up to 68,256 cells; the compact one, beyond,
+/// keeps 4,095 steps in other buffers than these).
+const STEPS: usize = ohaca::planner::arena::FULL_STEPS;
 
 fn point(s: &str) -> Point {
     let (x, y) = s.split_once(',').expect("X,Y");

@@ -9,7 +9,7 @@
 //!
 //! `--steps N` bounds the ant paths as a device does; `--arena WORDS` plans in an arena of that
 //! many words laid out by `ohaca::planner::arena::carve` (the STM32F411's: 25856), paths bounded
-//! by `--steps` (default 2047).
+//! by `--steps` (default the STM32F411's bound, `ohaca::board::F411.max_steps`).
 //! ```
 //!
 //! For each map: the `N` (default 20) scenarios of largest `optimal` of its scenario file, the exact
@@ -95,7 +95,7 @@ fn main() {
             let t0 = Instant::now();
             let ws = match arena {
                 Some(_) => {
-                    let c = ohaca::planner::arena::carve(&mut words, cells, steps.unwrap_or(2047))
+                    let c = ohaca::planner::arena::carve(&mut words, cells, steps.unwrap_or(ohaca::board::F411.max_steps))
                         .expect("the map fits the arena");
                     c.workspace.with_curve(&mut curve)
                 }

@@ -4,8 +4,8 @@
 //!
 //! - **f411** (the STM32F411 and the default QEMU build): an arena of the board's length, laid
 //!   out per map by [`ohaca::planner::arena::carve`] (every buffer on maps of up to 68,256
-//!   cells, the compact layout beyond: no pruning, 64 pheromone blocks, 1,876 steps at
-//!   512 x 512).
+//!   cells and paths of up to 2,047 steps, the compact layout beyond: no pruning, 64 pheromone
+//!   blocks, a packed coarse route, paths of up to 4,095 steps on every map it takes).
 //! - **h743** (the STM32H743 and its QEMU twin): heap buffers of the board's shape: ant paths of
 //!   up to 16,384 steps, 16,384 links, the move table on maps of up to 1,024 cells, the
 //!   iteration's best and worst ants walked again.
@@ -221,7 +221,7 @@ mod tests {
         assert_eq!(
             differs_from_host(&F411, 604 * 307),
             Some(MapLayout {
-                steps: 2047,
+                steps: 4095,
                 compact: true
             })
         );

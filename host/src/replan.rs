@@ -191,7 +191,8 @@ pub trait Planner {
 /// The host core, planning as a board's firmware does ([`crate::board::BoardStorage`]), so its
 /// paths are the device's bit for bit. [`HostPlanner::new`] (`ohaca replan` and `ohaca ros
 /// --host` without `--board`) plans as the STM32F411 and the default QEMU firmware do (in an
-/// arena of its length laid out by `ohaca::planner::arena::carve`, its 2,047-step path bound),
+/// arena of its length laid out by `ohaca::planner::arena::carve`, its path bound: 2,047 steps
+/// in the full layout, 4,095 in the compact one),
 /// and on a map too large for that arena with heap storage and the same path bound;
 /// [`HostPlanner::on`] (`--board`) exactly as the board does, refusing maps it does not take.
 pub struct HostPlanner {

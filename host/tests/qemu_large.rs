@@ -24,7 +24,7 @@ use qemu::{assert_core_path, core_plan, have_qemu, longest_scenario, maps, Qemu}
 
 /// The F411's capacity (`ohaca::board::F411`).
 const CELLS: u32 = 262_144;
-const STEPS: u32 = 2047;
+const STEPS: u32 = 4095;
 
 #[test]
 fn the_f411_build_takes_262144_cells_and_refuses_more() {

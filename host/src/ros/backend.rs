@@ -304,7 +304,7 @@ mod tests {
         let cap = b.capacity().unwrap().unwrap();
         assert_eq!(
             (cap.cells, cap.max_side, cap.max_steps),
-            (262_144, 4096, 2047)
+            (262_144, 4096, 4095)
         );
         assert!(b.describe().contains("f411"));
         assert!(matches!(

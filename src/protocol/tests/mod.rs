@@ -172,7 +172,7 @@ fn hello() -> HelloReply<'static> {
         capacity: Capacity {
             cells: 262_144,
             max_side: 4096,
-            max_steps: 2047,
+            max_steps: 4095,
             max_chunk: MAX_CHUNK as u16,
             max_request: MAX_REQUEST as u16,
             plan_queue: 4,
