@@ -110,6 +110,21 @@ fn a_512x512_city_plans_at_full_resolution_bit_identical_to_the_host() {
     plans_as_the_host("NewYork_0_512", &map, start, goal, &[1, 2]);
 }
 
+/// `maze512-1-0` (512 x 512, corridors one cell wide): the scenario from (40, 125) to
+/// (502, 437), whose optimum is 4,000 steps, plans on the STM32F411 build (4,095-step paths in
+/// the compact layout; protocol 10's firmware kept 1,876 at 512 x 512 and answered
+/// `PathTooLong`), at that optimum and bit for bit as the host core plans it.
+#[test]
+fn a_4000_step_maze_path_plans_at_512x512_bit_identical_to_the_host() {
+    need_qemu!();
+    let map = Map::load(maps().join("large/maze512-1-0.map")).expect("maze512-1-0");
+    assert_eq!(map.cells(), CELLS as usize);
+    let (start, goal) = (Point::new(40, 125), Point::new(502, 437));
+    let host = core_plan(&map, start, goal, &Params::default()).expect("host plan");
+    assert_eq!(host.raw_cells, 4001, "the scenario's optimum: 4,000 steps");
+    plans_as_the_host("maze512-1-0", &map, start, goal, &[1]);
+}
+
 /// A 604 x 307 depot (the shape of Nav2's sample depot: racks in rows, pillars, noise), corner
 /// to corner, bit for bit as the host core plans it.
 #[test]
