@@ -6,7 +6,7 @@
 //!
 //! | board | [`Board`] | cells | ant path | layout |
 //! | --- | --- | ---: | ---: | --- |
-//! | STM32F411 (and the default QEMU build, which copies it) | [`F411`] | 262,144 | 2,047 (fewer above 258,048 cells: 1,876 at 512 x 512; the compact layout above 68,256) | one arena of 25,856 words, laid out per map by [`crate::planner::arena::carve`] |
+//! | STM32F411 (and the default QEMU build, which copies it) | [`F411`] | 262,144 | 4,095 (2,047 on maps of up to 68,256 cells, which get the full layout) | one arena of 25,856 words, laid out per map by [`crate::planner::arena::carve`] |
 //! | STM32H743 (and its QEMU twin, `twin-h743`) | [`H743`] | 2,097,152 | 16,384 | separate buffers over four RAM regions: every buffer for its largest map, 16,384 links, the move table on maps of up to 1,024 cells |
 //!
 //! The core's planner never names a board: [`crate::planner::arena`] takes an arena's length,
@@ -71,9 +71,10 @@ pub struct MapLayout {
 }
 
 /// The STM32F411 (128 KiB of RAM) and the default QEMU build: maps of up to 262,144 cells
-/// (512 x 512, or Nav2's 604 x 307 depot at 5 cm), ant paths of up to 2,047 steps, in one arena
+/// (512 x 512, or Nav2's 604 x 307 depot at 5 cm), ant paths of up to 4,095 steps, in one arena
 /// of 103,424 bytes (an 8 KiB map buffer and the 95,232-byte `Storage` it replaced): every
-/// buffer on maps of up to 68,256 cells, the compact layout beyond (1,876 steps at 512 x 512).
+/// buffer and paths of up to 2,047 steps ([`arena::FULL_STEPS`]) on maps of up to 68,256 cells,
+/// the compact layout beyond (4,095 steps on every map it takes, 512 x 512 included).
 pub const F411: Board = Board {
     name: "f411",
     cells: 262_144,

@@ -63,9 +63,10 @@ pub enum Error {
     /// died at a dead end (or the run was finished before its first iteration).
     NoAntArrived,
     /// The goal is reachable, but no ant reached it and some ants were dropped because their
-    /// paths grew longer than the workspace keeps (`Workspace::steps`; 2,047 steps on the
-    /// STM32F411 and the default QEMU board, 16,384 on the STM32H743): the way to the goal is
-    /// longer than that, or the ants wandered that far.
+    /// paths grew longer than the workspace keeps (`Workspace::steps`; 4,095 steps on the
+    /// STM32F411 and the default QEMU board, 2,047 on maps of up to 68,256 cells there, 16,384
+    /// on the STM32H743): the way to the goal is longer than that (backtracking ants found no way
+    /// within it), or the ants wandered that far.
     PathTooLong {
         /// Ants dropped over the run.
         ants: u32,

@@ -17,13 +17,14 @@ pub const MAX_SIDE: u16 = BOARD.max_side;
 pub const MAP_BYTES: usize = MAX_CELLS.div_ceil(8);
 /// Most cells of a map the planner plans on: every map the device holds, at full resolution.
 pub const PLAN_CELLS: usize = MAX_CELLS;
-/// Longest ant path the planner keeps, in steps (an ant whose path grows longer is dropped, and a
-/// plan no ant finishes that way is `Error PathTooLong`): the board's `BOARD`. A
-/// straight path across a 256 x 256 map has at most 255 steps, but a maze's or a long corridor's
-/// (4096 x 16) can be far longer: the longest scenario of `maps/large/maze-128-128-2` has 1,379
-/// steps (BENCHMARKS.md, section 4), within the 2,047 of the STM32F411 and the default QEMU
-/// board (the STM32H743 and its twin keep 16,384). On the small boards' maps of more than 68,256
-/// cells the arena leaves fewer (`ohaca::planner::arena::steps_for`: 1,876 at 512 x 512).
+/// Longest ant path the planner keeps, in steps (a backtracking ant takes a cell beyond it for a
+/// wall, a dying one is dropped, and a plan no ant finishes that way is `Error PathTooLong`): the
+/// board's `BOARD`. A straight path across a 256 x 256 map has at most 255 steps, but a maze's or
+/// a long corridor's (4096 x 16) can be far longer: the longest scenario of
+/// `maps/large/maze-128-128-2` has 1,379 steps (BENCHMARKS.md, section 4), one of `maze512-1-0`
+/// 4,000. The STM32F411 and the default QEMU board keep 4,095 (2,047 on maps of up to 68,256
+/// cells, which get the arena's full layout: `ohaca::planner::arena::steps_for`), the STM32H743
+/// and its twin 16,384.
 pub const PLAN_STEPS: usize = BOARD.max_steps;
 /// Bytes the board's receive buffer holds (the UART driver's ring, 1 KiB on every board): the
 /// request bytes a host may have outstanding (`Capacity::window_bytes`). Within them nothing is

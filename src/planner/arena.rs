@@ -10,18 +10,36 @@
 //!
 //! | layout | when | what | words at its largest map in an arena of 25,856 (the STM32F411's, [`crate::board::F411`]) |
 //! | --- | --- | --- | --- |
-//! | full | it fits (on the F411: maps of up to 65,536 cells) | the map, `tabu` and `dead` (1 bit a cell each), `tau` and `delta` ([`BLOCKS`] entries), the route's [`GUIDE_BLOCKS`] words, [`LINKS`] links, `steps + 1` path cells and two tours (the iteration's best and worst are walked again), the move table on maps of up to 1,024 cells | 25,856 (65,536 cells, 2,047 steps) |
-//! | compact | the full one does not fit | the map, `tabu`; **no pruning marks** (the run does not prune), pheromone on at most [`COMPACT_BLOCKS`] blocks, the same route, links for tightening's hash table (and, on maps of fewer than 129,792 cells, for one slice of the local search's scratch), as many path steps as the rest holds (at most the caller's bound) | 25,856 (262,144 cells, 1,876 steps) |
+//! | full | it fits with paths of up to [`FULL_STEPS`] (on the F411: maps of up to 68,256 cells) | the map, `tabu` and `dead` (1 bit a cell each), `tau` and `delta` ([`BLOCKS`] entries), the route's [`GUIDE_BLOCKS`] words, [`LINKS`] links, `steps + 1` path cells and two tours (the iteration's best and worst are walked again), the move table on maps of up to 1,024 cells | 25,856 (65,536 cells, 2,047 steps) |
+//! | compact | the full one does not fit | the map, `tabu`; **no pruning marks** (the run does not prune), pheromone on at most [`COMPACT_BLOCKS`] blocks, the same route **packed** to four bits a block (512 words, [`crate::route::pack`]), `steps + 1` path cells and two tours, and only the links no other buffer can lend ([`super::lend`]; 2,048 at 512 x 512): paths of up to the caller's bound | 25,600 (262,144 cells, 4,095 steps) |
 //!
 //! The full layout gives a run exactly the buffers of a fixed `Storage<{ words(65536) }, 2048,
 //! 4096, 1024, 0, 0>` (65,536 cells, 2,047-step paths), so its plans are that storage's bit for
-//! bit. The compact one plans like any workspace without pruning
-//! marks and with coarser pheromone blocks: the coarse route's heap and the local search's
-//! scratch come from the tabu bit set, which is free before the first ant and after the last.
-//! Why these and not other savings, measured on the 512 x 512 maps (`BENCHMARKS.md`, section 1b,
-//! "Compact layout"): the route's block size decides the quality (a route on 1,024 blocks instead
-//! of 4,096 took `NewYork_0_512` from 1.0019 to 1.0167 of the optimum), the pheromone's does not
-//! (64 blocks instead of 1,024: the same means), and pruning only saves moves.
+//! bit; it keeps [`FULL_STEPS`] whatever the caller's bound, so a larger bound changes no plan of
+//! a map it holds. The compact one plans like any workspace without pruning marks and with
+//! coarser pheromone blocks. Why these and not other savings, measured on the 512 x 512 maps
+//! (`BENCHMARKS.md`, section 1b, "Compact layout"): the route's block size decides the quality (a
+//! route on 1,024 blocks instead of 4,096 took `NewYork_0_512` from 1.0019 to 1.0167 of the
+//! optimum), the pheromone's does not (64 blocks instead of 1,024: the same means), and pruning
+//! only saves moves.
+//!
+//! **Where a compact run's words go, phase by phase** (the F411 at 512 x 512: the map 8,192, the
+//! tabu set 8,192, pheromone 512, route 512, path cells 4,096, tours 2,048, links 2,048, 256
+//! unused). Each step of a path costs a word and a half it keeps (a path cell, two tour bytes)
+//! and half a word of links; everything else a phase needs is lent by a buffer idle in that phase
+//! ([`super::lend`] has the whole table):
+//!
+//! | phase | what it uses beyond the map, pheromone and tours |
+//! | --- | --- |
+//! | setup | the coarse route's words and heap (a word a block each, 4,096 blocks): the tabu set halved, packed into the route's 512 words afterwards |
+//! | colony | the tabu set; tightening's table of packed (cell, position) keys over the links and the path cells' words: 6,144 slots for a path of 4,096 cells, a load of 2/3 ([`crate::tighten::keyed_words`]) |
+//! | polish | the path cells (the raw path, then the waypoints); the local search's two slices of 4,056 words from the tabu set halved (two of at least 3,456 on maps of 221,184 to 259,583 cells: windows of 48 to 51 cells a side); the smoothing's links from the tabu set |
+//! | between plans | the path cells and the best tour (the answer the firmware sends in parts, and a replan reuses) and the pheromone |
+//!
+//! Protocol 10's firmware had the route as a word a block and tightening's table of positions in
+//! the links beside laid-out path cells: 1,876 steps at 512 x 512, where `maze512-1-0`'s
+//! 4,000-step scenario got `PathTooLong` (the test
+//! `the_f411s_arena_plans_a_4000_step_path_at_512_x_512` plans it at its optimum now).
 //!
 //! Guarantees: the layout depends only on the arena's length, the map's cells and the step
 //! bound (a host that carves an arena of the device's length plans what the device plans); the

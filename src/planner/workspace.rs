@@ -27,7 +27,8 @@
 //! the route change only at the update), so the second walk is the first, bit for bit: the same
 //! increments, the same best path, the same plan (a test compares every algorithm and dead-end
 //! rule both ways). It costs two walks an iteration (about 4 % of an iteration's moves with 50
-//! ants) and saves two bytes a path step: on the STM32F411 that is what paths of 2,047 steps fit in.
+//! ants) and saves two bytes a path step: on the STM32F411 that is what paths of 2,047 steps fit in
+//! (its arena's full layout; the compact one keeps 4,095, [`super::arena`]).
 
 use crate::bitmap::words;
 use crate::error::Error;

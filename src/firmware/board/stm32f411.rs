@@ -11,7 +11,7 @@ use static_cell::ConstStaticCell;
 
 use super::Board;
 
-/// Maps of up to 262,144 cells, paths of up to 2,047 steps (fewer above 68,256 cells), in one
+/// Maps of up to 262,144 cells, paths of up to 4,095 steps (2,047 up to 68,256 cells), in one
 /// arena of 103,424 bytes: `ohaca::board::F411`.
 pub const BOARD: ohaca::board::Board = ohaca::board::F411;
 
