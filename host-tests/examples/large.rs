@@ -95,8 +95,12 @@ fn main() {
             let t0 = Instant::now();
             let ws = match arena {
                 Some(_) => {
-                    let c = ohaca::planner::arena::carve(&mut words, cells, steps.unwrap_or(ohaca::board::F411.max_steps))
-                        .expect("the map fits the arena");
+                    let c = ohaca::planner::arena::carve(
+                        &mut words,
+                        cells,
+                        steps.unwrap_or(ohaca::board::F411.max_steps),
+                    )
+                    .expect("the map fits the arena");
                     c.workspace.with_curve(&mut curve)
                 }
                 None => st.workspace(),

@@ -1,5 +1,20 @@
-//! What each phase of a run borrows from buffers that are idle at that point: the one place
-//! where a buffer takes a second role, so two phases never write the same words unknowingly.
+//! What each phase of a run borrows: one typed view of the workspace per phase, and the one
+//! place where a buffer idle in that phase takes a second role, so two phases never write the
+//! same words unknowingly.
+//!
+//! | view | phase | owns | borrows idle |
+//! | --- | --- | --- | --- |
+//! | [`Setting`] | setup (before the first ant) | the pruning marks, the coarse route ([`Guide`]) | [`Idle`]: the tabu set, the links, the path cells' words |
+//! | [`Colony`] | the iterations | the pheromone and its increments, the tabu set, the tours; reads the marks, the moves and the route | tightening's index: the path cells and the links |
+//! | [`Polishing`] | after the last iteration, and a reused answer's repair | the answer (best tour, path cells), the increments (distances, the route's stash) | [`Spent`]: the tabu set, the links, the route's words once stashed |
+//!
+//! Between plans a workspace keeps the pheromone, the answer (best tour and path cells, which
+//! the firmware sends in parts and a replan reuses, [`super::Placed`]) and, for a warm start,
+//! the pruning marks and the route's stashed links ([`super::Memory`]); everything else is
+//! scratch. The route's two forms are two variants of [`Guide`], so a packed route can be
+//! neither repaired nor stashed (there is no word a block to read), by type.
+//!
+//! Which buffer lends what:
 //!
 //! | phase | needs | lent from, in order of preference |
 //! | --- | --- | --- |
@@ -17,8 +32,241 @@
 //! and the route's words are scratch once the colony is done ([`super::Memory`] keeps nothing of
 //! them, or stashes what it keeps in the pheromone increments first).
 
+use crate::grid::{Dir, Point};
+use crate::pheromone::Blocks;
 #[cfg(doc)]
 use crate::route;
+use crate::route::Route;
+
+use super::workspace::Workspace;
+
+/// The coarse route's words, by what they hold: the role is in the type, not in a flag beside a
+/// slice.
+#[derive(Debug)]
+pub(super) enum Guide<'a> {
+    /// A word a block ([`route::build`]: links, next block, distance): a warm start repairs it.
+    Words(&'a mut [u32]),
+    /// Four bits a block, the next block only ([`route::pack`]): built again every run, its
+    /// words and heap lent by [`Idle::packed_route`].
+    Packed(&'a mut [u32]),
+}
+
+impl<'a> Guide<'a> {
+    /// Its words, whatever they hold.
+    pub(super) fn len(&self) -> usize {
+        match self {
+            Guide::Words(w) | Guide::Packed(w) => w.len(),
+        }
+    }
+
+    /// Four bits a block.
+    pub(super) fn is_packed(&self) -> bool {
+        matches!(self, Guide::Packed(_))
+    }
+
+    /// The same role over a shorter borrow.
+    pub(super) fn reborrow(&mut self) -> Guide<'_> {
+        match self {
+            Guide::Words(w) => Guide::Words(w),
+            Guide::Packed(w) => Guide::Packed(w),
+        }
+    }
+
+    /// Its words as scratch (after the colony, when no ant reads the route).
+    pub(super) fn scratch(self) -> &'a mut [u32] {
+        match self {
+            Guide::Words(w) | Guide::Packed(w) => w,
+        }
+    }
+
+    /// The route the ants read from it.
+    pub(super) fn route(&self, blocks: Blocks, goal: Point, width: u16, height: u16) -> Route<'_> {
+        match self {
+            Guide::Words(w) => Route::new(blocks, w, goal, width, height),
+            Guide::Packed(w) => Route::packed(blocks, w, goal, width, height),
+        }
+    }
+}
+
+/// What the setup borrows before the first ant: what it makes (the pruning marks, the coarse
+/// route) and the buffers idle until the first ant that it makes them with.
+pub(super) struct Setting<'w> {
+    /// The pruning marks it writes.
+    pub(super) dead: &'w mut [u32],
+    /// The move table (empty: computed on the fly).
+    pub(super) moves: &'w [u8],
+    /// The coarse route it writes.
+    pub(super) guide: Guide<'w>,
+    /// Idle until the first ant.
+    pub(super) idle: Idle<'w>,
+}
+
+/// The buffers idle before the first ant, lent to the setup by what it asks for.
+pub(super) struct Idle<'w> {
+    tabu: &'w mut [u32],
+    links: &'w mut [u32],
+    /// The path cells' words (empty when they are not word-aligned).
+    cells: &'w mut [u32],
+}
+
+impl Idle<'_> {
+    /// The flood fill's visited set and ring.
+    pub(super) fn reach(&mut self) -> (&mut [u32], &mut [u32]) {
+        (self.tabu, self.links)
+    }
+
+    /// The pruning's stack.
+    pub(super) fn prune_stack(&mut self) -> &mut [u32] {
+        self.links
+    }
+
+    /// A word-a-block route of `count` blocks: the words to write and the heap (the links if
+    /// they hold `count` words, else the tabu set); `None` for a packed route.
+    pub(super) fn route_words<'g>(
+        &'g mut self,
+        guide: &'g mut Guide<'_>,
+        count: usize,
+    ) -> Option<(&'g mut [u32], &'g mut [u32])> {
+        let Guide::Words(words) = guide else {
+            return None;
+        };
+        let heap = if self.links.len() >= count {
+            &mut *self.links
+        } else {
+            &mut *self.tabu
+        };
+        Some((words, heap))
+    }
+
+    /// A packed route of `count` blocks: the words and heap to build it in ([`route`], the table
+    /// above) and the words to pack it into; `None` for a word-a-block route or without room.
+    pub(super) fn packed_route<'g>(
+        &'g mut self,
+        guide: &'g mut Guide<'_>,
+        count: usize,
+    ) -> Option<((&'g mut [u32], &'g mut [u32]), &'g mut [u32])> {
+        let Guide::Packed(out) = guide else {
+            return None;
+        };
+        Some((route(self.tabu, self.cells, self.links, count)?, out))
+    }
+}
+
+/// What the colony's iterations borrow: every buffer an ant reads or writes.
+pub(super) struct Colony<'w> {
+    pub(super) tau: &'w mut [[f32; 4]],
+    pub(super) delta: &'w mut [[f32; 4]],
+    /// The ant's tabu set (and tightening's filter).
+    pub(super) tabu: &'w mut [u32],
+    pub(super) dead: &'w [u32],
+    pub(super) moves: &'w [u8],
+    /// The ant's path, the iteration's best and worst (empty: walked again), the run's best.
+    pub(super) tours: [&'w mut [Dir]; 4],
+    /// Tightening's index ([`crate::tighten::tighten`]): the path cells, then the links.
+    pub(super) index: (&'w mut [Point], &'w mut [u32]),
+    /// The coarse route the ants read.
+    pub(super) guide: &'w Guide<'w>,
+}
+
+/// What the work after the last iteration borrows (and a reused answer's repair): the answer it
+/// writes (the best tour, the path cells), the pheromone increments (the smoothing's distances,
+/// and the stash of the route's links for the next warm start), the route (stashed, then
+/// scratch) and the buffers idle after the last ant.
+pub(super) struct Polishing<'w> {
+    pub(super) best: &'w mut [Dir],
+    pub(super) points: &'w mut [Point],
+    pub(super) delta: &'w mut [[f32; 4]],
+    /// The route, to stash before its words become scratch.
+    pub(super) guide: Guide<'w>,
+    /// Idle after the last ant.
+    pub(super) idle: Spent<'w>,
+}
+
+/// The buffers idle after the last ant, lent to the polish by what it asks for.
+pub(super) struct Spent<'w> {
+    tabu: &'w mut [u32],
+    links: &'w mut [u32],
+}
+
+impl Spent<'_> {
+    /// The local search's two slices on a large map ([`refine`], the table above): the links,
+    /// the route's words (`guide`, stashed first if kept) and the tabu set.
+    pub(super) fn refine<'g>(
+        &'g mut self,
+        guide: &'g mut Guide<'_>,
+        words: usize,
+        fewest: usize,
+    ) -> Option<(&'g mut [u32], &'g mut [u32])> {
+        refine(
+            self.links,
+            guide.reborrow().scratch(),
+            self.tabu,
+            words,
+            fewest,
+        )
+    }
+
+    /// The local search's two slices on a small map: two slices of `words` of the links
+    /// (shorter when they do not hold both: the search then leaves the path as it is).
+    pub(super) fn halves_of_links(&mut self, words: usize) -> (&mut [u32], &mut [u32]) {
+        let (a, rest) = self.links.split_at_mut(words.min(self.links.len()));
+        (a, rest.get_mut(..words).unwrap_or_default())
+    }
+
+    /// The smoothing's links for a raw path of `n` cells ([`smoothing`]).
+    pub(super) fn smoothing(&mut self, n: usize) -> &mut [u32] {
+        smoothing(self.links, self.tabu, n)
+    }
+
+    /// The links (the corridor search's scratch on small maps).
+    pub(super) fn links(&mut self) -> &mut [u32] {
+        self.links
+    }
+}
+
+impl<'a> Workspace<'a> {
+    /// The setup's view.
+    pub(super) fn setting(&mut self) -> Setting<'_> {
+        Setting {
+            dead: self.dead,
+            moves: self.moves,
+            guide: self.guide.reborrow(),
+            idle: Idle {
+                tabu: self.tabu,
+                links: self.links,
+                cells: bytemuck::try_cast_slice_mut(&mut *self.points).unwrap_or_default(),
+            },
+        }
+    }
+
+    /// The colony's view.
+    pub(super) fn colony(&mut self) -> Colony<'_> {
+        Colony {
+            tau: self.tau,
+            delta: self.delta,
+            tabu: self.tabu,
+            dead: self.dead,
+            moves: self.moves,
+            tours: [self.tour, self.iter_best, self.iter_worst, self.best],
+            index: (self.points, self.links),
+            guide: &self.guide,
+        }
+    }
+
+    /// The polish's view (and a reused answer's repair's).
+    pub(super) fn polishing(&mut self) -> Polishing<'_> {
+        Polishing {
+            best: self.best,
+            points: self.points,
+            delta: self.delta,
+            guide: self.guide.reborrow(),
+            idle: Spent {
+                tabu: self.tabu,
+                links: self.links,
+            },
+        }
+    }
+}
 
 /// Two slices of `words` words from `a` and `b`: one of each, else both from `a`, else both
 /// from `b`; `None` if neither way fits.

@@ -40,6 +40,7 @@ use crate::pheromone::BLOCKS;
 use crate::refine::{self, Scratch};
 use crate::smoothing::{Smoother, SmoothingKind};
 
+use super::lend::Polishing;
 use super::params::{Algorithm, Params};
 use super::plan::{Origin, Plan};
 use super::run::{REFINE_WORDS, SHORT_REFINE_WORDS};
@@ -176,17 +177,16 @@ pub(super) fn repair<'a>(
     }
     let (li, lj) = (l_at(i)?, l_at(j)?);
     // 2. The detour, into the tail of `points` (free: the waypoints end at `end`).
-    let Workspace {
+    // The answer, the increments and the buffers idle between plans (`lend::Polishing`).
+    let Polishing {
         best,
         points,
-        links,
-        guide,
-        tabu,
         delta,
-        ..
-    } = ws;
+        mut guide,
+        mut idle,
+    } = ws.polishing();
     let cap = points.len();
-    let (sa, sb) = super::lend::refine(links, guide, tabu, REFINE_WORDS, SHORT_REFINE_WORDS)?;
+    let (sa, sb) = idle.refine(&mut guide, REFINE_WORDS, SHORT_REFINE_WORDS)?;
     let mut scratch = Scratch::new(sa, sb);
     let room = cap.checked_sub(end)?;
     let tail = points.get_mut(end..)?;
@@ -260,10 +260,8 @@ pub(super) fn repair<'a>(
     let ks = {
         let dist = delta.as_flattened_mut();
         let input = points.get_mut(ns_at..)?;
-        {
-            let links = super::lend::smoothing(links, tabu, ns);
-            Smoother::new(kind, ns, dist, links).finish(grid, input, dist, links)
-        }
+        let links = idle.smoothing(ns);
+        Smoother::new(kind, ns, dist, links).finish(grid, input, dist, links)
     };
     if ks < 2
         || points.get(ns_at) != Some(&li)

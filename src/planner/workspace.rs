@@ -36,6 +36,7 @@ use crate::grid::{Dir, Point};
 use crate::pheromone::{Blocks, BLOCKS};
 use crate::route::GUIDE_BLOCKS;
 
+use super::lend::Guide;
 use super::plan::CurvePoint;
 
 /// Every buffer a run needs, borrowed from the caller (see the module docs for the sizes).
@@ -53,10 +54,8 @@ pub struct Workspace<'a> {
     pub(super) points: &'a mut [Point],
     pub(super) links: &'a mut [u32],
     pub(super) curve: &'a mut [CurvePoint],
-    pub(super) guide: &'a mut [u32],
-    /// `guide` holds a packed route ([`crate::route::pack`]: four bits a block, built in scratch
-    /// the setup borrows, [`super::lend`]), not a word a block.
-    pub(super) packed_route: bool,
+    /// The coarse route: a word a block, or packed ([`Workspace::with_packed_route`]).
+    pub(super) guide: Guide<'a>,
 }
 
 /// The caller's buffers, by name, for [`Workspace::new`].
@@ -135,8 +134,7 @@ impl<'a> Workspace<'a> {
             points: b.points,
             links: b.links,
             curve: b.curve,
-            guide: b.guide,
-            packed_route: false,
+            guide: Guide::Words(b.guide),
         }
     }
 
@@ -144,10 +142,8 @@ impl<'a> Workspace<'a> {
     /// ([`crate::route::pack`]): [`GUIDE_BLOCKS`]` / 8` words for the finest route, its words
     /// and heap built in the tabu set or the links before the first ant ([`super::lend`]).
     pub fn with_packed_route(self) -> Self {
-        Workspace {
-            packed_route: true,
-            ..self
-        }
+        let guide = Guide::Packed(self.guide.scratch());
+        Workspace { guide, ..self }
     }
 
     /// The same workspace recording the convergence curve in `curve` (one entry an iteration;
@@ -234,7 +230,6 @@ impl<'a> Workspace<'a> {
             links,
             curve,
             guide,
-            packed_route,
         } = self;
         let (tau, _) = tau.split_at_mut(n.min(tau.len()));
         let (delta, _) = delta.split_at_mut(n.min(delta.len()));
@@ -257,7 +252,6 @@ impl<'a> Workspace<'a> {
             links,
             curve,
             guide,
-            packed_route,
         })
     }
 

@@ -8,12 +8,11 @@ use crate::geometry::steps_length;
 use crate::grid::{Dir, Moves, Point, Reach};
 use crate::pheromone::Table;
 use crate::rng::Xoshiro128pp;
-use crate::route::Route;
 use crate::tighten::tighten;
 use crate::update::{deposit, wolves, WolfPaths};
 
+use crate::planner::lend::Colony;
 use crate::planner::plan::CurvePoint;
-use crate::planner::workspace::Workspace;
 
 use super::Run;
 
@@ -177,29 +176,20 @@ impl Run<'_, '_> {
     /// the same increments and the same best path bit for bit (`docs/ALGORITHM.md`, "Memory").
     pub(super) fn walk_ants(&mut self, mut on_tour: impl FnMut(&[Dir])) -> Iteration {
         let p = self.params;
-        let Workspace {
+        // Every buffer an ant reads or writes (`lend::Colony`).
+        let Colony {
             tau,
             delta,
             tabu,
             dead,
             moves,
-            tour,
-            iter_best,
-            iter_worst,
-            best,
-            points,
-            links,
+            tours: [tour, iter_best, iter_worst, best],
+            index: (points, links),
             guide,
-            packed_route,
-            ..
-        } = &mut self.ws;
+        } = self.ws.colony();
         let moves = Moves::new(*self.grid, moves);
         let (width, height) = (self.grid.width(), self.grid.height());
-        let route = if *packed_route {
-            Route::packed(self.guide_blocks, guide, self.goal, width, height)
-        } else {
-            Route::new(self.guide_blocks, guide, self.goal, width, height)
-        };
+        let route = guide.route(self.guide_blocks, self.goal, width, height);
         let tau = Table::new(self.blocks, tau);
         let mut delta = Table::new(self.blocks, delta);
         let mut ant = Ant {
@@ -318,8 +308,8 @@ impl Run<'_, '_> {
                 it: &it,
                 steps: (b.steps, w.steps),
                 kept: (
-                    keep_best.then_some(&**iter_best),
-                    keep_worst.then_some(&**iter_worst),
+                    keep_best.then_some(&*iter_best),
+                    keep_worst.then_some(&*iter_worst),
                 ),
                 best,
                 tour,

@@ -30,13 +30,14 @@ use crate::rng::Xoshiro128pp;
 use crate::route;
 use crate::smoothing::SmoothingKind;
 
+use super::lend::Guide;
 use super::params::{Algorithm, Params};
 use super::plan::Origin;
 use super::plan::{CurvePoint, Plan};
 use super::warm::{self, Answer, Area, Kept, Memory};
 use super::workspace::Workspace;
 use colony::Best;
-use polish::{Polish, SMALL_REFINE_LINKS};
+use polish::{Polish, SMALL_REFINE_WORDS};
 
 /// A warm start whose changed cells' bounding box holds more than `1 / REBUILD_SHARE` of the
 /// map's cells prunes and routes from scratch instead of repairing the last run's marks and
@@ -230,7 +231,7 @@ impl<'g, 'a> Run<'g, 'a> {
         let cells = grid.cells();
         let (width, height) = (grid.width(), grid.height());
         let blocks = Blocks::with_budget(width, height, ws.pheromone_budget());
-        let ws = ws.fit(cells, blocks)?;
+        let mut ws = ws.fit(cells, blocks)?;
         for (p, e) in [(start, Endpoint::Start), (goal, Endpoint::Goal)] {
             if !grid.contains(p) {
                 return Err(Error::OutOfBounds(e));
@@ -242,7 +243,7 @@ impl<'g, 'a> Run<'g, 'a> {
         Moves::fill(grid, ws.moves);
         let guide_blocks = match ws.guide.len() {
             // A packed route keeps four bits a block: the finest route in an eighth of the words.
-            _ if ws.packed_route => route::blocks(width, height),
+            _ if ws.guide.is_packed() => route::blocks(width, height),
             // A workspace with fewer route words than `GUIDE_BLOCKS` routes on larger blocks.
             n @ 1..route::GUIDE_BLOCKS => Blocks::with_budget(width, height, n),
             _ => route::blocks(width, height),
@@ -271,32 +272,35 @@ impl<'g, 'a> Run<'g, 'a> {
             Some((changes, Some(kept))) if params.prune && local(changes) => Some((changes, kept)),
             _ => None,
         };
-        let relinked = reuse.is_some_and(|(_, k)| k.route) && {
-            let kept = ws.delta.as_flattened();
-            let n = route::stash_len(guide_blocks);
-            kept.len() >= n
-                && route::unstash(
-                    guide_blocks,
-                    kept.get(kept.len().wrapping_sub(n)..).unwrap_or_default(),
-                    ws.guide,
-                )
-        };
+        let relinked = reuse.is_some_and(|(_, k)| k.route)
+            && match &mut ws.guide {
+                Guide::Words(words) => {
+                    let kept = ws.delta.as_flattened();
+                    let n = route::stash_len(guide_blocks);
+                    kept.len() >= n
+                        && route::unstash(
+                            guide_blocks,
+                            kept.get(kept.len().wrapping_sub(n)..).unwrap_or_default(),
+                            words,
+                        )
+                }
+                // A packed route keeps no links.
+                Guide::Packed(_) => false,
+            };
         ws.delta.fill([0.0; 4]);
         let heuristic = Heuristic::new(goal, params.attraction(), params.beta);
         // The local search: OHACA on every map, when the workspace can lend its scratch (every
         // `Storage` with at least 4,096 links, and `HeapStorage`; on large maps like the coarse
         // route, on small ones from the links alone).
-        let scratch = if blocks.shift() > 0 {
-            super::lend::refine(
-                ws.links,
-                ws.guide,
-                ws.tabu,
-                REFINE_WORDS,
-                SHORT_REFINE_WORDS,
-            )
-            .is_some()
-        } else {
-            ws.links.len() >= SMALL_REFINE_LINKS
+        let scratch = {
+            let mut v = ws.polishing();
+            if blocks.shift() > 0 {
+                v.idle
+                    .refine(&mut v.guide, REFINE_WORDS, SHORT_REFINE_WORDS)
+                    .is_some()
+            } else {
+                v.idle.halves_of_links(SMALL_REFINE_WORDS).1.len() == SMALL_REFINE_WORDS
+            }
         };
         let refines = params.refine && params.algorithm == Algorithm::Ohaca && scratch;
         crate::fmt::debug!(

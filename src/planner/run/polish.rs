@@ -14,7 +14,7 @@ use crate::planner::plan::RawPath;
 
 use super::colony::Best;
 use super::Run;
-use crate::planner::lend;
+use crate::planner::lend::Guide;
 
 /// Window side of the local search ([`Params::refine`]). Its scratch is the links and the coarse
 /// route's words, free after the last iteration: two slices of [`Scratch::words`]`(52)` = 4,056
@@ -38,8 +38,6 @@ const _: () = assert!(REFINE_WORDS <= GUIDE_BLOCKS);
 /// [`GUIDE_BLOCKS`] have them; a smaller one keeps the colony's path, as before).
 pub const SMALL_REFINE_SIDE: usize = 32;
 pub(super) const SMALL_REFINE_WORDS: usize = Scratch::words(SMALL_REFINE_SIDE);
-/// Links a workspace needs for the local search on small maps.
-pub(super) const SMALL_REFINE_LINKS: usize = 2 * SMALL_REFINE_WORDS;
 /// Cells the local search expands between two yields of [`Run::polish_step`] (a window expands
 /// at most `REFINE_SIDE^2` = 2,704).
 const REFINE_SLICE: u64 = 8192;
@@ -75,7 +73,9 @@ impl Run<'_, '_> {
             return false;
         }
         let grid = self.grid;
-        let ws = &mut self.ws;
+        // The answer, the increments, the route and the buffers idle after the last ant
+        // (`lend::Polishing`).
+        let mut ws = self.ws.polishing();
         let kind = if self.params.algorithm == Algorithm::Ohaca {
             self.params.smoothing
         } else {
@@ -96,14 +96,14 @@ impl Run<'_, '_> {
                 // before the local search takes the route's words as scratch: in the last
                 // slots of the pheromone increments, which the smoothing leaves alone (it uses
                 // a ring of at most `LOOKBACK + 1` from the front).
-                if self.routed && !ws.packed_route {
+                if let (true, Guide::Words(words)) = (self.routed, &ws.guide) {
                     let dist = ws.delta.as_flattened_mut();
                     let n = route::stash_len(self.guide_blocks);
                     let room = dist.len().saturating_sub(LOOKBACK.wrapping_add(1));
                     self.stashed = n <= room && {
                         let at = dist.len().wrapping_sub(n);
                         let out = dist.get_mut(at..).unwrap_or_default();
-                        route::stash(self.guide_blocks, ws.guide, out)
+                        route::stash(self.guide_blocks, words, out)
                     };
                 }
                 let refiner = self
@@ -116,7 +116,7 @@ impl Run<'_, '_> {
                         kind,
                         n,
                         ws.delta.as_flattened_mut(),
-                        lend::smoothing(ws.links, ws.tabu, n),
+                        ws.idle.smoothing(n),
                     )),
                 }
             }
@@ -124,20 +124,11 @@ impl Run<'_, '_> {
                 // Large maps: the links and the coarse route's words; small maps: two halves of
                 // the links (see `SMALL_REFINE_SIDE`).
                 let (a, b) = if self.blocks.shift() > 0 {
-                    lend::refine(
-                        ws.links,
-                        ws.guide,
-                        ws.tabu,
-                        REFINE_WORDS,
-                        SHORT_REFINE_WORDS,
-                    )
-                    .unwrap_or((&mut [], &mut []))
+                    ws.idle
+                        .refine(&mut ws.guide, REFINE_WORDS, SHORT_REFINE_WORDS)
+                        .unwrap_or((&mut [], &mut []))
                 } else {
-                    let (a, rest) = ws
-                        .links
-                        .split_at_mut(SMALL_REFINE_WORDS.min(ws.links.len()));
-                    let b = rest.get_mut(..SMALL_REFINE_WORDS).unwrap_or_default();
-                    (a, b)
+                    ws.idle.halves_of_links(SMALL_REFINE_WORDS)
                 };
                 let mut budget = Budget::new(REFINE_SLICE);
                 if r.resume(grid, ws.points, &mut Scratch::new(a, b), &mut budget) {
@@ -167,7 +158,7 @@ impl Run<'_, '_> {
                         kind,
                         n,
                         ws.delta.as_flattened_mut(),
-                        lend::smoothing(ws.links, ws.tabu, n),
+                        ws.idle.smoothing(n),
                     ))
                 } else {
                     Polish::Refine(r)
@@ -175,7 +166,7 @@ impl Run<'_, '_> {
             }
             Polish::Smooth(mut sm) => {
                 let dist = ws.delta.as_flattened_mut();
-                let links = lend::smoothing(ws.links, ws.tabu, sm.cells());
+                let links = ws.idle.smoothing(sm.cells());
                 if sm.resume(grid, ws.points, dist, links, SMOOTH_SLICE) {
                     Polish::Smooth(sm)
                 } else {
@@ -187,7 +178,7 @@ impl Run<'_, '_> {
                             k,
                             crate::corridor::RADIUS,
                             ws.delta,
-                            ws.links,
+                            ws.idle.links(),
                         )
                     } else {
                         k

@@ -7,7 +7,6 @@ use crate::grid::{Moves, Reach};
 use crate::prune::{self, prune};
 use crate::route;
 
-use super::super::lend;
 use super::{Area, Run, Setup};
 
 impl Run<'_, '_> {
@@ -19,7 +18,8 @@ impl Run<'_, '_> {
     pub fn setup_step(&mut self) -> bool {
         let grid = self.grid;
         let p = &self.params;
-        let ws = &mut self.ws;
+        // What the setup owns and the buffers it borrows until the first ant (`lend::Setting`).
+        let mut ws = self.ws.setting();
         match self.setup {
             Setup::Reach => {
                 // Backtracking ants skip the flood fill, cold or warm: if the goal is cut off,
@@ -31,8 +31,9 @@ impl Run<'_, '_> {
                 // prove anything, still need it.
                 let proved_by_ants = p.dead_end == DeadEnd::Backtrack;
                 self.reach_checked = !proved_by_ants;
+                let (visited, ring) = ws.idle.reach();
                 if !proved_by_ants
-                    && grid.reachable(self.start, self.goal, ws.tabu, ws.links) == Reach::No
+                    && grid.reachable(self.start, self.goal, visited, ring) == Reach::No
                 {
                     self.no_path = true;
                     self.done = true;
@@ -55,7 +56,7 @@ impl Run<'_, '_> {
                                 (kept.start, self.start, self.goal),
                                 changes.map(Area::corners),
                                 ws.dead,
-                                ws.links,
+                                ws.idle.prune_stack(),
                             );
                             let touched = r.touched.map(|(min, max)| Area { min, max });
                             self.touched = match (touched, changes) {
@@ -66,7 +67,13 @@ impl Run<'_, '_> {
                             self.relinked &= !r.rebuilt;
                             r.pruned
                         }
-                        None => prune(&moves, self.start, self.goal, ws.dead, ws.links),
+                        None => prune(
+                            &moves,
+                            self.start,
+                            self.goal,
+                            ws.dead,
+                            ws.idle.prune_stack(),
+                        ),
                     }
                 } else {
                     crate::bitmap::clear(ws.dead, grid.cells());
@@ -80,33 +87,31 @@ impl Run<'_, '_> {
                 let wanted = self.blocks.shift() > 0 && p.algorithm.attracts();
                 let (goal, blocks) = (self.goal, self.guide_blocks);
                 let moves = Moves::new(*grid, ws.moves);
+                let count = blocks.count();
+                let (relink, area) = (self.relinked && self.marks, self.touched.map(Area::corners));
                 self.routed = wanted
-                    && if ws.packed_route {
-                        // Built in words the tabu set or the links lend (idle until the first
-                        // ant), then packed into `guide`: built again each run, never repaired
-                        // (a packed route is kept only by workspaces without pruning marks).
-                        let points =
-                            bytemuck::try_cast_slice_mut(&mut *ws.points).unwrap_or_default();
-                        match lend::route(ws.tabu, points, ws.links, blocks.count()) {
-                            Some((words, heap)) => {
+                    && if ws.guide.is_packed() {
+                        // Built in words the tabu set, the path cells or the links lend (idle
+                        // until the first ant), then packed: built again each run, never
+                        // repaired (a packed route is kept only by workspaces without pruning
+                        // marks).
+                        match ws.idle.packed_route(&mut ws.guide, count) {
+                            Some(((words, heap), out)) => {
                                 route::build(&moves, blocks, goal, ws.dead, words, heap)
-                                    && route::pack(blocks, words, ws.guide)
+                                    && route::pack(blocks, words, out)
                             }
                             None => false,
                         }
                     } else {
-                        // The heap: the links, or the tabu bit set (free until the first ant).
-                        let heap = if ws.links.len() >= blocks.count() {
-                            &mut *ws.links
-                        } else {
-                            &mut *ws.tabu
-                        };
-                        if self.relinked && self.marks {
+                        match ws.idle.route_words(&mut ws.guide, count) {
                             // The last run's links, repaired where the map or the marks changed.
-                            let area = self.touched.map(Area::corners);
-                            route::repair(&moves, blocks, goal, ws.dead, ws.guide, heap, area)
-                        } else {
-                            route::build(&moves, blocks, goal, ws.dead, ws.guide, heap)
+                            Some((words, heap)) if relink => {
+                                route::repair(&moves, blocks, goal, ws.dead, words, heap, area)
+                            }
+                            Some((words, heap)) => {
+                                route::build(&moves, blocks, goal, ws.dead, words, heap)
+                            }
+                            None => false,
                         }
                     };
                 crate::fmt::debug!("plan: {} cells pruned", self.pruned);
