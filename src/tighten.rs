@@ -226,7 +226,7 @@ pub const fn hash_words(n: usize) -> usize {
 
 /// The fewest words of `pos` with which [`tighten`] tightens every path of up to `n` cells on a
 /// map of up to 2^(32 - bits(n)) cells when `cells` lends its `n` words too: a table of packed
-/// (cell, position) keys over both ([`Keyed`]), of at least `3n / 2` slots. The compact arena
+/// (cell, position) keys over both (`Keyed`), of at least `3n / 2` slots. The compact arena
 /// ([`crate::planner::arena`]) sizes its links so: half the words of [`hash_words`].
 pub const fn keyed_words(n: usize) -> usize {
     n.div_ceil(2)

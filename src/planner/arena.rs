@@ -11,7 +11,7 @@
 //! | layout | when | what | words at its largest map in an arena of 25,856 (the STM32F411's, [`crate::board::F411`]) |
 //! | --- | --- | --- | --- |
 //! | full | it fits with paths of up to [`FULL_STEPS`] (on the F411: maps of up to 68,256 cells) | the map, `tabu` and `dead` (1 bit a cell each), `tau` and `delta` ([`BLOCKS`] entries), the route's [`GUIDE_BLOCKS`] words, [`LINKS`] links, `steps + 1` path cells and two tours (the iteration's best and worst are walked again), the move table on maps of up to 1,024 cells | 25,856 (65,536 cells, 2,047 steps) |
-//! | compact | the full one does not fit | the map, `tabu`; **no pruning marks** (the run does not prune), pheromone on at most [`COMPACT_BLOCKS`] blocks, the same route **packed** to four bits a block (512 words, [`crate::route::pack`]), `steps + 1` path cells and two tours, and only the links no other buffer can lend ([`super::lend`]; 2,048 at 512 x 512): paths of up to the caller's bound | 25,600 (262,144 cells, 4,095 steps) |
+//! | compact | the full one does not fit | the map, `tabu`; **no pruning marks** (the run does not prune), pheromone on at most [`COMPACT_BLOCKS`] blocks, the same route **packed** to four bits a block (512 words, [`crate::route::pack`]), `steps + 1` path cells and two tours, and only the links no other buffer can lend (`planner::lend`; 2,048 at 512 x 512): paths of up to the caller's bound | 25,600 (262,144 cells, 4,095 steps) |
 //!
 //! The full layout gives a run exactly the buffers of a fixed `Storage<{ words(65536) }, 2048,
 //! 4096, 1024, 0, 0>` (65,536 cells, 2,047-step paths), so its plans are that storage's bit for
@@ -27,7 +27,7 @@
 //! tabu set 8,192, pheromone 512, route 512, path cells 4,096, tours 2,048, links 2,048, 256
 //! unused). Each step of a path costs a word and a half it keeps (a path cell, two tour bytes)
 //! and half a word of links; everything else a phase needs is lent by a buffer idle in that phase
-//! ([`super::lend`] has the whole table):
+//! (`planner::lend` has the whole table):
 //!
 //! | phase | what it uses beyond the map, pheromone and tours |
 //! | --- | --- |
@@ -116,7 +116,7 @@ pub const fn compact_words(cells: usize, steps: usize) -> usize {
 }
 
 /// Links of the compact layout: the most any phase borrows beside the tabu set
-/// ([`super::lend`]): tightening's keyed table over the links and the path cells' words
+/// (`planner::lend`): tightening's keyed table over the links and the path cells' words
 /// ([`keyed_words`]: `(steps + 1) / 2`; [`hash_words`] on maps too large for its keys), the
 /// smoothing's `steps + 1` links where the tabu set is shorter, the local search's two slices of
 /// [`REFINE_WORDS`] and the packed route's words and heap (a word a block) as far as the tabu
@@ -163,7 +163,7 @@ const fn path_words(steps: usize) -> usize {
 /// even the compact layout fits the arena (small maps may still get the full layout there).
 ///
 /// The compact layout's size grows with the map but for a few steps down: its links lend what a
-/// short tabu set cannot ([`super::lend`]), so a larger map may need fewer words than a smaller
+/// short tabu set cannot (`planner::lend`), so a larger map may need fewer words than a smaller
 /// one. Between those steps its size grows two words per 32 cells; the capacity is where it first
 /// exceeds the arena.
 pub const fn capacity(arena: usize) -> usize {

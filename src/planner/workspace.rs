@@ -140,7 +140,7 @@ impl<'a> Workspace<'a> {
 
     /// The same workspace keeping its coarse route packed in `guide`, four bits a block
     /// ([`crate::route::pack`]): [`GUIDE_BLOCKS`]` / 8` words for the finest route, its words
-    /// and heap built in the tabu set or the links before the first ant ([`super::lend`]).
+    /// and heap built in the tabu set or the links before the first ant (`planner::lend`).
     pub fn with_packed_route(self) -> Self {
         let guide = Guide::Packed(self.guide.scratch());
         Workspace { guide, ..self }
