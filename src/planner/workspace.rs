@@ -13,7 +13,12 @@
 //! | `points` | `steps + 1` | 4 | the best path as cells, tightening scratch |
 //! | `links` | `cells`, or at least tightening's table ([`crate::tighten::hash_words`]`(steps + 1)`: `2 (steps + 1)` half-word slots at a load of 1/2, down to `3 (steps + 1) / 2` at 2/3; fewer leave walks untightened), `steps + 1` (the smoothing's shortest-path rule; fewer: its greedy rule) and [`GUIDE_BLOCKS`] | 4 | path positions (tightening), flood-fill ring, pruning stack, route heap, smoothing links |
 //! | `curve` | iterations recorded | 16 | the convergence curve |
-//! | `guide` | [`GUIDE_BLOCKS`] on maps of more than [`BLOCKS`] cells, else none | 4 | the coarse route ([`crate::route`]) |
+//! | `guide` | [`GUIDE_BLOCKS`] on maps of more than [`BLOCKS`] cells, else none; an eighth of that packed ([`Workspace::with_packed_route`]) | 4 | the coarse route ([`crate::route`]) |
+//!
+//! A buffer idle in a phase lends itself to another role there (the links above, the tabu set to
+//! the route's heap and the local search, the path cells to tightening's keyed table); each phase
+//! borrows the workspace through its own typed view, which decides that in one place
+//! (`planner::lend`: `Setting`, `Colony`, `Polishing`).
 //!
 //! So the colony's memory is a fixed budget (pheromone) plus what the longest ant path needs
 //! (`steps`), plus two bits a map cell. The map itself (one bit a cell) is the caller's.
