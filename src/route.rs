@@ -218,10 +218,9 @@ pub fn pack(blocks: Blocks, words: &[u32], out: &mut [u32]) -> bool {
         return false;
     };
     for (o, eight) in out.iter_mut().zip(words.chunks(8)) {
-        *o = eight
-            .iter()
-            .enumerate()
-            .fold(0, |acc, (k, w)| acc | ((w >> 8) & 15) << (4 * k as u32));
+        *o = eight.iter().enumerate().fold(0, |acc, (k, w)| {
+            acc | ((w >> 8) & 15).wrapping_shl((k as u32).wrapping_mul(4))
+        });
     }
     true
 }

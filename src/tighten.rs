@@ -235,9 +235,9 @@ pub const fn keyed_words(n: usize) -> usize {
 /// Whether a [`keyed_words`] table holds paths of `n` cells on a map of `cells` cells: a cell
 /// index and a position fit 32 bits together.
 pub const fn keyed_fits(cells: usize, n: usize) -> bool {
-    let bits = usize::BITS - n.leading_zeros();
-    let cell_bits = usize::BITS - cells.saturating_sub(1).leading_zeros();
-    bits < 32 && bits + cell_bits <= 32
+    let bits = usize::BITS.saturating_sub(n.leading_zeros());
+    let cell_bits = usize::BITS.saturating_sub(cells.saturating_sub(1).leading_zeros());
+    bits < 32 && bits.saturating_add(cell_bits) <= 32
 }
 
 /// Where [`tighten`] finds a cell's position on the path.

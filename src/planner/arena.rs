@@ -167,64 +167,68 @@ const fn path_words(steps: usize) -> usize {
 /// one. Between those steps its size grows two words per 32 cells; the capacity is where it first
 /// exceeds the arena.
 pub const fn capacity(arena: usize) -> usize {
-    // Tabu-set lengths at which the links' share changes, in increasing order (at the first
-    // of each, the share is the next piece's).
-    let n = MIN_STEPS + 1;
-    let mut cuts = [
+    // Tabu-set lengths go from piece to piece: [lo, next_cut(lo)).
+    let end = usize::MAX / 64;
+    let mut lo = 0usize;
+    while lo < end {
+        let hi = next_cut(lo);
+        // The largest tabu length in [lo, hi) that fits, when the piece's last one does not.
+        let last = hi.saturating_sub(1);
+        if !fits_compact(arena, last) {
+            if !fits_compact(arena, lo) {
+                return lo.saturating_sub(1).saturating_mul(32);
+            }
+            // Bisection: fits at `a`, not at `b`.
+            let (mut a, mut b) = (lo, last);
+            while b.saturating_sub(a) > 1 {
+                let m = a.saturating_add(b.saturating_sub(a) / 2);
+                if fits_compact(arena, m) {
+                    a = m;
+                } else {
+                    b = m;
+                }
+            }
+            return a.saturating_mul(32);
+        }
+        lo = hi;
+    }
+    end.saturating_mul(32)
+}
+
+/// Whether a map with a tabu set of `w` words fits the compact layout with [`MIN_STEPS`].
+const fn fits_compact(arena: usize, w: usize) -> bool {
+    compact_words(w.saturating_mul(32), MIN_STEPS) <= arena
+}
+
+/// The smallest tabu-set length above `x` at which the compact layout's links change (what the
+/// tabu set lends: the local search's slices, the route's words and heap, the smoothing's links).
+const fn next_cut(x: usize) -> usize {
+    let cuts = [
         REFINE_WORDS,
-        2 * REFINE_WORDS,
+        REFINE_WORDS.saturating_mul(2),
+        SHORT_REFINE_WORDS.saturating_mul(2),
         GUIDE_BLOCKS,
-        2 * GUIDE_BLOCKS,
-        n,
-        keyed_words(0), // 0: the first piece starts at an empty map
+        GUIDE_BLOCKS.saturating_mul(2),
+        MIN_STEPS.saturating_add(1),
     ];
-    // Sort (six entries).
-    let mut i = 0;
-    while i < cuts.len() {
-        let mut j = i + 1;
-        while j < cuts.len() {
-            if cuts[j] < cuts[i] {
-                let t = cuts[i];
-                cuts[i] = cuts[j];
-                cuts[j] = t;
-            }
-            j += 1;
-        }
-        i += 1;
+    let mut best = usize::MAX / 64;
+    // A const fn: the six candidates by hand.
+    let [a, b, c, d, e, f] = cuts;
+    best = min_above(best, a, x);
+    best = min_above(best, b, x);
+    best = min_above(best, c, x);
+    best = min_above(best, d, x);
+    best = min_above(best, e, x);
+    min_above(best, f, x)
+}
+
+/// `c` if it lies above `x` and below `best`, else `best`.
+const fn min_above(best: usize, c: usize, x: usize) -> usize {
+    if c > x && c < best {
+        c
+    } else {
+        best
     }
-    // Each piece [lo, hi) of tabu words: the layout's words grow with the map; find the first
-    // length that does not fit.
-    let mut k = 0;
-    while k < cuts.len() {
-        let lo = cuts[k];
-        let hi = if k + 1 < cuts.len() {
-            cuts[k + 1]
-        } else {
-            usize::MAX / 64
-        };
-        if hi > lo {
-            // The largest tabu length in [lo, hi) that fits, if the piece's last one does not.
-            let last = hi - 1;
-            if compact_words(last.saturating_mul(32), MIN_STEPS) > arena {
-                if compact_words(lo.saturating_mul(32), MIN_STEPS) > arena {
-                    return lo.saturating_sub(1).saturating_mul(32);
-                }
-                // Binary search: fits at `a`, not at `b`.
-                let (mut a, mut b) = (lo, last);
-                while b - a > 1 {
-                    let m = a + (b - a) / 2;
-                    if compact_words(m.saturating_mul(32), MIN_STEPS) <= arena {
-                        a = m;
-                    } else {
-                        b = m;
-                    }
-                }
-                return a.saturating_mul(32);
-            }
-        }
-        k += 1;
-    }
-    (usize::MAX / 64).saturating_mul(32)
 }
 
 /// The longest path a map of `cells` cells gets in an arena of `arena` words with paths bounded
@@ -247,7 +251,7 @@ pub const fn steps_for(arena: usize, cells: usize, max_steps: usize) -> Option<(
         a = b;
     }
     while b > a.saturating_add(1) {
-        let m = a + (b - a) / 2;
+        let m = a.saturating_add(b.saturating_sub(a) / 2);
         if compact_words(cells, m) <= arena {
             a = m;
         } else {

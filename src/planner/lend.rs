@@ -88,6 +88,9 @@ impl<'a> Guide<'a> {
     }
 }
 
+/// Two slices of scratch words.
+type Pair<'g> = (&'g mut [u32], &'g mut [u32]);
+
 /// What the setup borrows before the first ant: what it makes (the pruning marks, the coarse
 /// route) and the buffers idle until the first ant that it makes them with.
 pub(super) struct Setting<'w> {
@@ -144,7 +147,7 @@ impl Idle<'_> {
         &'g mut self,
         guide: &'g mut Guide<'_>,
         count: usize,
-    ) -> Option<((&'g mut [u32], &'g mut [u32]), &'g mut [u32])> {
+    ) -> Option<(Pair<'g>, &'g mut [u32])> {
         let Guide::Packed(out) = guide else {
             return None;
         };
