@@ -14,7 +14,8 @@ map's bytes in the device's one map buffer, the bytes a raw upload's frames put 
 their time at 115200 8N1, the iterations, the instructions of the plan
 (from `Run::new` to the smoothed path; `Path.ticks`), its split (with defmt-print), and the raw
 length against the `.scen` optimum. A plan that fails shows its error (a path longer than the
-2,047 steps the device keeps, 16,384 on the twin, is `PathTooLong`). A map beyond the device's
+4,095 steps the device keeps (2,047 on maps of up to 68,256 cells), 16,384 on the twin, is
+`PathTooLong`). A map beyond the device's
 capacity (Hello's `cells`) is uploaded all the same: its row shows the device's refusal and what
 the map would need.
 The planner's storage does not grow with the map (`BENCHMARKS.md` section 5).
@@ -52,6 +53,9 @@ MAPS = [
     ("128 x 128", "maps/large/maze-128-128-2.map", "maps/large/maze-128-128-2-random-1.scen"),
     ("256 x 256", "maps/large/Boston_0_256.map", "maps/large/Boston_0_256-random-1.scen"),
     ("512 x 512", "maps/large/NewYork_0_512.map", "maps/large/NewYork_0_512.map.scen"),
+    # A 4,000-step way at 512 x 512 (issue 29, item 4): maze512-1-0's scenario whose optimum is
+    # 4,000, within the F411's 4,095-step paths (its longest, 4,847, is beyond them).
+    ("512 x 512", "maps/large/maze512-1-0.map", ((40, 125), (502, 437), 4000.0)),
     ("1024 x 1024", "maps/large/Sydney_0_1024.map", "maps/large/Sydney_0_1024.map.scen"),
     # Nav2's sample depot (host/assets/ros/, Apache-2.0) at its native 5 cm: a fixed far pair,
     # just inside the outer walls' top-left and bottom-right corners.
