@@ -81,17 +81,6 @@ impl<'a> Route<'a> {
         }
     }
 
-    /// The next block's direction from block `b` (`NONE`: the goal's block or no route).
-    #[inline]
-    fn next(&self, b: usize) -> u32 {
-        if self.packed {
-            let shift = ((b & 7) as u32).wrapping_mul(4);
-            self.words.get(b >> 3).map_or(NONE, |w| (w >> shift) & 15)
-        } else {
-            self.words.get(b).map_or(NONE, |w| (w >> 8) & 15)
-        }
-    }
-
     /// The block of cell `p`.
     #[inline]
     pub fn block(&self, p: Point) -> usize {
@@ -101,13 +90,28 @@ impl<'a> Route<'a> {
     /// The point the potential field pulls towards from cell `p`.
     #[inline]
     pub fn target(&self, p: Point) -> Point {
+        // One branch a call, outside the look-ahead: each form reads its words with constants.
+        if self.packed {
+            self.target_by(p, |b| {
+                let shift = ((b & 7) as u32).wrapping_mul(4);
+                self.words.get(b >> 3).map_or(NONE, |w| (w >> shift) & 15)
+            })
+        } else {
+            self.target_by(p, |b| self.words.get(b).map_or(NONE, |w| (w >> 8) & 15))
+        }
+    }
+
+    /// [`Route::target`] with `next(b)`: block `b`'s next block's direction (`NONE`: the goal's
+    /// block or no route).
+    #[inline(always)]
+    fn target_by(&self, p: Point, next: impl Fn(usize) -> u32) -> Point {
         let s = self.blocks.shift();
         let (mut bx, mut by) = (i32::from(p.x >> s), i32::from(p.y >> s));
         let across = self.blocks.across();
         for _ in 0..LOOKAHEAD {
             // Block coordinates are below 2^16: the index fits.
             let b = (by as usize).wrapping_mul(across).wrapping_add(bx as usize);
-            let next = self.next(b);
+            let next = next(b);
             if next >= NONE {
                 return self.goal;
             }

@@ -123,13 +123,15 @@ pub fn tighten(
         }
         // The path's cells before and after this one are known without a look-up: `tour[i]` is
         // the step out of this cell and `tour[i - 1]` the step into it (see above).
+        // (Index arithmetic: both are cells of the map, one move from this one.)
+        let step = |d: Dir| offsets.get(usize::from(d & 7)).copied().unwrap_or(0);
         let prev = match i.checked_sub(1).and_then(|k| tour.get(k)) {
-            Some(&d) => grid.index(neighbour(cp, opposite(d))),
+            Some(&d) => ci.wrapping_add_signed(step(d).wrapping_neg()),
             None => usize::MAX,
         };
         let next = tour
             .get(i)
-            .map_or(usize::MAX, |&d| grid.index(neighbour(cp, d)));
+            .map_or(usize::MAX, |&d| ci.wrapping_add_signed(step(d)));
         let mut mask = moves.at(ci, cp);
         // Furthest later path cell one allowed move away (the next cell always qualifies).
         let mut best = (i, 0u8);
