@@ -59,6 +59,9 @@ pub struct Walk {
     pub may_tighten: bool,
 }
 
+/// What the tour's last slot holds until the path fills the tour (no direction is 255).
+const UNFILLED: Dir = 0xFF;
+
 /// Why a walk ended without reaching the goal.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Lost {
@@ -160,8 +163,12 @@ impl Ant<'_, '_, '_> {
         let mut steps = 0usize;
         let mut moves = 0u32;
         let mut may_tighten = false;
-        // A cell was refused because the path would have outgrown the tour.
-        let mut clipped = false;
+        // The tour's last slot, unwritten until the path fills the tour: only then can a cell be
+        // refused for the tour's length (below), and a walk that backs out of everything proves
+        // nothing. A mark in the buffer, not a flag in the loop: the loop keeps its registers.
+        if let Some(last) = tour.last_mut() {
+            *last = UNFILLED;
+        }
         bitmap::set(tabu, ci);
         // The sub-goal changes only when the ant enters another block.
         let mut block = usize::MAX;
@@ -260,13 +267,18 @@ impl Ant<'_, '_, '_> {
                 match self.dead_end {
                     DeadEnd::Die => return Err(Lost::Died),
                     DeadEnd::Backtrack => {
-                        // Back at the start with nothing left: no path, unless the tour's
-                        // length cut some ways off (then nothing is proved).
-                        steps = steps.checked_sub(1).ok_or(if clipped {
-                            Lost::Overflow
-                        } else {
-                            Lost::Exhausted
-                        })?;
+                        // Back at the start with nothing left: no path, unless the path once
+                        // filled the tour, when its length may have cut ways off (then nothing
+                        // is proved; the colony's flood fill decides).
+                        let Some(s) = steps.checked_sub(1) else {
+                            let filled = tour.last().is_none_or(|&d| d != UNFILLED);
+                            return Err(if filled {
+                                Lost::Overflow
+                            } else {
+                                Lost::Exhausted
+                            });
+                        };
+                        steps = s;
                         let back = opposite(tour.get(steps).copied().ok_or(Lost::Overflow)?);
                         ci = ci.wrapping_add_signed(
                             offsets.get(usize::from(back)).copied().unwrap_or(0),
@@ -291,7 +303,6 @@ impl Ant<'_, '_, '_> {
                         let ni = ci
                             .wrapping_add_signed(offsets.get(usize::from(d)).copied().unwrap_or(0));
                         bitmap::set(tabu, ni);
-                        clipped = true;
                         moves = moves.wrapping_sub(1); // counted above: at least 1
                         continue;
                     }

@@ -90,15 +90,20 @@ impl<'a> Route<'a> {
     /// The point the potential field pulls towards from cell `p`.
     #[inline]
     pub fn target(&self, p: Point) -> Point {
-        // One branch a call, outside the look-ahead: each form reads its words with constants.
         if self.packed {
-            self.target_by(p, |b| {
-                let shift = ((b & 7) as u32).wrapping_mul(4);
-                self.words.get(b >> 3).map_or(NONE, |w| (w >> shift) & 15)
-            })
-        } else {
-            self.target_by(p, |b| self.words.get(b).map_or(NONE, |w| (w >> 8) & 15))
+            // Out of line: the word-a-block form below stays as the ants' loop inlines it.
+            return self.target_packed(p);
         }
+        self.target_by(p, |b| self.words.get(b).map_or(NONE, |w| (w >> 8) & 15))
+    }
+
+    /// [`Route::target`] on a [`pack`]ed route.
+    #[inline(never)]
+    fn target_packed(&self, p: Point) -> Point {
+        self.target_by(p, |b| {
+            let shift = ((b & 7) as u32).wrapping_mul(4);
+            self.words.get(b >> 3).map_or(NONE, |w| (w >> shift) & 15)
+        })
     }
 
     /// [`Route::target`] with `next(b)`: block `b`'s next block's direction (`NONE`: the goal's
