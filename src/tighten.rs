@@ -572,37 +572,45 @@ mod tests {
         (out, t[..out.steps].to_vec())
     }
 
+    /// Every wandering walk of `seeds` on each map size, with `run(links)`: it tightened with
+    /// that many words of index.
+    fn each_walk(
+        sizes: &[(u16, u16)],
+        seeds: core::ops::Range<u64>,
+        mut f: impl FnMut((u16, u16, u64), &Wandering, &dyn Fn(usize) -> (Walk, Vec<Dir>)),
+    ) {
+        for &(w, h) in sizes {
+            for seed in seeds.clone() {
+                let Some(wd) = wandering_walk(w, h, seed) else {
+                    continue;
+                };
+                let run =
+                    |links: usize| tightened((w, h, &wd.bits), wd.walk, &wd.tour, &wd.tabu, links);
+                f((w, h, seed), &wd, &run);
+            }
+        }
+    }
+
     #[test]
     fn the_hash_tables_tighten_as_the_per_cell_index_does() {
         // Wandering walks on a 48 x 40 map; each is tightened with a per-cell index, with the
         // smallest hash table of 16-bit slots (half a word a slot) of a load factor of 1/2, and
-        // with one word too few (the walk comes back untightened, or tightened alike in the
-        // table half the size when that holds it).
+        // with one word too few (tightened alike in the table half the size when that holds it,
+        // else by the keyed table over the links and the cells' words), and with too few words
+        // even for that (the walk comes back untightened).
         let (w, h) = (48u16, 40u16);
         let mut changed = 0;
-        for seed in 0..40u64 {
-            let Some(Wandering {
-                bits,
-                walk,
-                tour,
-                tabu,
-            }) = wandering_walk(w, h, seed)
-            else {
-                continue;
-            };
+        each_walk(&[(w, h)], 0..40, |(_, _, seed), wd, run| {
+            let (walk, tour) = (wd.walk, &wd.tour);
             let n = walk.steps + 1;
-            let run = |links: usize| tightened((w, h, &bits), walk, &tour, &tabu, links);
             let cells = usize::from(w) * usize::from(h);
             let words = (2 * n).next_power_of_two() / 2;
             if words >= cells {
                 // As many words as cells: the per-cell index, no hash table to test.
-                continue;
+                return;
             }
             let direct = run(cells);
             assert_eq!(run(words), direct, "seed {seed}");
-            // One word too few for a load factor of 1/2: the table half its size if that keeps
-            // the load factor at most 2/3 (the next test), else the keyed table over the links
-            // and the cells' words; with fewer words than that, the walk comes back untightened.
             if words < n + n.div_ceil(2) {
                 assert_eq!(hash_words(n), words, "seed {seed}");
             } else {
@@ -613,7 +621,7 @@ mod tests {
             let (short, path) = run(keyed_words(n) - 1);
             assert_eq!((short, path.as_slice()), (walk, &tour[..walk.steps]));
             changed += usize::from(direct.0.steps < walk.steps);
-        }
+        });
         assert!(changed >= 10, "{changed}");
     }
 
@@ -624,32 +632,21 @@ mod tests {
         // below: with the words of that smaller table, each walk is tightened exactly as with the
         // per-cell index; with one word fewer, as the keyed table over links and cells does it.
         let (mut smaller, mut shortened) = (0, 0);
-        for (w, h) in [(48u16, 40u16), (64, 24), (30, 30), (80, 60)] {
-            for seed in 0..40u64 {
-                let Some(Wandering {
-                    bits,
-                    walk,
-                    tour,
-                    tabu,
-                }) = wandering_walk(w, h, seed)
-                else {
-                    continue;
-                };
-                let n = walk.steps + 1;
-                let slots = (2 * n).next_power_of_two() / 2;
-                if slots < n + n.div_ceil(2) {
-                    continue;
-                }
-                let run = |links: usize| tightened((w, h, &bits), walk, &tour, &tabu, links);
-                let words = slots / 2;
-                assert_eq!(hash_words(n), words);
-                let direct = run(usize::from(w) * usize::from(h));
-                assert_eq!(run(words), direct, "{w}x{h} seed {seed}");
-                shortened += usize::from(direct.0.steps < walk.steps);
-                assert_eq!(run(words - 1), direct, "{w}x{h} seed {seed}");
-                smaller += 1;
+        let sizes = [(48u16, 40u16), (64, 24), (30, 30), (80, 60)];
+        each_walk(&sizes, 0..40, |(w, h, seed), wd, run| {
+            let n = wd.walk.steps + 1;
+            let slots = (2 * n).next_power_of_two() / 2;
+            if slots < n + n.div_ceil(2) {
+                return;
             }
-        }
+            let words = slots / 2;
+            assert_eq!(hash_words(n), words);
+            let direct = run(usize::from(w) * usize::from(h));
+            assert_eq!(run(words), direct, "{w}x{h} seed {seed}");
+            shortened += usize::from(direct.0.steps < wd.walk.steps);
+            assert_eq!(run(words - 1), direct, "{w}x{h} seed {seed}");
+            smaller += 1;
+        });
         // Enough walks of such lengths, and enough of them shortened (a table that never finds a
         // cell would leave every walk as it was).
         assert!(smaller >= 20 && shortened >= 10, "{smaller} {shortened}");
@@ -726,44 +723,33 @@ mod tests {
         // Wandering walks on maps large enough for walks of hundreds of cells: the keyed table
         // with as few links as it needs, and with many more, tightens each as the per-cell index.
         let mut shortened = 0;
-        for (w, h) in [(120u16, 90u16), (200, 40)] {
-            for seed in 0..12u64 {
-                let Some(Wandering {
-                    bits,
-                    walk,
-                    tour,
-                    tabu,
-                }) = wandering_walk(w, h, seed)
-                else {
-                    continue;
-                };
-                let n = walk.steps + 1;
-                let run = |links: usize| tightened((w, h, &bits), walk, &tour, &tabu, links);
-                let direct = run(usize::from(w) * usize::from(h));
-                assert_eq!(run(keyed_words(n)), direct, "{w}x{h} seed {seed}");
-                assert_eq!(run(keyed_words(n) + 1), direct, "{w}x{h} seed {seed}");
-                // Without the tabu set's filter every neighbour is looked up: the same path.
-                let g = Grid::new(w, h, &bits).unwrap();
-                let mut t = tour.clone();
-                let mut cells = vec![Point::default(); n];
-                let mut pos = vec![0u32; keyed_words(n)];
-                let out = tighten(
-                    &Moves::new(g, &[]),
-                    Point::new(0, 0),
-                    walk,
-                    &mut t,
-                    &mut cells,
-                    &mut pos,
-                    &[],
-                );
-                assert_eq!(
-                    (out, t[..out.steps].to_vec()),
-                    direct,
-                    "{w}x{h} seed {seed}"
-                );
-                shortened += usize::from(direct.0.steps < walk.steps);
-            }
-        }
+        each_walk(&[(120, 90), (200, 40)], 0..12, |(w, h, seed), wd, run| {
+            let n = wd.walk.steps + 1;
+            let direct = run(usize::from(w) * usize::from(h));
+            assert_eq!(run(keyed_words(n)), direct, "{w}x{h} seed {seed}");
+            assert_eq!(run(keyed_words(n) + 1), direct, "{w}x{h} seed {seed}");
+            // Without the tabu set's filter every neighbour is looked up: the same path.
+            let g = Grid::new(w, h, &wd.bits).unwrap();
+            let mut t = wd.tour.clone();
+            let mut cells = vec![Point::default(); n];
+            let mut pos = vec![0u32; keyed_words(n)];
+            let moves = Moves::new(g, &[]);
+            let out = tighten(
+                &moves,
+                Point::new(0, 0),
+                wd.walk,
+                &mut t,
+                &mut cells,
+                &mut pos,
+                &[],
+            );
+            assert_eq!(
+                (out, t[..out.steps].to_vec()),
+                direct,
+                "{w}x{h} seed {seed}"
+            );
+            shortened += usize::from(direct.0.steps < wd.walk.steps);
+        });
         assert!(shortened >= 6, "{shortened}");
     }
 }
