@@ -33,60 +33,11 @@
 //! them, or stashes what it keeps in the pheromone increments first).
 
 use crate::grid::{Dir, Point};
-use crate::pheromone::Blocks;
 #[cfg(doc)]
 use crate::route;
-use crate::route::Route;
 
+pub(super) use super::workspace::Guide;
 use super::workspace::Workspace;
-
-/// The coarse route's words, by what they hold: the role is in the type, not in a flag beside a
-/// slice.
-#[derive(Debug)]
-pub(super) enum Guide<'a> {
-    /// A word a block ([`route::build`]: links, next block, distance): a warm start repairs it.
-    Words(&'a mut [u32]),
-    /// Four bits a block, the next block only ([`route::pack`]): built again every run, its
-    /// words and heap lent by [`Idle::packed_route`].
-    Packed(&'a mut [u32]),
-}
-
-impl<'a> Guide<'a> {
-    /// Its words, whatever they hold.
-    pub(super) fn len(&self) -> usize {
-        match self {
-            Guide::Words(w) | Guide::Packed(w) => w.len(),
-        }
-    }
-
-    /// Four bits a block.
-    pub(super) fn is_packed(&self) -> bool {
-        matches!(self, Guide::Packed(_))
-    }
-
-    /// The same role over a shorter borrow.
-    pub(super) fn reborrow(&mut self) -> Guide<'_> {
-        match self {
-            Guide::Words(w) => Guide::Words(w),
-            Guide::Packed(w) => Guide::Packed(w),
-        }
-    }
-
-    /// Its words as scratch (after the colony, when no ant reads the route).
-    pub(super) fn scratch(self) -> &'a mut [u32] {
-        match self {
-            Guide::Words(w) | Guide::Packed(w) => w,
-        }
-    }
-
-    /// The route the ants read from it.
-    pub(super) fn route(&self, blocks: Blocks, goal: Point, width: u16, height: u16) -> Route<'_> {
-        match self {
-            Guide::Words(w) => Route::new(blocks, w, goal, width, height),
-            Guide::Packed(w) => Route::packed(blocks, w, goal, width, height),
-        }
-    }
-}
 
 /// Two slices of scratch words.
 type Pair<'g> = (&'g mut [u32], &'g mut [u32]);

@@ -39,9 +39,8 @@ use crate::bitmap::words;
 use crate::error::Error;
 use crate::grid::{Dir, Point};
 use crate::pheromone::{Blocks, BLOCKS};
-use crate::route::GUIDE_BLOCKS;
+use crate::route::{Route, GUIDE_BLOCKS};
 
-use super::lend::Guide;
 use super::plan::CurvePoint;
 
 /// Every buffer a run needs, borrowed from the caller (see the module docs for the sizes).
@@ -427,5 +426,53 @@ impl<
 {
     fn default() -> Self {
         Self::new()
+    }
+}
+
+/// The coarse route's words, by what they hold: the role is in the type, not in a flag beside a
+/// slice.
+#[derive(Debug)]
+pub(super) enum Guide<'a> {
+    /// A word a block ([`route::build`]: links, next block, distance): a warm start repairs it.
+    Words(&'a mut [u32]),
+    /// Four bits a block, the next block only ([`route::pack`]): built again every run, its
+    /// words and heap lent by the setup (`planner::lend`).
+    Packed(&'a mut [u32]),
+}
+
+impl<'a> Guide<'a> {
+    /// Its words, whatever they hold.
+    pub(super) fn len(&self) -> usize {
+        match self {
+            Guide::Words(w) | Guide::Packed(w) => w.len(),
+        }
+    }
+
+    /// Four bits a block.
+    pub(super) fn is_packed(&self) -> bool {
+        matches!(self, Guide::Packed(_))
+    }
+
+    /// The same role over a shorter borrow.
+    pub(super) fn reborrow(&mut self) -> Guide<'_> {
+        match self {
+            Guide::Words(w) => Guide::Words(w),
+            Guide::Packed(w) => Guide::Packed(w),
+        }
+    }
+
+    /// Its words as scratch (after the colony, when no ant reads the route).
+    pub(super) fn scratch(self) -> &'a mut [u32] {
+        match self {
+            Guide::Words(w) | Guide::Packed(w) => w,
+        }
+    }
+
+    /// The route the ants read from it.
+    pub(super) fn route(&self, blocks: Blocks, goal: Point, width: u16, height: u16) -> Route<'_> {
+        match self {
+            Guide::Words(w) => Route::new(blocks, w, goal, width, height),
+            Guide::Packed(w) => Route::packed(blocks, w, goal, width, height),
+        }
     }
 }
