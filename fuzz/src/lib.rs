@@ -176,7 +176,9 @@ pub fn check_planner(input: &PlannerInput) {
             for &(c, blocked) in input.replan.iter().flat_map(|r| &r.changes) {
                 // The device's cell writer; a cell off the map changes nothing.
                 if ohaca::protocol::set_rect((w, h), &mut bits, (c.x, c.y, 1, 1), blocked).is_ok() {
-                    memory.changed(Area::cell(c));
+                    // A cleared cell is reported as cleared (what the firmware's receiver does).
+                    let cleared = (!blocked).then_some(Area::cell(c));
+                    memory.changed(Area::cell(c), cleared);
                 }
             }
         }
