@@ -18,6 +18,7 @@
 //! | --- | --- |
 //! | `params` | [`Algorithm`], [`Params`] and their ranges |
 //! | `workspace` | [`Workspace`], [`Buffers`], [`Storage`]: every buffer, one layout |
+//! | `lend` | one typed view of the workspace per phase (setup, colony, polish) and what a buffer idle in a phase lends to it |
 //! | `run` | [`Run`]: the loop as a state machine (setup, walk + update + record, polish) |
 //! | `plan` | [`Plan`], [`RawPath`], [`CurvePoint`]: the result |
 //! | `placed` | [`Placed`], [`Bases`]: where a plan lies in its workspace, to read it again later (the firmware's path parts) |
