@@ -45,7 +45,6 @@ pub fn tighten(
     // Cannot wrap for a real walk (steps < cells); were `steps` usize::MAX, `tour.get(..steps)`
     // below would fail and the walk come back unchanged.
     let n = walk.steps.wrapping_add(1);
-    let offsets = grid.offsets();
     if cells.len() < n {
         return walk;
     }
@@ -55,7 +54,7 @@ pub fn tighten(
     // The index: positions in `pos` (a per-cell array, or a hash table) checked against the path
     // laid out in `cells`, or, when `pos` is too short for that, a table of packed
     // (cell, position) keys over `pos` and `cells`' words together ([`Keyed`]).
-    let index = if PathIndex::fits(pos.len(), grid.cells(), n) {
+    if PathIndex::fits(pos.len(), grid.cells(), n) {
         let Some(mut ix) = PathIndex::new(pos, grid.cells(), n) else {
             return walk;
         };
@@ -69,7 +68,10 @@ pub fn tighten(
                 p = neighbour(p, d);
             }
         }
-        Index::Laid(ix, laid)
+        let laid: &[Point] = laid;
+        straighten(moves, start, walk, tour, visited, |cell| {
+            ix.find(cell, |j| laid.get(j).map(|&q| grid.index(q)))
+        })
     } else {
         let Some(mut k) = Keyed::new(pos, cells, grid.cells(), n) else {
             return walk;
@@ -81,8 +83,24 @@ pub fn tighten(
                 p = neighbour(p, d);
             }
         }
-        Index::Keyed(k)
-    };
+        straighten(moves, start, walk, tour, visited, |cell| k.find(cell))
+    }
+}
+
+/// [`tighten`]'s pass over the path in `tour`, with `find(cell)`: the cell's position on it.
+/// Generic over the index, so the look-ups of the inner loop branch on nothing else.
+#[inline(always)]
+fn straighten(
+    moves: &Moves<'_>,
+    start: Point,
+    walk: Walk,
+    tour: &mut [Dir],
+    visited: &[u32],
+    find: impl Fn(usize) -> Option<usize>,
+) -> Walk {
+    let grid = moves.grid();
+    let n = walk.steps.wrapping_add(1);
+    let offsets = grid.offsets();
     let mut i = 0usize;
     let mut out = 0usize;
     let (mut straight, mut diagonal) = (0u32, 0u32);
@@ -150,7 +168,7 @@ pub fn tighten(
                 }
                 continue;
             }
-            if let Some(j) = index.find(nb, grid) {
+            if let Some(j) = find(nb) {
                 if j > best.0 {
                     best = (j, d);
                 }
@@ -242,25 +260,6 @@ pub const fn keyed_fits(cells: usize, n: usize) -> bool {
     bits < 32 && bits.saturating_add(cell_bits) <= 32
 }
 
-/// Where [`tighten`] finds a cell's position on the path.
-enum Index<'a> {
-    /// Positions in `pos`, checked against the path laid out in these cells.
-    Laid(PathIndex<'a>, &'a [Point]),
-    /// Packed (cell, position) keys: nothing laid out.
-    Keyed(Keyed<'a>),
-}
-
-impl Index<'_> {
-    /// The position of map cell `cell` on the path, if it is on it.
-    #[inline]
-    fn find(&self, cell: usize, grid: &crate::grid::Grid<'_>) -> Option<usize> {
-        match self {
-            Index::Laid(ix, cells) => ix.find(cell, |j| cells.get(j).map(|&q| grid.index(q))),
-            Index::Keyed(k) => k.find(cell),
-        }
-    }
-}
-
 /// An open-addressing table of `(cell << bits) | (position + 1)` keys (0 = empty) over two
 /// slices of words, slot `k` in the first while `k` is below its length, then in the second: the
 /// links and the path cells' own words, which [`tighten`] does not need laid out when the key
@@ -284,6 +283,11 @@ impl<'a> Keyed<'a> {
         }
         let bits = usize::BITS.wrapping_sub(n.leading_zeros());
         let b: &mut [u32] = bytemuck::try_cast_slice_mut(cells).ok()?;
+        // At most 2n slots (a load of 1/2): the table is cleared for every walk it indexes, and
+        // more slots would only cost that.
+        let most = n.checked_mul(2)?;
+        let a = a.get_mut(..most.min(a.len()))?;
+        let b = b.get_mut(..most.saturating_sub(a.len()).min(b.len()))?;
         let len = a.len().checked_add(b.len())?;
         if len < n.checked_add(n.div_ceil(2))? || u32::try_from(len).is_err() {
             return None;
