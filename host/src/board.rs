@@ -221,7 +221,7 @@ mod tests {
         assert_eq!(
             differs_from_host(&F411, 604 * 307),
             Some(MapLayout {
-                steps: 4095,
+                steps: F411.max_steps,
                 compact: true
             })
         );

@@ -23,8 +23,8 @@ use ohaca_host::Map;
 use qemu::{assert_core_path, core_plan, have_qemu, longest_scenario, maps, Qemu};
 
 /// The F411's capacity (`ohaca::board::F411`).
-const CELLS: u32 = 262_144;
-const STEPS: u32 = 4095;
+const CELLS: u32 = ohaca::board::F411.cells as u32;
+const STEPS: u32 = ohaca::board::F411.max_steps as u32;
 
 #[test]
 fn the_f411_build_takes_262144_cells_and_refuses_more() {

@@ -524,6 +524,7 @@ fn a_cancel_stops_a_long_path_at_once() {
     );
     assert!(w <= FIFTY_MS, "{w}: {fs:?}");
     assert!(after.len() <= 1, "{after:?}");
+    assert!(parts < 13, "the whole path went out: {fs:?}");
     let s = link.stats().expect("stats");
     assert_eq!((s.cancelled, s.replies_dropped, s.rx_overruns), (1, 0, 0));
     // It serves on: the same plan again, whole.
@@ -600,7 +601,10 @@ fn the_twins_16000_step_path_lets_replies_pass_and_stops_at_a_cancel() {
     need_qemu!();
     let (_q, mut link, counters) = qemu::boot_paced_with(qemu::twin_firmware(), BAUD);
     let info = link.hello().expect("hello");
-    assert_eq!(info.capacity.max_steps, 16_384);
+    assert_eq!(
+        info.capacity.max_steps as usize,
+        ohaca::board::H743.max_steps
+    );
     let (w, h) = (254u16, 127u16);
     let (plan, params, map) = long_path_on(&mut link, &counters, serpentine_of(w, h));
     let (stats, s1, update, s2) = stats_and_a_cell_update(&mut link);
@@ -632,8 +636,8 @@ fn the_twins_16000_step_path_lets_replies_pass_and_stops_at_a_cancel() {
     let core = qemu::core_plan_on(ohaca::board::H743, &map, start, goal, &params)
         .expect("the core plans it");
     qemu::assert_core_path("the twin's serpentine", &core, &path);
-    // The same plan again, cancelled while it goes out.
-    link.set_cells(&[WALL_CELL], false).expect("clear the cell");
+    // The same plan again (uploaded again: the cell update above is undone), cancelled while it
+    // goes out.
     let (plan, _, _) = long_path_on(&mut link, &counters, serpentine_of(w, h));
     let cancel = link.send(&Request::Cancel).expect("send Cancel");
     let sent = link.transport().wait_sent(TIMEOUT).expect("Cancel sent");
@@ -648,6 +652,13 @@ fn the_twins_16000_step_path_lets_replies_pass_and_stops_at_a_cancel() {
     let w3 = waited(&fs, cancel, sent);
     println!("twin: Cancel during it answered after {w3} host-bound bytes");
     assert!(w3 <= FIFTY_MS, "{w3}");
+    // At most the part already going out follows the Ack.
+    let ack = fs.iter().find(|f| f.id == cancel).expect("the Ack");
+    let after = fs
+        .iter()
+        .filter(|f| f.id == plan && f.kind == "PathPart" && f.first.to_host > ack.last.to_host)
+        .count();
+    assert!(after <= 1, "{after} parts after the Ack");
     let s = link.stats().expect("stats");
     assert_eq!((s.parted, s.cancelled, s.replies_dropped), (2, 1, 0));
 }

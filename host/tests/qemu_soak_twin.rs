@@ -62,11 +62,11 @@ const LIMITS: MapLimits = MapLimits {
 };
 /// Chunk frames in flight.
 const WINDOW: usize = 3;
-/// The device's window (`Capacity::window`, `window_bytes`: 8 requests and 1,024 bytes on every
-/// board). Every write's replies are read before the next write, and a write is at most
+/// The device's window (`Capacity::window`, `window_bytes`: the board's `window` and `rx_ring`,
+/// the same on every board). Every write's replies are read before the next write, and a write is at most
 /// [`WINDOW`] chunk frames (at most 164 bytes each with inserted garbage) and a lone `00`: well
 /// within it, so nothing may be lost (`rx_overruns`, `replies_dropped` 0). Asserted per write.
-const DEVICE_WINDOW: (usize, usize) = (8, 1024);
+const DEVICE_WINDOW: (usize, usize) = (ohaca::board::H743.window, ohaca::board::H743.rx_ring);
 /// How long one reply may take (a plan on 512 x 512 without `-icount` takes a second or two).
 const REPLY_TIMEOUT: Duration = Duration::from_secs(120);
 

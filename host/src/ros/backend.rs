@@ -304,7 +304,11 @@ mod tests {
         let cap = b.capacity().unwrap().unwrap();
         assert_eq!(
             (cap.cells, cap.max_side, cap.max_steps),
-            (262_144, 4096, 4095)
+            (
+                ohaca::board::F411.cells as u32,
+                ohaca::board::F411.max_side,
+                ohaca::board::F411.max_steps as u32
+            )
         );
         assert!(b.describe().contains("f411"));
         assert!(matches!(
