@@ -15,7 +15,10 @@
 //!   `LOOKBACK + 1` cells (every shared small-map path) get the exact all-pairs DP, bit for bit as
 //!   before the look-back existed. Longer paths get the windowed DP and then one greedy
 //!   line-of-sight pass over its waypoints (a waypoint goes when its neighbours see each other),
-//!   so a long straight stretch still ends up as one segment. See [`LOOKBACK`] for the cost.
+//!   so a long straight stretch still ends up as one segment. See [`LOOKBACK`] for the cost. The
+//!   planner's paths, locally shortest after its local search, take a bounded candidate scan
+//!   ([`Smoother::bounded`]): at most `LOOKBACK / STRIDE + CHAIN + 2 NEAR` = 48 segment tests a
+//!   raw cell, whatever the map.
 //! - [`SmoothingKind::Greedy`]: the paper's steps 1-5 literally: from the anchor `S`, extend `N`
 //!   along the path while `S` sees `N`; when it does not, the node before `N` becomes the next
 //!   anchor and a waypoint. Kept for faithful comparisons.
@@ -112,6 +115,8 @@ pub struct Smoother {
     j: usize,
     /// Entries of the `dist` ring used.
     ring: usize,
+    /// A path longer than the ring takes the bounded candidate scan ([`Smoother::bounded`]).
+    bounded: bool,
 }
 
 impl Smoother {
@@ -137,6 +142,20 @@ impl Smoother {
                 n
             },
             ring,
+            bounded: false,
+        }
+    }
+
+    /// The same smoothing with the bounded candidate scan ([`chain_cells`]) on a path longer than
+    /// [`LOOKBACK`]` + 1` cells: at most `LOOKBACK / STRIDE + CHAIN + 2 NEAR` segment tests a raw
+    /// cell instead of up to `LOOKBACK - 1`. For paths that are already locally shortest, as the
+    /// planner's are after its local search ([`crate::refine`]): there the result is within about
+    /// 0.1 % of the full scan's (`docs/ALGORITHM.md`, "Smoothing"); on a wandering path that
+    /// loops back on itself the full scan can find a much shorter way through its cells.
+    pub fn bounded(self) -> Self {
+        Smoother {
+            bounded: true,
+            ..self
         }
     }
 
@@ -157,7 +176,13 @@ impl Smoother {
         let n = self.n.min(pts.len());
         let to = self.j.saturating_add(cells).min(n);
         let ring = dist.get_mut(..self.ring).unwrap_or_default();
-        dp_cells(grid, pts, ring, prev, LOOKBACK, self.j..to);
+        if self.bounded && self.ring < n {
+            // A path longer than the look-back: the bounded scan along the chain of waypoints.
+            let clear = |a: Point, b: Point| segment_clear(grid, a, b);
+            chain_cells(clear, pts, ring, prev, LOOKBACK, self.j..to);
+        } else {
+            dp_cells(grid, pts, ring, prev, LOOKBACK, self.j..to);
+        }
         self.j = to.max(self.j);
         self.j < n
     }
@@ -330,6 +355,100 @@ fn dp_cells(
             if cand < best && segment_clear(grid, pi, pj) {
                 best = cand;
                 from = i;
+            }
+        }
+        if let (Some(d), Some(p)) = (dist.get_mut(slot(j)), prev.get_mut(j)) {
+            *d = best;
+            *p = from as u32;
+        }
+    }
+}
+
+/// Predecessors of `j - 1` that the bounded scan ([`chain_cells`]) tries at most.
+pub const CHAIN: usize = 16;
+/// Cells just before `j - 1` whose own predecessors [`chain_cells`] also tries.
+pub const NEAR: usize = 8;
+/// [`chain_cells`] also tries every `STRIDE`-th cell of the look-back window.
+pub const STRIDE: usize = 8;
+
+/// The DP of a path longer than the look-back window ([`LOOKBACK`]), with a bounded candidate
+/// scan. [`dp_cells`] tries every cell of the window (up to `lookback - 1` segment tests a cell:
+/// 117 a cell on `maze-128-128-2`'s winding 1,380-cell path, nearly all rejected); this tries at
+/// most `lookback / STRIDE + CHAIN + 2 NEAR` candidates a cell, whatever the map:
+///
+/// - every [`STRIDE`]-th cell of the window (fixed indices, so neighbouring cells share them),
+///   earliest first: where a long straight stretch may be cut, to within `STRIDE` cells;
+/// - the chain of `j - 1`'s predecessors (`prev[j - 1]`, `prev[prev[j - 1]]`, ...: the waypoints
+///   of the shortest path found to `j - 1`) inside the window, at most [`CHAIN`], farthest first:
+///   Theta*'s "parent of the parent", along the raw path;
+/// - the [`NEAR`] cells before `j - 1` and their predecessors: the other neighbours Theta* would
+///   relax `j` from.
+///
+/// Each is tested (a segment test) only when strictly shorter than the best clear one so far, as
+/// in [`dp_cells`]; the previous cell `j - 1` is the default. What it gives up against the full
+/// scan is a cut point between two stride cells that no chain passes through; the greedy pass
+/// after the DP ([`merge`]) and the taut pull (`crate::taut`), which moves waypoints a cell at a
+/// time, take that back: on the colony's paths of the depot, Boston, New York and
+/// `maze-128-128-2` the pulled result is within 0.01 % of the full scan's, shorter on two
+/// (`docs/ALGORITHM.md`, "Smoothing", has the figures).
+fn chain_cells(
+    mut clear: impl FnMut(Point, Point) -> bool,
+    pts: &[Point],
+    dist: &mut [f32],
+    prev: &mut [u32],
+    lookback: usize,
+    cells: core::ops::Range<usize>,
+) {
+    let ring = dist.len();
+    let slot = |i: usize| i.checked_rem(ring).unwrap_or(0);
+    let mut chain = [0usize; CHAIN];
+    for j in cells {
+        let Some(&pj) = pts.get(j) else { break };
+        let before = j.wrapping_sub(1); // j >= 1
+        let (mut best, mut from) = match (dist.get(slot(before)), pts.get(before)) {
+            (Some(&d), Some(&p)) => (d + distance(p, pj), before),
+            _ => break,
+        };
+        let lo = j.saturating_sub(lookback);
+        // Branch and bound: a candidate is tested only when it would beat the best so far.
+        let mut try_from = |i: usize| {
+            if let (Some(&di), Some(&pi)) = (dist.get(slot(i)), pts.get(i)) {
+                let cand = di + distance(pi, pj);
+                if cand < best && clear(pi, pj) {
+                    best = cand;
+                    from = i;
+                }
+            }
+        };
+        let near = j.saturating_sub(NEAR).max(lo);
+        let mut i = lo.div_ceil(STRIDE).wrapping_mul(STRIDE);
+        while i < near {
+            try_from(i);
+            i = i.wrapping_add(STRIDE);
+        }
+        // `j - 1`'s predecessors inside the window, nearest first (the start links to itself).
+        let mut len = 0usize;
+        let mut a = before;
+        while let (Some(&up), Some(s)) = (prev.get(a), chain.get_mut(len)) {
+            let up = up as usize;
+            if up >= a || up < lo {
+                break;
+            }
+            *s = up;
+            len = len.wrapping_add(1);
+            a = up;
+        }
+        for &i in chain.get(..len).unwrap_or_default().iter().rev() {
+            try_from(i);
+        }
+        let mut last = usize::MAX;
+        for b in near..before {
+            let up = prev.get(b).map_or(b, |&u| u as usize);
+            for i in [up, b] {
+                if i >= lo && i != last && i < before {
+                    last = i;
+                    try_from(i);
+                }
             }
         }
         if let (Some(d), Some(p)) = (dist.get_mut(slot(j)), prev.get_mut(j)) {
@@ -681,6 +800,111 @@ mod tests {
         }
         assert_eq!(worse, 0, "windowed DP longer than greedy in {worse} cases");
         assert!(total_gain > 0.0);
+    }
+
+    /// A walk from the left edge that heads right (a step towards the right edge two times in
+    /// three, otherwise any allowed step) until it reaches the right edge or `steps`.
+    fn heading_walk(
+        rng: &mut crate::rng::Xoshiro128pp,
+        w: u16,
+        h: u16,
+        density: f32,
+        steps: usize,
+    ) -> (Vec<u8>, Vec<Point>) {
+        loop {
+            let (b, _) = random_walk(rng, w, h, density, 0);
+            let g = Grid::new(w, h, &b).unwrap();
+            let start = Point::new(0, (rng.next_word() % u32::from(h)) as u16);
+            if !g.is_free(start) {
+                continue;
+            }
+            let mut path = vec![start];
+            let mut tries = 0;
+            while path.len() <= steps && tries < 20 * steps {
+                tries += 1;
+                let p = *path.last().unwrap();
+                if p.x + 1 >= w {
+                    break;
+                }
+                // NE, E, SE (7, 0, 1 in the crate's order) head right.
+                let d = if rng.next_unit() < 0.67 {
+                    [7u8, 0, 1][(rng.next_word() % 3) as usize]
+                } else {
+                    (rng.next_word() % 8) as u8
+                };
+                if let Some(q) = g.step(p, d) {
+                    if !path.contains(&q) {
+                        path.push(q);
+                    }
+                }
+            }
+            if path.len() > 2 * usize::from(LOOKBACK as u16) {
+                return (b, path);
+            }
+        }
+    }
+
+    #[test]
+    fn the_bounded_scan_tests_at_most_its_candidates_and_follows_the_full_scan() {
+        // The bound: at most `LOOKBACK / STRIDE + CHAIN + 2 NEAR` segment tests a raw cell,
+        // whatever the map (the full scan makes up to `LOOKBACK - 1`), and the DP stays close to
+        // the full scan's: never longer than greedy, within a few per cent of the full scan.
+        let bound = LOOKBACK / STRIDE + CHAIN + 2 * NEAR;
+        let mut rng = crate::rng::Xoshiro128pp::from_u64(23);
+        let (mut full_tests, mut chain_tests) = (0usize, 0usize);
+        let (mut full_len, mut chain_len) = (0f32, 0f32);
+        for case in 0..40 {
+            let steps = 300 + case * 20;
+            let density = 0.03 + 0.004 * case as f32;
+            let (b, walk) = heading_walk(&mut rng, 240, 120, density, steps);
+            let g = Grid::new(240, 120, &b).unwrap();
+            // Locally shortest first, as the planner's paths are when it smooths them.
+            let mut raw = vec![Point::new(0, 0); walk.len() + 64];
+            let words = crate::refine::Scratch::words(52);
+            let (mut sa, mut sb) = (vec![0u32; words], vec![0u32; words]);
+            let scratch = crate::refine::Scratch::new(&mut sa, &mut sb);
+            let mut budget = crate::refine::Budget::unlimited();
+            let n = crate::refine::refine(&g, &walk, &mut raw, scratch, &mut budget).unwrap();
+            raw.truncate(n);
+            if n <= LOOKBACK + 1 {
+                continue;
+            }
+            let ring = n.min(LOOKBACK + 1);
+            // The bounded scan, counting its tests per cell.
+            let (mut dist, mut prev) = (vec![0f32; ring], vec![0u32; n]);
+            let mut worst = 0usize;
+            for j in 1..n {
+                let mut tests = 0usize;
+                let count = |a: Point, c: Point| {
+                    tests += 1;
+                    segment_clear(&g, a, c)
+                };
+                chain_cells(count, &raw, &mut dist, &mut prev, LOOKBACK, j..j + 1);
+                worst = worst.max(tests);
+                chain_tests += tests;
+            }
+            assert!(worst <= bound, "case {case}: {worst} tests for one cell");
+            // The smoothing as a whole (bounded DP, merge, taut pull) against the full scan's.
+            let mut p = raw.clone();
+            let (mut d, mut r) = (vec![0f32; ring], vec![0u32; n]);
+            let k = Smoother::new(SmoothingKind::Shortest, n, &mut d, &mut r)
+                .bounded()
+                .finish(&g, &mut p, &mut d, &mut r);
+            for s in p[..k].windows(2) {
+                assert!(segment_clear(&g, s[0], s[1]), "case {case} {s:?}");
+            }
+            chain_len += polyline_length(&p[..k]);
+            let mut q = raw.clone();
+            let kq = shortest_with(&g, &mut q, n, &mut d, &mut r, LOOKBACK);
+            let kq = drop_collinear(&mut q, kq);
+            let kq = crate::taut::pull(&g, &mut q, kq);
+            full_len += polyline_length(&q[..kq]);
+            full_tests += 1;
+        }
+        assert!(chain_tests > 0 && full_tests > 0);
+        // Over the refined walks the bounded smoothing is within 0.5 % of the full scan's.
+        assert!(chain_len <= full_len * 1.005, "{chain_len} against {full_len}");
+        eprintln!("bounded {chain_len} full {full_len}, tests {chain_tests}");
     }
 
     #[test]

@@ -154,12 +154,16 @@ impl Run<'_, '_> {
                         straight,
                         diagonal,
                     });
-                    Polish::Smooth(Smoother::new(
-                        kind,
-                        n,
-                        ws.delta.as_flattened_mut(),
-                        ws.idle.smoothing(n),
-                    ))
+                    // The refined path is locally shortest: the smoothing's bounded scan.
+                    Polish::Smooth(
+                        Smoother::new(
+                            kind,
+                            n,
+                            ws.delta.as_flattened_mut(),
+                            ws.idle.smoothing(n),
+                        )
+                        .bounded(),
+                    )
                 } else {
                     Polish::Refine(r)
                 }
