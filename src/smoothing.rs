@@ -903,7 +903,10 @@ mod tests {
         }
         assert!(chain_tests > 0 && full_tests > 0);
         // Over the refined walks the bounded smoothing is within 0.5 % of the full scan's.
-        assert!(chain_len <= full_len * 1.005, "{chain_len} against {full_len}");
+        assert!(
+            chain_len <= full_len * 1.005,
+            "{chain_len} against {full_len}"
+        );
         eprintln!("bounded {chain_len} full {full_len}, tests {chain_tests}");
     }
 

@@ -22,6 +22,7 @@
 //! | setup: the coarse route, packed ([`route::pack`], the compact arena) | the route's words and its heap, a word a block each | the tabu bit set halved, else the tabu set and the links, else the links halved |
 //! | colony: tightening ([`crate::tighten`]) | a cell -> position index | the links (a per-cell array or a hash table), else the links and the path cells' words together (packed keys) |
 //! | polish: the local search ([`crate::refine`]) | two slices of [`super::run::REFINE_WORDS`] | the links and the route's words, the links and the tabu set, the tabu set and the route's words, the tabu set halved, the links halved |
+//! | polish: the local search's memo ([`crate::refine::Memo`]) | [`MEMO_RECORDS`] records | the front of the pheromone increments (the smoothing's ring later, the route's stash at the far end) |
 //! | polish: the smoothing ([`crate::smoothing`]) | `n` links for its shortest-path rule (fewer: the greedy rule) | the links, else the tabu set (free after the last ant and the local search) |
 //! | a reused answer's repair ([`super::repair`]) | the local search's scratch, then the smoothing's links | as in the polish |
 //!
@@ -41,6 +42,23 @@ use super::workspace::Workspace;
 
 /// Two slices of scratch words.
 type Pair<'g> = (&'g mut [u32], &'g mut [u32]);
+
+/// Windows the local search's memo remembers ([`crate::refine::Memo`]): more than a pass
+/// searches on the large maps' longest paths (at most 23 on `maze-128-128-2`'s 1,380 cells).
+pub(super) const MEMO_RECORDS: usize = 32;
+
+/// The local search's memo: the front of the pheromone increments, idle from the last ant to the
+/// smoothing, before the `tail` words at their end (the route's stash). Empty when the increments
+/// cannot hold [`MEMO_RECORDS`] records besides the tail (the search then runs without it).
+pub(super) fn memo(delta: &mut [[f32; 4]], tail: usize) -> &mut [u32] {
+    let words: &mut [u32] = bytemuck::cast_slice_mut(delta.as_flattened_mut());
+    let want = crate::refine::memo_words(MEMO_RECORDS);
+    if words.len() >= want.saturating_add(tail) {
+        words.get_mut(..want).unwrap_or_default()
+    } else {
+        &mut []
+    }
+}
 
 /// What the setup borrows before the first ant: what it makes (the pruning marks, the coarse
 /// route) and the buffers idle until the first ant that it makes them with.

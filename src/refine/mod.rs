@@ -62,8 +62,10 @@
 use crate::error::Error;
 use crate::grid::{direction, Grid, Point};
 
+mod memo;
 mod window;
 
+pub use memo::{words as memo_words, Memo, RECORD_WORDS};
 use window::{place, pred, search, Box2, Shape};
 
 /// Cost of a straight step in search units.
@@ -94,6 +96,8 @@ pub struct Scratch<'a> {
     heap: &'a mut [u16],
     /// Position of each box cell in `heap` ([`CLOSED`] once expanded; the tail of the second).
     pos: &'a mut [u16],
+    /// The windows searched so far, if lent ([`Scratch::with_memo`]).
+    memo: Option<Memo<'a>>,
 }
 
 /// `g` of a cell not reached yet.
@@ -133,6 +137,17 @@ impl<'a> Scratch<'a> {
             f,
             heap: halves(a.split_at_mut(half.min(a.len())).0),
             pos: halves(b.split_at_mut(half.min(b.len())).0),
+            memo: None,
+        }
+    }
+
+    /// The same scratch with a memo of the windows searched ([`Memo`]): a window whose ends and
+    /// box a record holds, and that would not improve its piece, is not searched again. The
+    /// refined path is the same with or without it.
+    pub fn with_memo(self, memo: Memo<'a>) -> Self {
+        Scratch {
+            memo: Some(memo),
+            ..self
         }
     }
 
@@ -204,6 +219,8 @@ pub struct Budget {
     pub windows: u32,
     /// Windows whose piece was replaced by a shorter one.
     pub improved: u32,
+    /// Windows not searched because the memo knew they would not improve ([`Memo`]).
+    pub remembered: u32,
 }
 
 impl Budget {
@@ -214,6 +231,7 @@ impl Budget {
             expanded: 0,
             windows: 0,
             improved: 0,
+            remembered: 0,
         }
     }
 
@@ -527,11 +545,22 @@ impl Refiner {
                 w: bw,
                 h: bh,
             };
-            budget.windows = budget.windows.saturating_add(1);
-            if let Some(cost) = search(grid, &bbox, ps, pt, scratch, budget) {
-                if cost < old {
-                    replaced = self.replace(grid, out, scratch, &bbox, s, t, pt);
+            // A window asked before that would not improve its piece needs no search (the
+            // proof is in `memo`'s docs).
+            let key = memo::Key::new(ps, pt, &bbox);
+            let known = scratch.memo.as_ref().and_then(|m| m.find(key));
+            if known.is_none_or(|cost| cost < old) {
+                budget.windows = budget.windows.saturating_add(1);
+                if let Some(cost) = search(grid, &bbox, ps, pt, scratch, budget) {
+                    if let Some(m) = scratch.memo.as_mut() {
+                        m.put(key, cost);
+                    }
+                    if cost < old {
+                        replaced = self.replace(grid, out, scratch, &bbox, s, t, pt);
+                    }
                 }
+            } else {
+                budget.remembered = budget.remembered.saturating_add(1);
             }
         }
         if replaced {

@@ -244,3 +244,136 @@ fn a_budget_stops_and_resumes_to_the_same_result() {
     assert_eq!(spent.windows, total.windows);
     assert!(calls > 3, "{calls}");
 }
+
+/// A random map (`density` blocked) and a wandering valid path of about `steps` steps on it.
+fn wandering(seed: u64, w: u16, h: u16, density: f32, steps: usize) -> (Vec<u8>, Vec<Point>) {
+    let mut rng = crate::rng::Xoshiro128pp::from_u64(seed);
+    loop {
+        let cells = usize::from(w) * usize::from(h);
+        let mut b = vec![0u8; cells.div_ceil(8)];
+        for i in 0..cells {
+            if rng.next_unit() < density {
+                b[i / 8] |= 1 << (i % 8);
+            }
+        }
+        let g = Grid::new(w, h, &b).unwrap();
+        let start = Point::new(0, (rng.next_word() % u32::from(h)) as u16);
+        if !g.is_free(start) {
+            continue;
+        }
+        let mut path = vec![start];
+        let mut seen = vec![false; cells];
+        seen[usize::from(start.y) * usize::from(w) + usize::from(start.x)] = true;
+        let mut tries = 0;
+        while path.len() <= steps && tries < 20 * steps {
+            tries += 1;
+            let p = *path.last().unwrap();
+            // Mostly rightwards (E, SE, NE), sometimes anywhere: a colony-like wander.
+            let d = if rng.next_unit() < 0.6 {
+                [7u8, 0, 1][(rng.next_word() % 3) as usize]
+            } else {
+                (rng.next_word() % 8) as u8
+            };
+            if let Some(q) = g.step(p, d) {
+                let i = usize::from(q.y) * usize::from(w) + usize::from(q.x);
+                if !seen[i] {
+                    seen[i] = true;
+                    path.push(q);
+                }
+            }
+        }
+        if path.len() > steps / 2 {
+            return (b, path);
+        }
+    }
+}
+
+#[test]
+fn a_memo_changes_no_path() {
+    // The memo skips a search only when a record holds the same ends and box and says the piece
+    // would not improve: the refined path must be the same, bit for bit, with or without it,
+    // also cut into budgets with the memo reopened at each (as the planner does).
+    let (mut remembered, mut searched) = (0u32, 0u32);
+    for case in 0..16u64 {
+        let density = 0.05 + 0.008 * case as f32;
+        let (b, path) = wandering(case, 150, 60, density, 400);
+        let g = Grid::new(150, 60, &b).unwrap();
+        let cells = 20 * 20;
+        let (want, plain) = run(&g, &path, cells);
+        // At once.
+        let mut out = vec![Point::default(); path.len() + 16];
+        let mut s = Heapless::new(cells, 0x5A);
+        let mut words = vec![0xDEAD_BEEFu32; crate::refine::memo_words(8)];
+        let memo = Memo::clear(&mut words);
+        let mut budget = Budget::unlimited();
+        let k = refine(
+            &g,
+            &path,
+            &mut out,
+            s.scratch().with_memo(memo),
+            &mut budget,
+        )
+        .unwrap();
+        assert_eq!(&out[..k], &want[..], "case {case}");
+        assert_eq!(budget.improved, plain.improved, "case {case}");
+        assert_eq!(
+            budget.windows + budget.remembered,
+            plain.windows,
+            "case {case}"
+        );
+        remembered += budget.remembered;
+        searched += budget.windows;
+        // Records that differ from a real search only in the box, or only in one end, and claim
+        // no window could improve: none may be taken for that search (a key that leaves out the
+        // box or an end takes them, and a window that would improve is skipped).
+        let held = words[1] as usize;
+        let records: Vec<Vec<u32>> = words[2..]
+            .chunks_exact(RECORD_WORDS)
+            .take(held)
+            .map(<[u32]>::to_vec)
+            .collect();
+        let mut poisoned = vec![0u32; crate::refine::memo_words(4 * held)];
+        let mut bad = Memo::clear(&mut poisoned);
+        let cell = |v: u32| Point::new(v as u16, (v >> 16) as u16);
+        for r in &records {
+            let (ps, pt, corner, size) = (cell(r[0]), cell(r[1]), cell(r[2]), cell(r[3]));
+            let bx = |x0: u16, w: u16| Box2 {
+                x0,
+                y0: corner.y,
+                w: usize::from(w),
+                h: usize::from(size.y),
+            };
+            let shifted = |p: Point| Point::new(p.x ^ 1, p.y);
+            for key in [
+                memo::Key::new(ps, pt, &bx(corner.x ^ 1, size.x)),
+                memo::Key::new(ps, pt, &bx(corner.x, size.x ^ 1)),
+                memo::Key::new(shifted(ps), pt, &bx(corner.x, size.x)),
+                memo::Key::new(ps, shifted(pt), &bx(corner.x, size.x)),
+            ] {
+                bad.put(key, u32::MAX);
+            }
+        }
+        let mut out = vec![Point::default(); path.len() + 16];
+        let memo = Memo::reopen(&mut poisoned);
+        let mut b = Budget::unlimited();
+        let k = refine(&g, &path, &mut out, s.scratch().with_memo(memo), &mut b).unwrap();
+        assert_eq!(&out[..k], &want[..], "poisoned, case {case}");
+        // In pieces of a few hundred expansions, the memo reopened each time.
+        let mut out = vec![Point::default(); path.len() + 16];
+        let mut r = Refiner::new(&g, &path, &mut out, DEFAULT_PASSES).unwrap();
+        Memo::clear(&mut words);
+        let mut budget = Budget::new(0);
+        loop {
+            budget.limit = budget.expanded + 300;
+            let memo = Memo::reopen(&mut words);
+            let mut scratch = s.scratch().with_memo(memo);
+            if r.resume(&g, &mut out, &mut scratch, &mut budget) {
+                break;
+            }
+        }
+        let k = r.finish(&mut out);
+        assert_eq!(&out[..k], &want[..], "pieces, case {case}");
+    }
+    // The memo was used, and saved searches.
+    assert!(remembered > 10, "{remembered} remembered of {searched}");
+}

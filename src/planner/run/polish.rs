@@ -3,7 +3,7 @@
 //! smoothing a stretch of raw cells at a time. The firmware yields between pieces.
 
 use crate::grid::{direction, is_diagonal};
-use crate::refine::{self, Budget, Refiner, Scratch};
+use crate::refine::{self, Budget, Memo, Refiner, Scratch};
 use crate::route::{self, GUIDE_BLOCKS};
 use crate::smoothing::{Smoother, SmoothingKind, LOOKBACK};
 
@@ -14,7 +14,7 @@ use crate::planner::plan::RawPath;
 
 use super::colony::Best;
 use super::Run;
-use crate::planner::lend::Guide;
+use crate::planner::lend::{self, Guide};
 
 /// Window side of the local search ([`Params::refine`]). Its scratch is the links and the coarse
 /// route's words, free after the last iteration: two slices of [`Scratch::words`]`(52)` = 4,056
@@ -44,6 +44,16 @@ const REFINE_SLICE: u64 = 8192;
 /// Raw cells of the smoothing DP between two yields of [`Run::polish_step`] (each tests at most
 /// [`crate::smoothing::LOOKBACK`] segments).
 const SMOOTH_SLICE: usize = 48;
+
+/// Words at the end of the pheromone increments that the route's stash holds (the local
+/// search's memo stays before them).
+fn stash_tail(stashed: bool, blocks: crate::pheromone::Blocks) -> usize {
+    if stashed {
+        route::stash_len(blocks)
+    } else {
+        0
+    }
+}
 
 /// The work after the last iteration, in order ([`Run::polish_step`]).
 #[derive(Clone, Copy, Debug)]
@@ -110,6 +120,12 @@ impl Run<'_, '_> {
                     .refines
                     .then(|| Refiner::in_place(grid, ws.points, n, refine::DEFAULT_PASSES).ok())
                     .flatten();
+                if refiner.is_some() {
+                    Memo::clear(lend::memo(
+                        ws.delta,
+                        stash_tail(self.stashed, self.guide_blocks),
+                    ));
+                }
                 match refiner {
                     Some(r) => Polish::Refine(r),
                     None => Polish::Smooth(Smoother::new(
@@ -131,7 +147,10 @@ impl Run<'_, '_> {
                     ws.idle.halves_of_links(SMALL_REFINE_WORDS)
                 };
                 let mut budget = Budget::new(REFINE_SLICE);
-                if r.resume(grid, ws.points, &mut Scratch::new(a, b), &mut budget) {
+                let tail = stash_tail(self.stashed, self.guide_blocks);
+                let memo = Memo::reopen(lend::memo(ws.delta, tail));
+                let mut scratch = Scratch::new(a, b).with_memo(memo);
+                if r.resume(grid, ws.points, &mut scratch, &mut budget) {
                     let n = r.finish(ws.points);
                     // The refined path becomes the run's raw path: its directions replace the
                     // best tour (never longer, at most as many cells as `points` holds).
@@ -156,13 +175,8 @@ impl Run<'_, '_> {
                     });
                     // The refined path is locally shortest: the smoothing's bounded scan.
                     Polish::Smooth(
-                        Smoother::new(
-                            kind,
-                            n,
-                            ws.delta.as_flattened_mut(),
-                            ws.idle.smoothing(n),
-                        )
-                        .bounded(),
+                        Smoother::new(kind, n, ws.delta.as_flattened_mut(), ws.idle.smoothing(n))
+                            .bounded(),
                     )
                 } else {
                     Polish::Refine(r)
