@@ -68,11 +68,11 @@ pub struct MapArgs {
     pub unknown: Unknown,
     /// Block every cell whose centre is within this radius of an obstacle's centre: metres
     /// (cells for maps without a resolution)
-    #[arg(long, value_name = "RADIUS", value_parser = parse_length)]
+    #[arg(long, value_name = "RADIUS", value_parser = parse_length, allow_negative_numbers = true)]
     pub inflate: Option<f64>,
     /// Resample to coarser cells of this size: metres (cells for maps without a resolution); a
     /// coarse cell is blocked if any pixel it covers is
-    #[arg(long, value_name = "SIZE", value_parser = parse_length)]
+    #[arg(long, value_name = "SIZE", value_parser = parse_length, allow_negative_numbers = true)]
     pub cell: Option<f64>,
 }
 

@@ -277,15 +277,17 @@ pub fn summary(r: &PlanReport) -> String {
                 .map_or_else(|| "- turns".to_string(), |t| count(u64::from(t), "turn")),
         );
     } else {
-        let _ = writeln!(
-            s,
-            "no path: {}",
-            r.error.as_deref().unwrap_or("no path found")
-        );
+        // The core's error already says "no path: ..." (no "no path: no path:").
+        let why = r.error.as_deref().unwrap_or("no path found");
+        if why.starts_with("no path") {
+            let _ = writeln!(s, "{why}");
+        } else {
+            let _ = writeln!(s, "no path: {why}");
+        }
     }
     let mut line = String::new();
     if let Some(it) = r.iterations {
-        let _ = write!(line, "{it} iterations");
+        line.push_str(&count(u64::from(it), "iteration"));
         if let Some(b) = r.best_iteration {
             let _ = write!(line, " (best found in iteration {})", u32::from(b) + 1);
         }
@@ -297,7 +299,7 @@ pub fn summary(r: &PlanReport) -> String {
     let p = &r.params;
     let _ = write!(
         line,
-        "{}   {} seed {}, {} ants",
+        "planned in {}   {} seed {}, {} ants",
         format_us(r.elapsed_us),
         p.algorithm,
         p.seed,

@@ -53,7 +53,11 @@ fn png_has_the_size_and_the_path_colour() {
         out.to_str().unwrap(),
     ]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
-    assert!(stdout(&o).is_empty());
+    // One line says what was written.
+    assert_eq!(
+        stdout(&o),
+        format!("wrote {} (1 of 1 planners found a path)\n", out.display())
+    );
     let img = image::open(&out).unwrap().to_rgb8();
     let m = Map::load(&map).unwrap();
     // The legend: header, 2 lines for the one algorithm, a gap, 6 keys.

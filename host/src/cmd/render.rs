@@ -67,6 +67,7 @@ pub fn run(args: &Args) -> u8 {
     let mut layers = Vec::new();
     let mut pheromone = None;
     let mut all_found = true;
+    let mut found = 0usize;
     for (i, &algorithm) in algorithms.iter().enumerate() {
         let params = ohaca::Params { algorithm, ..base };
         let want = args.pheromone && i == 0;
@@ -75,6 +76,7 @@ pub fn run(args: &Args) -> u8 {
             Err(e) => return bad_input(plan_error(&sc, &e)),
         };
         all_found &= t.report.found;
+        found += usize::from(t.report.found);
         if let Some(tau) = &t.pheromone {
             pheromone = Some(cell_pheromone(tau, sc.map.width, sc.map.height));
         }
@@ -88,6 +90,13 @@ pub fn run(args: &Args) -> u8 {
     if let Err(e) = draw::save(&scene, &args.out) {
         return bad_input(e);
     }
+    // Say what was written (render used to be silent on success).
+    println!(
+        "wrote {} ({} of {} planners found a path)",
+        args.out.display(),
+        found,
+        algorithms.len()
+    );
     if all_found {
         exit::FOUND
     } else {

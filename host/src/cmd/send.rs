@@ -505,10 +505,10 @@ impl Sender {
                 let hz = u64::from(info.capacity.tick_hz.max(1));
                 let us =
                     u64::try_from(u128::from(t) * 1_000_000 / u128::from(hz)).unwrap_or(u64::MAX);
+                // "planned in" above is the round trip the host saw (the link included).
                 s.push_str(&format!(
-                    "device time {} ({t} ticks at {hz} Hz), round trip {}\n",
+                    "of which the device planned {} ({t} ticks at {hz} Hz)\n",
                     format_us(us),
-                    format_us(report.elapsed_us)
                 ));
             }
             print(&s);
