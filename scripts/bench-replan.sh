@@ -118,13 +118,14 @@ unit = "ant moves" if host else "instructions"
 cost = (lambda p: p["moves"]) if host else (lambda p: p["ticks"] * 1000)
 fmt = (lambda v: f"{v / 1e3:.1f} k") if host else (lambda v: f"{v / 1e6:.2f} M")
 def parts(ps):
-    """Mean `Run::new` / iterations / `finish` of the plans that ran (M instructions)."""
+    """Mean `Run::new` / iterations / `finish` of the plans that ran (M instructions); reused
+    and repaired answers run no colony (the firmware logs them as reused, without a split)."""
     ran = [p["split"] for p in ps if p.get("split")]
     if not ran:
-        return "reused" if ps else ""
+        return "no run" if ps else ""
     s = " / ".join(f"{st.mean(x[i] for x in ran) / 1e3:.2f}" for i in range(3))
     return s + " M" + (f" ({len(ran)} of {len(ps)})" if len(ran) < len(ps) else "")
-extra = " | cold: setup / iterations / finish | warm: setup / iterations / finish" if split else ""
+extra = " cold: setup / iterations / finish | warm: setup / iterations / finish |" if split else ""
 print(f"| scenario | cold: {unit} | iterations | raw/opt | warm: {unit} | answer | iterations | raw/opt | warm/cold |{extra}")
 print("| --- | ---: | ---: | ---: | ---: | --- | ---: | ---: | ---: |" + (" ---: | ---: |" if split else ""))
 ratios = []
