@@ -7,7 +7,9 @@
         [--only NewYork,Sydney]                  # the STM32H743's capacity twin, up to 1024^2
 
 For each size (32^2 .. 512^2) one public Moving AI map of `maps/` and its longest scenario (the
-largest optimum in the map's `.scen`): boots the release firmware with `-icount shift=0` (1 tick
+largest optimum in the map's `.scen`), maze512-1-0's 4,000-step pair, and Nav2's depot at 5 cm
+(without inflation, and at 0.2 m inflation with three corner-to-corner pairs; their optima are
+worked out here, 8-connected without corner cutting): boots the release firmware with `-icount shift=0` (1 tick
 = 1 us = 1000 instructions), uploads the map over the emulated UART in raw 128-byte chunks,
 plans seeds 1..=N with the device's default parameters and prints one Markdown row per map: the
 map's bytes in the device's one map buffer, the bytes a raw upload's frames put on the wire and
@@ -60,6 +62,13 @@ MAPS = [
     # Nav2's sample depot (host/assets/ros/, Apache-2.0) at its native 5 cm: a fixed far pair,
     # just inside the outer walls' top-left and bottom-right corners.
     ("604 x 307", "maps/depot.map", ((9, 4), (596, 300))),
+    # The same depot as a robot plans on it (issue 36, item 5): inflated by 0.2 m, the robot's
+    # radius (`maps/depot-r20.map`, made from the YAML as `maps/README.md` says). Three
+    # corner-to-corner pairs across its open floor, each a few cells inside a corner of the free
+    # space: the two diagonals and the long top side.
+    ("604 x 307", "maps/depot-r20.map", ((14, 10), (590, 294))),
+    ("604 x 307", "maps/depot-r20.map", ((590, 10), (14, 294))),
+    ("604 x 307", "maps/depot-r20.map", ((14, 10), (590, 10))),
 ]
 # The shared fixed map of `maps/README.md` with its stated pair and optimum.
 FIXED = [("26 x 26", "maps/complex-26.map", ((0, 0), (25, 25), 41.7990))]
