@@ -313,11 +313,30 @@ pub fn check_plan(
     } else {
         best_it
     };
-    let early = patience > 0
-        && (u32::from(its) == u32::from(streak_from) + 1 + u32::from(patience)
-            || refines
-                && curve.len() != usize::from(its)
-                && u32::from(its) > u32::from(best_it) + u32::from(patience));
+    // A refining run also stops after the first iteration whose ants all arrived with a mean
+    // length within `REFINE_GAIN` of the iteration's best (`ohaca::planner::settled`), replayed
+    // here from the curve when it holds every iteration: such an iteration ends the run, and no
+    // earlier one may.
+    let agreed = |c: &ohaca::planner::CurvePoint| {
+        c.arrived == p.ants && c.mean * ohaca::planner::REFINE_GAIN <= c.best
+    };
+    // Large maps only (the pheromone in blocks; the compact layout's are larger still).
+    let windowed = refines && map.cells() > ohaca::pheromone::BLOCKS;
+    let settled = windowed && curve.len() == usize::from(its) && curve.last().is_some_and(agreed);
+    if windowed && curve.len() == usize::from(its) {
+        if let Some(i) = curve.iter().take(usize::from(its) - 1).position(agreed) {
+            return Err(format!(
+                "iteration {i} settled the corridor (mean {} of best {}), but the run went on to {its}",
+                curve[i].mean, curve[i].best
+            ));
+        }
+    }
+    let early = settled
+        || patience > 0
+            && (u32::from(its) == u32::from(streak_from) + 1 + u32::from(patience)
+                || refines
+                    && curve.len() != usize::from(its)
+                    && u32::from(its) > u32::from(best_it) + u32::from(patience));
     if its != p.iterations && !early {
         return Err(format!(
             "stopped after {its} of {} iterations (best at {best_it}, patience {patience})",

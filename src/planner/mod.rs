@@ -46,7 +46,7 @@ pub use placed::{Bases, Placed};
 pub use plan::{CurvePoint, Origin, Plan, RawPath};
 pub use repair::{longest_detour, MARGIN as REPAIR_MARGIN};
 pub use reuse::reuse;
-pub use run::{Run, REFINE_GAIN};
+pub use run::{settled, Run, REFINE_GAIN};
 pub use warm::{Area, Memory, BLOCKED, FREED, REPAIR_RADIUS};
 #[cfg(any(feature = "alloc", test))]
 pub(crate) use workspace::OwnedBuffers;

@@ -18,7 +18,7 @@ mod colony;
 mod polish;
 mod setup;
 
-pub use colony::REFINE_GAIN;
+pub use colony::{settled, REFINE_GAIN};
 pub(crate) use polish::{REFINE_WORDS, SHORT_REFINE_WORDS};
 
 use crate::error::{Endpoint, Error};
