@@ -91,7 +91,8 @@ pub struct Params {
     /// 0 = the same as `patience`. A warm start's `warm_patience` comes first. In a run that
     /// refines, a new best counts as a gain only if it is more than 1 % shorter than the best at
     /// the last gain ([`crate::planner::REFINE_GAIN`]); a smaller one is kept but the iteration
-    /// counts as stale.
+    /// counts as stale. On a large map such a run also stops, whatever its patience, after an
+    /// iteration whose ants settled the corridor ([`crate::planner::settled`]).
     pub refine_patience: u16,
     /// Seed of the random generator.
     pub seed: u64,

@@ -61,11 +61,11 @@ pub const REFINE_GAIN: f32 = 0.99;
 /// iteration's ants, drawn independently, all arrived and agree to within that on average, none
 /// of them found a way that much shorter than the rest, and the next iteration's ants, drawn
 /// from the pheromone those ants laid on that corridor, are less likely still to; the local
-/// search then makes the path inside it. Where the choice is real the ants disagree (on
-/// `ht_chantry`'s longest scenario the mean lies 2-4 % above the best) and the run goes on as
-/// before. Measured (`docs/bench/colony-issue36.md`): ant moves a plan halve on the mazes and
-/// drop by a third on the cities, the mean raw length over the 20 large maps stays 1.0009
-/// against 1.0008, and `ht_chantry` is unchanged.
+/// search then makes the path inside it. Where the choice is real the ants disagree and the
+/// run goes on as before (`ht_chantry`'s plans are unchanged). Measured
+/// (`docs/bench/colony-issue36.md`, `docs/ALGORITHM.md`): ant moves a plan halve on the mazes
+/// and drop by a third on the cities and the depot, and the mean raw length over the 20 large
+/// maps is 1.0009 against 1.0008 (1.0009 both with seeds 1-4).
 pub fn settled(point: &CurvePoint, ants: u16) -> bool {
     point.arrived == ants && point.mean * REFINE_GAIN <= point.best
 }
