@@ -3,8 +3,9 @@
 //! used to make most of the moves.
 //!
 //! - From the second iteration on, walks over 3 times the cheapest arrived walk are abandoned
-//!   (some are, on this map), the first iteration abandons none, and the raw path is still the
-//!   8-connected optimum;
+//!   (some are, on this map, in every run that has a second iteration: a run whose first
+//!   iteration settles its corridor, `ohaca::planner::settled`, has none), the first iteration
+//!   abandons none, and the raw path is still the 8-connected optimum;
 //! - the run makes far fewer moves than the same run without the budget would (the paper preset's
 //!   colony, which has none, abandons nothing);
 //! - host and device run the same code: `host/tests/qemu_e2e.rs` compares their paths bit for bit.
@@ -19,6 +20,7 @@ fn walled_in_ants_are_abandoned_after_the_first_iteration_and_the_path_stays_opt
     let case = &m.cases[0];
     let grid = m.map.grid();
     let mut moves = Vec::new();
+    let mut budgeted = 0;
     for seed in 1..=3 {
         let mut st = ohaca_host_tests::heap::storage(m.map.cells());
         let p = Params {
@@ -33,7 +35,10 @@ fn walled_in_ants_are_abandoned_after_the_first_iteration_and_the_path_stays_opt
             "seed {seed}: the first iteration has no budget"
         );
         while run.step() {}
-        assert!(run.abandoned() > 0, "seed {seed}: no walk was over budget");
+        if run.iteration() >= 2 {
+            assert!(run.abandoned() > 0, "seed {seed}: no walk was over budget");
+            budgeted += 1;
+        }
         moves.push(run.moves());
         let plan = run.finish().unwrap();
         assert!(
@@ -43,6 +48,7 @@ fn walled_in_ants_are_abandoned_after_the_first_iteration_and_the_path_stays_opt
             case.stated_opt8
         );
     }
+    assert!(budgeted > 0, "no run had a second iteration");
     // Before the budget these runs made 2.0-3.3 M moves (BENCHMARKS.md, section 1b); with it
     // about 0.5 M. The bound is loose on purpose: it fails only if the budget stops working.
     let mean = moves.iter().sum::<u64>() / moves.len() as u64;
