@@ -328,40 +328,8 @@ fn dp_cells(
     lookback: usize,
     cells: core::ops::Range<usize>,
 ) {
-    let ring = dist.len();
-    // `ring >= 1` whenever there is a cell to do, so the `checked_rem` never fails.
-    let slot = |i: usize| i.checked_rem(ring).unwrap_or(0);
-    for j in cells {
-        let Some(&pj) = pts.get(j) else { break };
-        // Default: come from the previous raw cell (always clear: it is a legal move).
-        let before = j.wrapping_sub(1); // j >= 1
-        let (mut best, mut from) = match (dist.get(slot(before)), pts.get(before)) {
-            (Some(&d), Some(&p)) => (d + distance(p, pj), before),
-            _ => break,
-        };
-        let lo = j.saturating_sub(lookback);
-        // The ring slot of `i`, stepped along with it: one division a cell, not one a candidate.
-        let mut at = slot(lo);
-        for i in lo..before {
-            let (Some(&di), Some(&pi)) = (dist.get(at), pts.get(i)) else {
-                break;
-            };
-            at = at.wrapping_add(1); // < ring
-            if at == ring {
-                at = 0;
-            }
-            let cand = di + distance(pi, pj);
-            // Strictly shorter only, so a tie keeps the earlier choice found first.
-            if cand < best && segment_clear(grid, pi, pj) {
-                best = cand;
-                from = i;
-            }
-        }
-        if let (Some(d), Some(p)) = (dist.get_mut(slot(j)), prev.get_mut(j)) {
-            *d = best;
-            *p = from as u32;
-        }
-    }
+    let clear = |a: Point, b: Point| segment_clear(grid, a, b);
+    scan_cells(clear, pts, dist, prev, lookback, cells, false);
 }
 
 /// Predecessors of `j - 1` that the bounded scan ([`chain_cells`]) tries at most.
@@ -389,28 +357,45 @@ pub const STRIDE: usize = 8;
 /// scan is a cut point between two stride cells that no chain passes through; the greedy pass
 /// after the DP ([`merge`]) and the taut pull (`crate::taut`), which moves waypoints a cell at a
 /// time, take that back: on the colony's paths of the depot, Boston, New York and
-/// `maze-128-128-2` the pulled result is within 0.01 % of the full scan's, shorter on two
+/// `maze-128-128-2` the pulled result is within 0.1 % of the full scan's, shorter on some
 /// (`docs/ALGORITHM.md`, "Smoothing", has the figures).
 fn chain_cells(
-    mut clear: impl FnMut(Point, Point) -> bool,
+    clear: impl FnMut(Point, Point) -> bool,
     pts: &[Point],
     dist: &mut [f32],
     prev: &mut [u32],
     lookback: usize,
     cells: core::ops::Range<usize>,
 ) {
+    scan_cells(clear, pts, dist, prev, lookback, cells, true);
+}
+
+/// The DP's loop over the raw cells `cells` for both scans: every cell of the window
+/// ([`dp_cells`]) or the bounded candidates ([`chain_cells`]); `clear` is the segment test.
+fn scan_cells(
+    mut clear: impl FnMut(Point, Point) -> bool,
+    pts: &[Point],
+    dist: &mut [f32],
+    prev: &mut [u32],
+    lookback: usize,
+    cells: core::ops::Range<usize>,
+    bounded: bool,
+) {
     let ring = dist.len();
+    // `ring >= 1` whenever there is a cell to do, so the `checked_rem` never fails.
     let slot = |i: usize| i.checked_rem(ring).unwrap_or(0);
     let mut chain = [0usize; CHAIN];
     for j in cells {
         let Some(&pj) = pts.get(j) else { break };
+        // Default: come from the previous raw cell (always clear: it is a legal move).
         let before = j.wrapping_sub(1); // j >= 1
         let (mut best, mut from) = match (dist.get(slot(before)), pts.get(before)) {
             (Some(&d), Some(&p)) => (d + distance(p, pj), before),
             _ => break,
         };
         let lo = j.saturating_sub(lookback);
-        // Branch and bound: a candidate is tested only when it would beat the best so far.
+        // Branch and bound: a candidate is tested only when it would beat the best so far
+        // (strictly, so a tie keeps the earlier choice found first).
         let mut try_from = |i: usize| {
             if let (Some(&di), Some(&pi)) = (dist.get(slot(i)), pts.get(i)) {
                 let cand = di + distance(pi, pj);
@@ -420,34 +405,41 @@ fn chain_cells(
                 }
             }
         };
-        let near = j.saturating_sub(NEAR).max(lo);
-        let mut i = lo.div_ceil(STRIDE).wrapping_mul(STRIDE);
-        while i < near {
-            try_from(i);
-            i = i.wrapping_add(STRIDE);
-        }
-        // `j - 1`'s predecessors inside the window, nearest first (the start links to itself).
-        let mut len = 0usize;
-        let mut a = before;
-        while let (Some(&up), Some(s)) = (prev.get(a), chain.get_mut(len)) {
-            let up = up as usize;
-            if up >= a || up < lo {
-                break;
+        if !bounded {
+            // Every cell of the window, earliest first.
+            for i in lo..before {
+                try_from(i);
             }
-            *s = up;
-            len = len.wrapping_add(1);
-            a = up;
-        }
-        for &i in chain.get(..len).unwrap_or_default().iter().rev() {
-            try_from(i);
-        }
-        let mut last = usize::MAX;
-        for b in near..before {
-            let up = prev.get(b).map_or(b, |&u| u as usize);
-            for i in [up, b] {
-                if i >= lo && i != last && i < before {
-                    last = i;
-                    try_from(i);
+        } else {
+            let near = j.saturating_sub(NEAR).max(lo);
+            let mut i = lo.div_ceil(STRIDE).wrapping_mul(STRIDE);
+            while i < near {
+                try_from(i);
+                i = i.wrapping_add(STRIDE);
+            }
+            // `j - 1`'s predecessors inside the window, nearest first (the start links to itself).
+            let mut len = 0usize;
+            let mut a = before;
+            while let (Some(&up), Some(s)) = (prev.get(a), chain.get_mut(len)) {
+                let up = up as usize;
+                if up >= a || up < lo {
+                    break;
+                }
+                *s = up;
+                len = len.wrapping_add(1);
+                a = up;
+            }
+            for &i in chain.get(..len).unwrap_or_default().iter().rev() {
+                try_from(i);
+            }
+            let mut last = usize::MAX;
+            for b in near..before {
+                let up = prev.get(b).map_or(b, |&u| u as usize);
+                for i in [up, b] {
+                    if i >= lo && i != last && i < before {
+                        last = i;
+                        try_from(i);
+                    }
                 }
             }
         }
@@ -617,13 +609,7 @@ mod tests {
         steps: usize,
     ) -> (Vec<u8>, Vec<Point>) {
         loop {
-            let cells = usize::from(w) * usize::from(h);
-            let mut b = vec![0u8; cells.div_ceil(8)];
-            for i in 0..cells {
-                if rng.next_unit() < density {
-                    b[i / 8] |= 1 << (i % 8);
-                }
-            }
+            let b = crate::testutil::random_bits(rng, w, h, density);
             let g = Grid::new(w, h, &b).unwrap();
             let start = Point::new(
                 (rng.next_word() % u32::from(w)) as u16,
@@ -802,48 +788,6 @@ mod tests {
         assert!(total_gain > 0.0);
     }
 
-    /// A walk from the left edge that heads right (a step towards the right edge two times in
-    /// three, otherwise any allowed step) until it reaches the right edge or `steps`.
-    fn heading_walk(
-        rng: &mut crate::rng::Xoshiro128pp,
-        w: u16,
-        h: u16,
-        density: f32,
-        steps: usize,
-    ) -> (Vec<u8>, Vec<Point>) {
-        loop {
-            let (b, _) = random_walk(rng, w, h, density, 0);
-            let g = Grid::new(w, h, &b).unwrap();
-            let start = Point::new(0, (rng.next_word() % u32::from(h)) as u16);
-            if !g.is_free(start) {
-                continue;
-            }
-            let mut path = vec![start];
-            let mut tries = 0;
-            while path.len() <= steps && tries < 20 * steps {
-                tries += 1;
-                let p = *path.last().unwrap();
-                if p.x + 1 >= w {
-                    break;
-                }
-                // NE, E, SE (7, 0, 1 in the crate's order) head right.
-                let d = if rng.next_unit() < 0.67 {
-                    [7u8, 0, 1][(rng.next_word() % 3) as usize]
-                } else {
-                    (rng.next_word() % 8) as u8
-                };
-                if let Some(q) = g.step(p, d) {
-                    if !path.contains(&q) {
-                        path.push(q);
-                    }
-                }
-            }
-            if path.len() > 2 * usize::from(LOOKBACK as u16) {
-                return (b, path);
-            }
-        }
-    }
-
     #[test]
     fn the_bounded_scan_tests_at_most_its_candidates_and_follows_the_full_scan() {
         // The bound: at most `LOOKBACK / STRIDE + CHAIN + 2 NEAR` segment tests a raw cell,
@@ -856,7 +800,8 @@ mod tests {
         for case in 0..40 {
             let steps = 300 + case * 20;
             let density = 0.03 + 0.004 * case as f32;
-            let (b, walk) = heading_walk(&mut rng, 240, 120, density, steps);
+            let (b, walk) =
+                crate::testutil::heading_walk(&mut rng, 240, 120, density, steps, 2 * LOOKBACK);
             let g = Grid::new(240, 120, &b).unwrap();
             // Locally shortest first, as the planner's paths are when it smooths them.
             let mut raw = vec![Point::new(0, 0); walk.len() + 64];

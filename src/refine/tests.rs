@@ -245,49 +245,6 @@ fn a_budget_stops_and_resumes_to_the_same_result() {
     assert!(calls > 3, "{calls}");
 }
 
-/// A random map (`density` blocked) and a wandering valid path of about `steps` steps on it.
-fn wandering(seed: u64, w: u16, h: u16, density: f32, steps: usize) -> (Vec<u8>, Vec<Point>) {
-    let mut rng = crate::rng::Xoshiro128pp::from_u64(seed);
-    loop {
-        let cells = usize::from(w) * usize::from(h);
-        let mut b = vec![0u8; cells.div_ceil(8)];
-        for i in 0..cells {
-            if rng.next_unit() < density {
-                b[i / 8] |= 1 << (i % 8);
-            }
-        }
-        let g = Grid::new(w, h, &b).unwrap();
-        let start = Point::new(0, (rng.next_word() % u32::from(h)) as u16);
-        if !g.is_free(start) {
-            continue;
-        }
-        let mut path = vec![start];
-        let mut seen = vec![false; cells];
-        seen[usize::from(start.y) * usize::from(w) + usize::from(start.x)] = true;
-        let mut tries = 0;
-        while path.len() <= steps && tries < 20 * steps {
-            tries += 1;
-            let p = *path.last().unwrap();
-            // Mostly rightwards (E, SE, NE), sometimes anywhere: a colony-like wander.
-            let d = if rng.next_unit() < 0.6 {
-                [7u8, 0, 1][(rng.next_word() % 3) as usize]
-            } else {
-                (rng.next_word() % 8) as u8
-            };
-            if let Some(q) = g.step(p, d) {
-                let i = usize::from(q.y) * usize::from(w) + usize::from(q.x);
-                if !seen[i] {
-                    seen[i] = true;
-                    path.push(q);
-                }
-            }
-        }
-        if path.len() > steps / 2 {
-            return (b, path);
-        }
-    }
-}
-
 #[test]
 fn a_memo_changes_no_path() {
     // The memo skips a search only when a record holds the same ends and box and says the piece
@@ -296,7 +253,8 @@ fn a_memo_changes_no_path() {
     let (mut remembered, mut searched) = (0u32, 0u32);
     for case in 0..16u64 {
         let density = 0.05 + 0.008 * case as f32;
-        let (b, path) = wandering(case, 150, 60, density, 400);
+        let mut rng = crate::rng::Xoshiro128pp::from_u64(case);
+        let (b, path) = crate::testutil::heading_walk(&mut rng, 150, 60, density, 400, 200);
         let g = Grid::new(150, 60, &b).unwrap();
         let cells = 20 * 20;
         let (want, plain) = run(&g, &path, cells);
