@@ -6,10 +6,16 @@
 //! else. The search is therefore an A* rooted at the goal's block (the route's distances are to
 //! the goal), led by the octile block distance to the start's block (10 / 14 per straight /
 //! diagonal block step: the steps' own costs, so the estimate is consistent and a closed block's
-//! distance is exact), ties broken towards the start (the smaller estimate), and it stops when
-//! it closes the start's block ([`Bound::Plan`]). It closes every block whose shortest block
-//! route through it is shorter than the shortest, `F` (the blocks a detour round a wall passes),
-//! some of those exactly as short (one route's, by the tie rule), and none longer.
+//! distance is exact), ties broken towards the straight line between the ends ([`Heap::tie`]).
+//! It runs until it closes the start's block, at `F`, the length of the shortest block route;
+//! by then it has closed every block whose shortest block route through it is shorter than `F`
+//! (the blocks a detour round a wall passes) and some as short. Then it widens
+//! ([`Bound::Plan`]): it goes on closing, in its own order, the blocks whose route through
+//! them is at most [`SLACK`] longer than `F`, up to [`WIDEN`] times the blocks it had closed
+//! (at least [`WIDEN_MIN`] more): first the ties nearest the line (a wider band), then the
+//! corridors a few block steps longer, which a route on coarse blocks cannot tell from the
+//! shortest one (without the widening, `w_woundedcoast` planned at 1.0042 of the optimum
+//! instead of 1.0010, 20 scenarios x 2 seeds).
 //!
 //! A block's links ([`super::links`]) are read from the map's bits when the search closes the
 //! block, never before, so the setup reads the border cells of the closed blocks only (a few
@@ -20,11 +26,11 @@
 //!
 //! **Why not an ellipse** (every block within `(1 + eps) F`, the near-optimal corridors): in
 //! the octile distance every block of the parallelogram between the ends of an open map lies
-//! on a shortest block route, so even `eps = 0` with its ties closed 2,702 of the depot's 2,964
+//! on a shortest block route, so `eps = 1/8` (and 30 more) closed 2,702 of the depot's 2,964
 //! blocks for a corner-to-corner pair, and 3,301 of Boston's 4,096: no cheaper than the whole
-//! map. The tie rule keeps one corridor, a band about a block wide along the route; the colony
-//! still chooses the corridor at the cell level (the pheromone, the tour length and the local
-//! search; the route only pulls).
+//! map. The count bound keeps the widening to a multiple of what the route itself needed;
+//! the colony still chooses the corridor at the cell level (the pheromone, the tour length and
+//! the local search; the route only pulls).
 //!
 //! **An ant outside the closed blocks.** A block the search reached but did not close (the
 //! ring around the closed band) keeps the next block it was reached from: a closed block, so the
@@ -45,10 +51,23 @@ use crate::pheromone::Blocks;
 
 use super::{dist, DIST_SHIFT, KNOWN, LINKS, NEXT_SHIFT};
 
+/// After the start's block, the search closes the blocks whose key is at most `F + SLACK`
+/// (four straight block steps: block routes are coarse, and a corridor whose cells are as short
+/// may be a few block steps longer on blocks) ...
+pub const SLACK: u32 = 40;
+
+/// ... up to `WIDEN` times the blocks it had closed by then (at least [`WIDEN_MIN`] more), in
+/// the search's order: the ties at `F` nearest the straight line first (a wider band), then the
+/// corridors a little longer.
+pub const WIDEN: u32 = 2;
+
+/// The fewest blocks the widening may add.
+pub const WIDEN_MIN: u32 = 32;
+
 /// How far the search runs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Bound {
-    /// The default: stop when the start's block is closed.
+    /// The default: stop once the start's block is closed and the widening is done.
     Plan,
     /// Close every block the goal's block reaches (a search over every block of the map: the
     /// reference the tests compare the bounded search with).
@@ -116,7 +135,14 @@ pub(super) fn search(
         | (super::NONE << NEXT_SHIFT)
         | (octile(gx, gy, sx, sy) << DIST_SHIFT);
     heap.push(words, goal_block);
+    // Once the start's block is closed at `F`: the last key and the last count of blocks the
+    // search still closes (the widening, `Bound::Plan`).
+    let (mut last_key, mut last_count) = (u32::MAX, u32::MAX);
     while heap.len > 0 {
+        let top = heap.block_at(0);
+        if words.get(top).map_or(u32::MAX, |&w| dist(w)) > last_key || done.closed >= last_count {
+            break;
+        }
         let b = heap.pop(words);
         done.closed = done.closed.wrapping_add(1);
         let Some(&wb) = words.get(b) else { break };
@@ -127,7 +153,11 @@ pub(super) fn search(
         if b == start_block {
             done.length = Some(g);
             if bound == Bound::Plan {
-                break;
+                last_key = g.saturating_add(SLACK);
+                last_count = done
+                    .closed
+                    .saturating_mul(WIDEN)
+                    .max(done.closed.saturating_add(WIDEN_MIN));
             }
         }
         // The links of a block are read when it is closed, and only then.
@@ -165,10 +195,30 @@ pub(super) fn search(
                     *w = (wn & (LINKS | KNOWN)) | (back << NEXT_SHIFT) | (nf << DIST_SHIFT);
                 }
                 heap.push(words, nb);
+            } else if nf == dist(wn) && prefer(&heap, wn, (nx, ny), b) {
+                let back = (d as u32).wrapping_add(4) & 7;
+                if let Some(w) = words.get_mut(nb) {
+                    *w = (wn & !(15 << NEXT_SHIFT)) | (back << NEXT_SHIFT);
+                }
             }
         }
     }
     done
+}
+
+/// Whether block `(nx, ny)`, reached as short through its next block (in `wn`) as through the
+/// closed block `b`, takes `b` instead: the one nearer the straight line between the ends
+/// ([`Heap::tie`]), so that the next blocks do not depend on the order the search closed its
+/// blocks in. Measured on the 20 longest scenarios x 3 seeds of four large maps against the
+/// first block to reach it (`ht_chantry` 1.0033 -> 1.0017 of the optimum, `Paris_1_256`
+/// 1.0005 -> 1.0011, the others the same) and against preferring a diagonal step as Dijkstra
+/// from the goal did (one `ht_chantry` plan at 1.15).
+fn prefer(heap: &Heap<'_>, wn: u32, (nx, ny): (usize, usize), b: usize) -> bool {
+    let d = ((wn >> NEXT_SHIFT) & 7) as usize;
+    let cx = nx.wrapping_add_signed(DX.get(d).copied().unwrap_or(0) as isize);
+    let cy = ny.wrapping_add_signed(DY.get(d).copied().unwrap_or(0) as isize);
+    let current = cy.wrapping_mul(heap.across).wrapping_add(cx);
+    (wn >> NEXT_SHIFT) & 15 < 8 && heap.tie(b) < heap.tie(current)
 }
 
 /// A closed block's slot in the heap.
@@ -360,7 +410,6 @@ mod tests {
             let goal = Point::new(pick(u32::from(w)) as u16, pick(u32::from(h)) as u16);
             let sh = blocks.shift();
             let (sx, sy) = (usize::from(start.x >> sh), usize::from(start.y >> sh));
-            let start_block = blocks.block(start);
             let run = |bound: Bound| {
                 let mut words = vec![super::super::unsearched(0); n];
                 let mut heap = vec![0u32; n];
@@ -380,13 +429,12 @@ mod tests {
             assert_eq!(rw.length, rp.length, "round {round}");
             let found = u32::from(rp.length.is_some());
             assert_eq!(
-                rp.closed,
-                rp.linked + found,
+                rp.closed, rp.linked,
                 "round {round}: links read when closed"
             );
             let h_of = |b: usize| octile(b % across, b / across, sx, sy);
             let f_star = rp.length.unwrap_or(u32::MAX);
-            let mut count = 0u32;
+            let (mut count, mut at_most_f) = (0u32, 0u32);
             for b in 0..n {
                 let why = format!("round {round}: {w} x {h}, shift {sh}, block {b}");
                 let reached = dist(whole[b]) != UNREACHED;
@@ -397,6 +445,9 @@ mod tests {
                         closed(&pheap, b),
                         "{why}: shorter than the route, not closed"
                     );
+                }
+                if reached && f <= f_star {
+                    at_most_f += 1;
                 }
                 if !closed(&pheap, b) {
                     assert_eq!(plan[b] & KNOWN, 0, "{why}: links read beyond the bound");
@@ -411,13 +462,12 @@ mod tests {
                     continue;
                 }
                 count += 1;
-                assert!(f <= f_star, "{why}: closed beyond the bound");
+                let last = f_star.saturating_add(SLACK);
+                assert!(f <= last, "{why}: closed beyond the slack");
                 assert_eq!(dist(plan[b]), f, "{why}: the key");
                 let (bx, by) = (b % across, b / across);
-                if b != start_block || found == 0 {
-                    let want = block_links(&moves, blocks, &dead, bx as u16, by as u16);
-                    assert_eq!(plan[b] & (LINKS | KNOWN), u32::from(want) | KNOWN, "{why}");
-                }
+                let want = block_links(&moves, blocks, &dead, bx as u16, by as u16);
+                assert_eq!(plan[b] & (LINKS | KNOWN), u32::from(want) | KNOWN, "{why}");
                 // The next block is one step nearer the goal on a shortest block route.
                 let d = ((plan[b] >> NEXT_SHIFT) & 15) as usize;
                 let g = dist(plan[b]) - h_of(b);
@@ -436,6 +486,12 @@ mod tests {
                 );
             }
             assert_eq!(count, rp.closed, "round {round}");
+            // The widening adds at most `WIDEN` times the blocks closed by the start's (all of
+            // those within `F`), or `WIDEN_MIN`.
+            if found == 1 {
+                let most = (at_most_f * WIDEN).max(at_most_f + WIDEN_MIN);
+                assert!(rp.closed <= most, "round {round}: {} > {most}", rp.closed);
+            }
             bounded += found;
             fewer += u32::from(rp.closed < rw.closed);
         }
@@ -446,7 +502,8 @@ mod tests {
     #[test]
     fn a_short_plan_on_a_large_open_map_reads_a_few_blocks() {
         // 1,024 x 1,024 free cells (4,096 blocks of 16 x 16), start and goal five blocks apart:
-        // the search closes the six blocks of the straight route and reads their links only.
+        // the search closes the six blocks of the straight route and a band around them, and
+        // reads their links only.
         // Breaking the bound (closing every block, as the whole search does) fails here.
         let (w, h) = (1024u16, 1024u16);
         let cells = usize::from(w) * usize::from(h);
@@ -469,8 +526,9 @@ mod tests {
         );
         let r = r.unwrap();
         assert_eq!(r.length, Some(50));
-        assert_eq!(r.closed, r.linked + 1);
-        assert!(r.closed <= 6, "{r:?}");
+        assert_eq!(r.closed, r.linked);
+        // The six blocks of the straight route, and at most `WIDEN_MIN` more.
+        assert!(r.closed <= 6 + WIDEN_MIN, "{r:?}");
         let known = words.iter().filter(|&&w| w & KNOWN != 0).count();
         assert_eq!(known, r.linked as usize);
         let all = build(
