@@ -352,9 +352,12 @@ pub(super) fn block(
         if r == n.wrapping_add(1) {
             south = (f, l);
         }
-        for (c, k) in cols.iter_mut().zip([0, 1, last, east]) {
-            c.0 |= bit(f, k) << r;
-            c.1 |= bit(l, k) << r;
+        // The side links read the block's own rows only (bits 1..=n of a column).
+        if (1..=n).contains(&r) {
+            for (c, k) in cols.iter_mut().zip([0, 1, last, east]) {
+                c.0 |= bit(f, k) << r;
+                c.1 |= bit(l, k) << r;
+            }
         }
     }
     // The block's own rows, or columns: bits 1..=n.

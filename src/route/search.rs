@@ -172,10 +172,10 @@ pub(super) fn search(
         } else {
             wb
         };
-        for d in 0..8usize {
-            if (wb >> d) & 1 == 0 {
-                continue;
-            }
+        let mut m = wb & LINKS;
+        while m != 0 {
+            let d = m.trailing_zeros() as usize & 7;
+            m &= m.wrapping_sub(1);
             let nx = bx.wrapping_add_signed(DX.get(d).copied().unwrap_or(0) as isize);
             let ny = by.wrapping_add_signed(DY.get(d).copied().unwrap_or(0) as isize);
             if nx >= across || ny >= down {
