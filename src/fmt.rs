@@ -19,3 +19,12 @@ macro_rules! debug {
 
 pub(crate) use debug;
 pub(crate) use trace;
+
+macro_rules! warning {
+    ($($x:tt)*) => {{
+        #[cfg(feature = "defmt")]
+        ::defmt::warn!($($x)*);
+    }};
+}
+
+pub(crate) use warning;

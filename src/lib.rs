@@ -15,7 +15,7 @@
 //! | [`grid`] | the occupancy map, cells, the no-corner-cutting rule, reachability |
 //! | [`bitmap`] | sets of cells at one bit per cell (tabu lists, pruned cells) |
 //! | [`prune`] | dead-end pruning: the cells no shortest path needs |
-//! | [`route`] | the coarse route whose sub-goals the potential field pulls towards on large maps |
+//! | [`route`] | the coarse route whose sub-goals the potential field pulls towards on large maps: the blocks' links, and a search over them bounded by the plan |
 //! | [`geometry`] | path lengths and the segment rule used by smoothing and path checks |
 //! | [`heuristic`] | the distance heuristic and the goal attraction of the potential field |
 //! | [`pheromone`] | the pheromone table: storage, evaporation, deposit, clamping |

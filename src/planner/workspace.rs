@@ -433,7 +433,8 @@ impl<
 /// slice.
 #[derive(Debug)]
 pub(super) enum Guide<'a> {
-    /// A word a block ([`route::build`]: links, next block, distance): a warm start repairs it.
+    /// A word a block ([`route::build`]: links and whether they are known, next block, the
+    /// search's key): a warm start repairs it.
     Words(&'a mut [u32]),
     /// Four bits a block, the next block only ([`route::pack`]): built again every run, its
     /// words and heap lent by the setup (`planner::lend`).

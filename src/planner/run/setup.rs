@@ -1,6 +1,8 @@
 //! The setup of a run before its first iteration, one piece at a time: the flood fill (is the
-//! goal reachable at all?), dead-end pruning, the coarse route of a large map. Each piece reads
-//! the whole map once, so the firmware yields between them.
+//! goal reachable at all?), dead-end pruning, the coarse route of a large map. The fill and the
+//! pruning read the map (the default preset skips the fill; only the full layout prunes), the
+//! route only the blocks its search closes ([`crate::route::search`]); the firmware yields
+//! between the pieces.
 
 use crate::ant::DeadEnd;
 use crate::grid::{Moves, Reach};
@@ -83,37 +85,64 @@ impl Run<'_, '_> {
             }
             Setup::Route => {
                 // Large maps: the potential field pulls along a coarse route (not for ACA, which
-                // has no attraction).
+                // has no attraction), searched over the blocks the plan needs only
+                // (`route::search`: from the goal's block until the start's block and every
+                // block within the slack are closed; each block's links read as it closes).
                 let wanted = self.blocks.shift() > 0 && p.algorithm.attracts();
-                let (goal, blocks) = (self.goal, self.guide_blocks);
+                let (ends, blocks) = ((self.start, self.goal), self.guide_blocks);
                 let moves = Moves::new(*grid, ws.moves);
                 let count = blocks.count();
                 let (relink, area) = (self.relinked && self.marks, self.touched.map(Area::corners));
-                self.routed = wanted
-                    && if ws.guide.is_packed() {
-                        // Built in words the tabu set, the path cells or the links lend (idle
-                        // until the first ant), then packed: built again each run, never
-                        // repaired (a packed route is kept only by workspaces without pruning
-                        // marks).
-                        match ws.idle.packed_route(&mut ws.guide, count) {
-                            Some(((words, heap), out)) => {
-                                route::build(&moves, blocks, goal, ws.dead, words, heap)
-                                    && route::pack(blocks, words, out)
-                            }
-                            None => false,
+                let bound = route::Bound::Plan;
+                let routed = if !wanted {
+                    Ok(None)
+                } else if ws.guide.is_packed() {
+                    // Built in words the tabu set, the path cells or the links lend (idle
+                    // until the first ant), then packed: built again each run, never
+                    // repaired (a packed route is kept only by workspaces without pruning
+                    // marks).
+                    match ws.idle.packed_route(&mut ws.guide, count) {
+                        Some(((words, heap), out)) => {
+                            route::build(&moves, blocks, ends, ws.dead, words, heap, bound)
+                                .and_then(|r| {
+                                    route::pack(blocks, words, out)
+                                        .then_some(Some(r))
+                                        .ok_or(route::Short)
+                                })
                         }
-                    } else {
-                        match ws.idle.route_words(&mut ws.guide, count) {
-                            // The last run's links, repaired where the map or the marks changed.
-                            Some((words, heap)) if relink => {
-                                route::repair(&moves, blocks, goal, ws.dead, words, heap, area)
-                            }
-                            Some((words, heap)) => {
-                                route::build(&moves, blocks, goal, ws.dead, words, heap)
-                            }
-                            None => false,
+                        None => Err(route::Short),
+                    }
+                } else {
+                    match ws.idle.route_words(&mut ws.guide, count) {
+                        // The last run's links, forgotten where the map or the marks changed.
+                        Some((words, heap)) if relink => {
+                            route::repair(&moves, blocks, ends, ws.dead, words, heap, area, bound)
+                                .map(Some)
                         }
-                    };
+                        Some((words, heap)) => {
+                            route::build(&moves, blocks, ends, ws.dead, words, heap, bound)
+                                .map(Some)
+                        }
+                        None => Err(route::Short),
+                    }
+                };
+                self.routed = match routed {
+                    Ok(Some(_searched)) => {
+                        crate::fmt::debug!(
+                            "plan: route closed {} blocks, read {} blocks' links",
+                            _searched.closed,
+                            _searched.linked
+                        );
+                        true
+                    }
+                    Ok(None) => false,
+                    // A workspace laid out without room for the route (none the arena lays
+                    // out): said, not silent; the ants are pulled at the goal.
+                    Err(route::Short) => {
+                        crate::fmt::warning!("plan: no room for the coarse route");
+                        false
+                    }
+                };
                 crate::fmt::debug!("plan: {} cells pruned", self.pruned);
                 self.setup = Setup::Done;
             }
