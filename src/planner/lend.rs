@@ -24,7 +24,7 @@
 //! | polish: the local search ([`crate::refine`]) | two slices of [`super::run::REFINE_WORDS`] | the links and the route's words, the links and the tabu set, the tabu set and the route's words, the tabu set halved, the links halved |
 //! | polish: the local search's memo ([`crate::refine::Memo`]) | [`MEMO_RECORDS`] records | the front of the pheromone increments (the smoothing's ring later, the route's stash at the far end) |
 //! | polish: the smoothing ([`crate::smoothing`]) | `n` links for its shortest-path rule (fewer: the greedy rule) | the links, else the tabu set (free after the last ant and the local search) |
-//! | a reused answer's repair ([`super::repair`]) | the local search's scratch, then the smoothing's links | as in the polish |
+//! | a reused answer's repair ([`super::repair`]) | the local search's scratch (no memo), then the smoothing's links | as in the polish |
 //!
 //! Every choice depends only on the buffers' lengths (never on their contents or addresses), so
 //! a host that lays out a device's arena plans exactly what the device plans, and a choice made
@@ -51,7 +51,8 @@ pub(super) const MEMO_RECORDS: usize = 32;
 /// smoothing, before the `tail` words at their end (the route's stash). Empty when the increments
 /// cannot hold [`MEMO_RECORDS`] records besides the tail (the search then runs without it).
 pub(super) fn memo(delta: &mut [[f32; 4]], tail: usize) -> &mut [u32] {
-    let words: &mut [u32] = bytemuck::cast_slice_mut(delta.as_flattened_mut());
+    let words: &mut [u32] =
+        bytemuck::try_cast_slice_mut(delta.as_flattened_mut()).unwrap_or_default();
     let want = crate::refine::memo_words(MEMO_RECORDS);
     if words.len() >= want.saturating_add(tail) {
         words.get_mut(..want).unwrap_or_default()

@@ -19,8 +19,8 @@
 //! would improve is searched (the path is read back from the search's scratch).
 //!
 //! Where it pays: every pass after the first repeats the windows of the last pass that landed
-//! on the same ends and box (on `NewYork_0_512`'s longest scenario 5 of the second pass's 7
-//! searches), and a pass that changes nothing is what ends the refinement.
+//! on the same ends and box, and a pass that changes nothing is what ends the refinement
+//! (measured in `docs/ALGORITHM.md`, "Local search").
 //!
 //! Panic-free: every index is checked; a memo too short for one record remembers nothing.
 

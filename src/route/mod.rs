@@ -6,8 +6,9 @@
 //! wall that faces the goal, and a backtracking ant explores each of them before it finds the way
 //! around (on a 256 x 256 city map an ant made ten times as many moves as its path has steps).
 //!
-//! On maps with more cells than [`GUIDE_BLOCKS`], the map is cut into square blocks, and before
-//! any ant runs:
+//! On maps of more than 1,024 cells (those whose pheromone is kept in blocks), the map is cut into
+//! at most [`GUIDE_BLOCKS`] square blocks (single cells on maps of at most [`GUIDE_BLOCKS`]
+//! cells), and before any ant runs:
 //!
 //! 1. **Connectivity** ([`links`]): block `B` links to a neighbouring block `B'` when some live
 //!    cell of `B` has an allowed move into a live cell of `B'` (pruned cells do not count). This

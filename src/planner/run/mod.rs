@@ -98,8 +98,8 @@ pub struct Run<'g, 'a> {
     done: bool,
 }
 
-/// The setup still to do before the first iteration, in order. Each piece reads the whole map
-/// once, so the firmware yields between them ([`Run::setup_step`]).
+/// The setup still to do before the first iteration, in order: the firmware yields between the
+/// pieces ([`Run::setup_step`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Setup {
     /// The flood fill (is the goal reachable at all?), for dying ants only: backtracking ants

@@ -14,8 +14,9 @@ use super::{Area, Run, Setup};
 impl Run<'_, '_> {
     /// Do the next piece of the setup, if any is left: the flood fill (a goal found unreachable
     /// ends the run: [`Run::finish`] gives [`crate::Error::NoPath`]), the dead-end pruning, the coarse
-    /// route. Returns `true` while setup remains. Each piece reads the whole map once (on a
-    /// 256 x 256 map about as long as an iteration), so the firmware yields between them;
+    /// route. Returns `true` while setup remains. The flood fill and the pruning read the whole
+    /// map once, the route only the blocks its bounded search closes; the firmware yields between
+    /// the pieces;
     /// [`Run::step`] does whatever setup is left itself, so other callers never need this.
     pub fn setup_step(&mut self) -> bool {
         let grid = self.grid;
