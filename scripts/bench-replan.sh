@@ -22,9 +22,9 @@ while [ $# -gt 0 ]; do
 done
 if [ "$build" = 1 ]; then
   cargo build --release -q
-  cargo build --release -q -p ohaca-host --target host-tuple
+  cargo build --profile host -q -p ohaca-host --target host-tuple
 fi
-ohaca="target/$(rustc -vV | sed -n 's/^host: //p')/release/ohaca"
+ohaca="target/$(rustc -vV | sed -n 's/^host: //p')/host/ohaca"
 device=()
 if [ "$host" = 0 ]; then
   port=$(python3 -c 'import socket; s=socket.socket(); s.bind(("127.0.0.1",0)); print(s.getsockname()[1])')

@@ -14,11 +14,13 @@ cargo test -p ohaca --target host-tuple
 cargo build --release
 cargo build --release --features twin-h743 --target-dir target/twin-h743
 # Host tool (incl. QEMU end-to-end tests, the twin's on 1024 x 1024 and 2048 x 1024 maps),
-# references, properties, shared maps. Release: the shared-map checks plan thousands of times.
-cargo test --release -p ohaca-host -p ohaca-host-tests --target host-tuple
+# references, properties, shared maps. Profile `host` (Cargo.toml): optimised, since the
+# shared-map checks plan thousands of times, without the firmware's fat LTO. It also builds the
+# `ohaca` tool the tests run, target/<host>/host/ohaca, which ros-test.sh below reuses.
+cargo test --profile host -p ohaca-host -p ohaca-host-tests --target host-tuple
 # The firmware's boot log against tests/golden/boot.txt, and the protocol selftest over QEMU.
 scripts/golden-boot.sh --no-build
 scripts/qemu-selftest.sh --no-build
 # `ohaca ros` as a ROS 2 node against Eclipse Cyclone DDS, loopback only: on the QEMU firmware,
 # then on the host core (map, poses, plan, a map update's warm replan, the Nav2 action).
-scripts/ros-test.sh
+scripts/ros-test.sh --no-build
