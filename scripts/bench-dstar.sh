@@ -9,9 +9,9 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 if [ "${1:-}" != --no-build ]; then
-  cargo build --release -q -p ohaca-host --target host-tuple
+  cargo build --profile host -q -p ohaca-host --target host-tuple
 fi
-ohaca="target/$(rustc -vV | sed -n 's/^host: //p')/release/ohaca"
+ohaca="target/$(rustc -vV | sed -n 's/^host: //p')/host/ohaca"
 c26=(--map maps/complex-26.map --start 0,0 --goal 25,25)
 boston=(--map maps/large/Boston_0_256.map --start 184,0 --goal 8,254)
 paris=(--map maps/large/Paris_1_256.map --start 156,255 --goal 18,15)

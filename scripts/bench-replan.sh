@@ -31,9 +31,9 @@ while [ $# -gt 0 ]; do
 done
 if [ "$build" = 1 ]; then
   cargo build --release -q
-  cargo build --release -q -p ohaca-host --target host-tuple
+  cargo build --profile host -q -p ohaca-host --target host-tuple
 fi
-ohaca="target/$(rustc -vV | sed -n 's/^host: //p')/release/ohaca"
+ohaca="target/$(rustc -vV | sed -n 's/^host: //p')/host/ohaca"
 device=()
 defmt=$(mktemp)
 log=$(mktemp)

@@ -35,12 +35,14 @@ step() { printf '\n== %s\n' "$*" >&2; }
 step "setup: Rust target thumbv7em-none-eabihf, qemu-system-arm"
 source scripts/setup.sh
 
-step "build: firmware (release, QEMU board) and the host tool"
-cargo build --release -q
-cargo build --release -q -p ohaca-host --target host-tuple
+# Not quiet: on a fresh clone these two builds take minutes (cargo prints each crate it compiles).
+step "build: firmware (release profile, QEMU board)"
+cargo build --release
+step "build: the host tool (host profile)"
+cargo build --profile host -p ohaca-host --target host-tuple
 target_dir=${CARGO_TARGET_DIR:-target}
 host=$(rustc -vV | sed -n 's/^host: //p')
-ohaca="$target_dir/$host/release/ohaca"
+ohaca="$target_dir/$host/host/ohaca"
 elf="$target_dir/thumbv7em-none-eabihf/release/ohaca"
 [ -x "$ohaca" ] || { echo "error: host tool not found at $ohaca" >&2; exit 1; }
 [ -f "$elf" ] || { echo "error: firmware not found at $elf" >&2; exit 1; }

@@ -10,7 +10,7 @@
 #
 # The firmware never exits by itself (it serves its UART), so QEMU is stopped once the log has as
 # many lines as the golden file and nothing more has arrived for a second (at most 15 s).
-# Installs defmt-print (`cargo install defmt-print --locked`) if it is missing.
+# Installs defmt-print if it is missing (scripts/install-defmt-print.sh: unoptimised, a minute).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -28,10 +28,7 @@ while [ $# -gt 0 ]; do
   esac
 done
 
-if ! command -v defmt-print >/dev/null 2>&1; then
-  echo "installing defmt-print" >&2
-  cargo install defmt-print --locked
-fi
+scripts/install-defmt-print.sh
 command -v qemu-system-arm >/dev/null || { echo "qemu-system-arm not found (scripts/setup.sh)" >&2; exit 2; }
 if [ "$build" = 1 ]; then
   cargo build --release -q

@@ -45,8 +45,8 @@ if [ -n "$baud" ]; then
   # defmt frames) is the relay's stdout. OHACA_BIN=path/to/ohaca uses a built tool instead.
   ohaca="${OHACA_BIN:-}"
   if [ -z "$ohaca" ]; then
-    cargo build --release -q -p ohaca-host --target host-tuple
-    ohaca="target/$(rustc -vV | sed -n 's/^host: //p')/release/ohaca"
+    cargo build --profile host -q -p ohaca-host --target host-tuple
+    ohaca="target/$(rustc -vV | sed -n 's/^host: //p')/host/ohaca"
   fi
   qemu=("$ohaca" relay --baud "$baud" --listen "127.0.0.1:${port}" --elf "$elf" ${icount:+--icount})
 else

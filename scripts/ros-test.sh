@@ -22,9 +22,9 @@ done
 host_target=$(rustc -vV | sed -n 's/^host: //p')
 if [ "$build" = 1 ]; then
   cargo build --release -q
-  cargo build --release -q -p ohaca-host --target "$host_target"
+  cargo build --profile host -q -p ohaca-host --target "$host_target"
 fi
-ohaca="target/$host_target/release/ohaca"
+ohaca="target/$host_target/host/ohaca"
 [ -x "$ohaca" ] || { echo "FAIL: no $ohaca (build it, or drop --no-build)" >&2; exit 1; }
 
 if ! command -v qemu-system-arm >/dev/null; then

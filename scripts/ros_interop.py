@@ -14,7 +14,7 @@ Plays the rest of a ROS 2 system with ROS 2's own DDS names, types and QoS (no R
      rmw_cyclonedds service mapping (request header in the payload): a goal that succeeds with a
      valid path, and one off the map that is aborted with GOAL_OUTSIDE_MAP (204).
 
-    scripts/ros_interop.py --ohaca target/x86_64-unknown-linux-gnu/release/ohaca --host
+    scripts/ros_interop.py --ohaca target/x86_64-unknown-linux-gnu/host/ohaca --host
     scripts/ros_interop.py --ohaca ... --tcp 127.0.0.1:4444     # a device (QEMU)
 
 Exit status 0 only if every check passed; any failure prints `FAIL: ...` and the node's log.

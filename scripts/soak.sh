@@ -35,11 +35,11 @@ target="$(realpath -m "${CARGO_TARGET_DIR:-target}")"  # absolute: the tests run
 cargo build --release
 if [ -n "$baud" ]; then export OHACA_SOAK_BAUD="$baud"; else unset OHACA_SOAK_BAUD; fi
 OHACA_FIRMWARE="$target/thumbv7em-none-eabihf/release/ohaca" OHACA_SOAK_FRAMES="$frames" \
-  cargo test --release -p ohaca-host --target x86_64-unknown-linux-gnu --test qemu_soak \
+  cargo test --profile host -p ohaca-host --target x86_64-unknown-linux-gnu --test qemu_soak \
   -- --nocapture --exact soak_thousands_of_valid_and_broken_frames
 if [ "$rounds" -gt 0 ]; then
   cargo build --release --features twin-h743 --target-dir "$target/twin-h743"
   OHACA_TWIN_FIRMWARE="$target/twin-h743/thumbv7em-none-eabihf/release/ohaca" \
     OHACA_SOAK_SCALE_ROUNDS="$rounds" \
-    cargo test --release -p ohaca-host --target x86_64-unknown-linux-gnu --test qemu_soak_twin -- --nocapture
+    cargo test --profile host -p ohaca-host --target x86_64-unknown-linux-gnu --test qemu_soak_twin -- --nocapture
 fi

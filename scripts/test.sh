@@ -7,18 +7,57 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 source scripts/setup.sh
 
+# Cargo builds one thing at a time in a target directory, so the two builds that have their own
+# run in the background while the rest builds in target/ (on a fresh clone that saves a minute or
+# two of the first run): the STM32H743's QEMU capacity twin (the H743's capacity and RAM regions
+# on the same QEMU board) that host/tests/qemu_twin.rs boots, and defmt-print, if missing, which
+# golden-boot.sh decodes the boot log with (scripts/install-defmt-print.sh). Their output goes to
+# a log that is shown if they fail.
+logs=$(mktemp -d)
+twin_pid=""
+defmt_pid=""
+cleanup() {
+  for p in $twin_pid $defmt_pid; do kill "$p" 2>/dev/null || true; done
+  rm -rf "$logs"
+}
+trap cleanup EXIT
+# join NAME PID: wait for a background build; on failure, show its log and stop.
+join() {
+  if wait "$2"; then
+    echo "$1: built" >&2
+  else
+    echo "FAIL: $1 (background build):" >&2
+    cat "$logs/$1" >&2
+    exit 1
+  fi
+}
+echo "building the H743 twin firmware in the background (target/twin-h743)" >&2
+cargo build --release --features twin-h743 --target-dir target/twin-h743 >"$logs/twin-h743" 2>&1 &
+twin_pid=$!
+if ! command -v defmt-print >/dev/null 2>&1; then
+  echo "installing defmt-print in the background (scripts/install-defmt-print.sh)" >&2
+  scripts/install-defmt-print.sh >"$logs/defmt-print" 2>&1 &
+  defmt_pid=$!
+fi
+
 # The core (planner + protocol): unit tests and doc examples, on the host.
 cargo test -p ohaca --target host-tuple
-# The QEMU firmware the end-to-end tests boot, and the STM32H743's QEMU capacity twin (the
-# H743's capacity and RAM regions on the same QEMU board) that host/tests/qemu_twin.rs boots.
+# The QEMU firmware the end-to-end tests boot.
 cargo build --release
-cargo build --release --features twin-h743 --target-dir target/twin-h743
+join twin-h743 "$twin_pid"
+twin_pid=""
 # Host tool (incl. QEMU end-to-end tests, the twin's on 1024 x 1024 and 2048 x 1024 maps),
-# references, properties, shared maps. Release: the shared-map checks plan thousands of times.
-cargo test --release -p ohaca-host -p ohaca-host-tests --target host-tuple
+# references, properties, shared maps. Profile `host` (Cargo.toml): optimised, since the
+# shared-map checks plan thousands of times, without the firmware's fat LTO. It also builds the
+# `ohaca` tool the tests run, target/<host>/host/ohaca, which ros-test.sh below reuses.
+cargo test --profile host -p ohaca-host -p ohaca-host-tests --target host-tuple
 # The firmware's boot log against tests/golden/boot.txt, and the protocol selftest over QEMU.
+if [ -n "$defmt_pid" ]; then
+  join defmt-print "$defmt_pid"
+  defmt_pid=""
+fi
 scripts/golden-boot.sh --no-build
 scripts/qemu-selftest.sh --no-build
 # `ohaca ros` as a ROS 2 node against Eclipse Cyclone DDS, loopback only: on the QEMU firmware,
 # then on the host core (map, poses, plan, a map update's warm replan, the Nav2 action).
-scripts/ros-test.sh
+scripts/ros-test.sh --no-build

@@ -1,8 +1,8 @@
 //! Per-iteration moves on one large-map scenario, or on a fresh maze (diagnostics).
 //!
 //! ```text
-//! cargo run --release -p ohaca-host-tests --target host-tuple --example diag -- [MAP [K]]
-//! cargo run --release -p ohaca-host-tests --target host-tuple --example diag -- maze:WIDTH[:SIDE] [K]
+//! cargo run --profile host -p ohaca-host-tests --target host-tuple --example diag -- [MAP [K]]
+//! cargo run --profile host -p ohaca-host-tests --target host-tuple --example diag -- maze:WIDTH[:SIDE] [K]
 //! ```
 use ohaca::{Params, Run};
 use ohaca_host_tests::gen::{far_pair, maze};

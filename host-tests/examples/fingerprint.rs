@@ -3,7 +3,7 @@
 //! Diff two runs to see whether a change moved any path (a refactor must not).
 //!
 //! ```text
-//! cargo run --release -p ohaca-host-tests --target host-tuple --example fingerprint > before.txt
+//! cargo run --profile host -p ohaca-host-tests --target host-tuple --example fingerprint > before.txt
 //! ```
 //!
 //! `OHACA_NO_PRUNE=1` turns dead-end pruning off (`Params::prune`). `--large N`: the `N` longest

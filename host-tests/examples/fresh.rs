@@ -3,7 +3,7 @@
 //! the map apart, seeded so every run generates the same maps.
 //!
 //! ```text
-//! cargo run --release -p ohaca-host-tests --target host-tuple --example fresh -- [--maps N] [--seeds N]
+//! cargo run --profile host -p ohaca-host-tests --target host-tuple --example fresh -- [--maps N] [--seeds N]
 //! ```
 //!
 //! Prints, per density: runs, valid, mean and worst raw length over the exact 8-connected optimum,

@@ -1,7 +1,7 @@
 //! Quality of one planner configuration on every shared map, as a Markdown table.
 //!
 //! ```text
-//! cargo run --release -p ohaca-host-tests --target host-tuple --example quality -- \
+//! cargo run --profile host -p ohaca-host-tests --target host-tuple --example quality -- \
 //!     [--algorithm aca|paca|haca|ohaca] [--a A] [--beta B] [--alpha A] [--rho R] [--xi X] [--q Q]
 //!     [--ants M] [--iterations N] [--patience P] [--refine-patience P] [--seeds N] [--dead-end backtrack|die]
 //!     [--smoothing shortest|greedy|none] [--no-tighten]

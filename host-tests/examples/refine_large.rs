@@ -3,7 +3,7 @@
 //! it cost (cells expanded).
 //!
 //! ```text
-//! cargo run --release -p ohaca-host-tests --target host-tuple --example refine_large -- \
+//! cargo run --profile host -p ohaca-host-tests --target host-tuple --example refine_large -- \
 //!     [--maps NAME,NAME,...] [--scen N] [--sides 48,64,128] [--passes P] [--cache DIR] \
 //!     [--smooth 1] [--patience P]
 //! ```

@@ -538,7 +538,7 @@ mod fake_device {
 }
 
 /// Upload sizes of real maps, raw against run-length coded, in bytes on the wire (frames
-/// included) and seconds at 115200 baud: `cargo test --release -p ohaca-host --target
+/// included) and seconds at 115200 baud: `cargo test --profile host -p ohaca-host --target
 /// host-tuple --lib upload_sizes -- --ignored --nocapture` (needs `../shared/maps/large`).
 #[cfg(test)]
 mod upload_sizes {
