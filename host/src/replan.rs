@@ -31,7 +31,7 @@ use std::collections::BinaryHeap;
 use serde::Deserialize;
 
 use ohaca::board::{Board, F411};
-use ohaca::planner::{reuse, Memory, Origin, Run};
+use ohaca::planner::{reuse, Fallback, Memory, Origin, Run};
 use ohaca::{Grid, Params, Point};
 
 use crate::board::BoardStorage;
@@ -158,8 +158,12 @@ pub struct Planned {
     pub moves: u64,
     /// Device ticks (`None` on the host).
     pub ticks: Option<u64>,
-    /// Cold, warm (the run kept the previous colony) or reused (the rest of the previous answer).
+    /// Cold, warm (the run kept the previous colony), reused (the rest of the previous answer)
+    /// or repaired (that with a local detour).
     pub origin: Origin,
+    /// Why a warm plan was not answered without a run ([`ohaca::planner::reuse`]'s reason:
+    /// the host core's; `None` from a device, which does not send it, and for cold plans).
+    pub fallback: Option<Fallback>,
 }
 
 impl Planned {
@@ -174,6 +178,7 @@ impl Planned {
             moves: plan.moves,
             ticks,
             origin: plan.origin,
+            fallback: None,
         }
     }
 }
@@ -272,10 +277,12 @@ impl Planner for HostPlanner {
             .workspace()
             .map_err(|e| e.to_string())?;
         // As the firmware does: a warm replan that no change since can shorten or block is the
-        // rest of the last answer (or its local repair).
+        // rest of the last answer (or its local repair); else the reason, kept for the table.
+        let mut fallback = None;
         if warm {
-            if let Some(plan) = reuse(&grid, start, goal, &self.params, &mut ws, &mut self.memory) {
-                return Ok(Planned::of(&plan, None));
+            match reuse(&grid, start, goal, &self.params, &mut ws, &mut self.memory) {
+                Ok(plan) => return Ok(Planned::of(&plan, None)),
+                Err(why) => fallback = Some(why),
             }
         }
         let mut run = if warm {
@@ -289,7 +296,10 @@ impl Planner for HostPlanner {
         while run.polish_step() {}
         run.keep(&mut self.memory);
         let plan = run.finish().map_err(|e| e.to_string())?;
-        Ok(Planned::of(&plan, None))
+        Ok(Planned {
+            fallback,
+            ..Planned::of(&plan, None)
+        })
     }
 }
 
@@ -326,6 +336,7 @@ impl<T: Transport> Planner for DevicePlanner<T> {
             moves: p.moves,
             ticks: Some(p.ticks),
             origin: p.origin,
+            fallback: None,
         })
     }
 }

@@ -113,18 +113,27 @@ async fn plan(
     // First, a warm plan that no change since can shorten or block is the rest of the last
     // answer: no run at all.
     if job.warm {
-        if let Some(plan) = reuse(&grid, start, goal, params, &mut ws, &mut memory) {
-            state::set_colony(memory);
-            let ticks = Instant::now().saturating_duration_since(t0).as_ticks();
-            defmt::info!(
-                "plan {}: reused, length {}, {} waypoints, {} ticks",
+        match reuse(&grid, start, goal, params, &mut ws, &mut memory) {
+            Ok(plan) => {
+                state::set_colony(memory);
+                let ticks = Instant::now().saturating_duration_since(t0).as_ticks();
+                defmt::info!(
+                    "plan {}: {}, length {}, {} waypoints, {} ticks",
+                    job.id,
+                    plan.origin.name(),
+                    plan.length,
+                    plan.waypoints().len(),
+                    ticks
+                );
+                let ready = ready(job, &plan, ticks, bases, (width, height), frame)?;
+                return Ok((ticks, ready));
+            }
+            // Why the colony runs: the replan could not be answered with the last answer.
+            Err(why) => defmt::info!(
+                "plan {}: not reused: {}",
                 job.id,
-                plan.length,
-                plan.waypoints().len(),
-                ticks
-            );
-            let ready = ready(job, &plan, ticks, bases, (width, height), frame)?;
-            return Ok((ticks, ready));
+                defmt::Display2Format(&why)
+            ),
         }
     }
     let mut run = if job.warm {

@@ -24,7 +24,8 @@
 //! | polish: the local search ([`crate::refine`]) | two slices of [`super::run::REFINE_WORDS`] | the links and the route's words, the links and the tabu set, the tabu set and the route's words, the tabu set halved, the links halved |
 //! | polish: the local search's memo ([`crate::refine::Memo`]) | [`MEMO_RECORDS`] records | the front of the pheromone increments (the smoothing's ring later, the route's stash at the far end) |
 //! | polish: the smoothing ([`crate::smoothing`]) | `n` links for its shortest-path rule (fewer: the greedy rule) | the links, else the tabu set (free after the last ant and the local search) |
-//! | a reused answer's repair ([`super::repair`]) | the local search's scratch (no memo), then the smoothing's links | as in the polish |
+//! | a reused answer's repair ([`super::repair`]): the detour | two slices, as many words as it can get (its box is sized by what blocks the answer, up to what the slices hold; no memo) | the pair of the links, the route's words and the tabu set, or one of them halved, whose shorter slice is longest (the first such in that order on a tie) |
+//! | a reused answer's repair: the smoothing | `n` links, as in the polish | as in the polish |
 //!
 //! Every choice depends only on the buffers' lengths (never on their contents or addresses), so
 //! a host that lays out a device's arena plans exactly what the device plans, and a choice made
@@ -186,6 +187,12 @@ impl Spent<'_> {
         (a, rest.get_mut(..words).unwrap_or_default())
     }
 
+    /// The detour's scratch of a reused answer's repair ([`detour`], the table above): the
+    /// longest two slices the links, the route's words (`guide`) and the tabu set give.
+    pub(super) fn detour<'g>(&'g mut self, guide: &'g mut Guide<'_>) -> Pair<'g> {
+        detour(self.links, guide.reborrow().scratch(), self.tabu)
+    }
+
     /// The smoothing's links for a raw path of `n` cells ([`smoothing`]).
     pub(super) fn smoothing(&mut self, n: usize) -> &mut [u32] {
         smoothing(self.links, self.tabu, n)
@@ -283,6 +290,40 @@ pub(super) fn refine<'x>(
     }
     let (a, b) = tabu.split_at_mut_checked(half)?;
     Some((a, b.get_mut(..half)?))
+}
+
+/// A repair's detour scratch between plans, when the links, the route's words and the tabu set are
+/// all idle: of the pairs (links, route), (links, tabu set), (tabu set, route) and of each of the
+/// three halved, the one whose shorter slice is longest (the first in that order on a tie), both
+/// slices cut to that length; two empty slices when every buffer is empty. It depends on the
+/// three lengths only, so host and device lend the same.
+pub(super) fn detour<'x>(
+    links: &'x mut [u32],
+    guide: &'x mut [u32],
+    tabu: &'x mut [u32],
+) -> Pair<'x> {
+    let (l, g, t) = (links.len(), guide.len(), tabu.len());
+    let sizes = [l.min(g), l.min(t), t.min(g), l / 2, t / 2, g / 2];
+    let mut pick = 0usize;
+    let mut words = 0usize;
+    for (k, &w) in sizes.iter().enumerate() {
+        if w > words {
+            (pick, words) = (k, w);
+        }
+    }
+    let cut = |x: &'x mut [u32]| -> &'x mut [u32] { x.get_mut(..words).unwrap_or_default() };
+    let halves = |x: &'x mut [u32]| -> Pair<'x> {
+        let (a, b) = x.split_at_mut(words.min(x.len()));
+        (a, b.get_mut(..words).unwrap_or_default())
+    };
+    match pick {
+        0 => (cut(links), cut(guide)),
+        1 => (cut(links), cut(tabu)),
+        2 => (cut(tabu), cut(guide)),
+        3 => halves(links),
+        4 => halves(tabu),
+        _ => halves(guide),
+    }
 }
 
 /// Words [`refine`] needs in the links beside a tabu set of `tabu` words (and a route of fewer
@@ -383,5 +424,33 @@ mod tests {
                 assert_eq!(s >= n, links >= smoothing_links(tabu, n), "{tabu} {links}");
             }
         }
+    }
+
+    #[test]
+    fn a_detour_gets_the_longest_pair_the_idle_buffers_give() {
+        // Every pairing against a brute force over the six ways: both slices as long as the best
+        // way's shorter one, and disjoint (two `&mut` borrows of one buffer cannot overlap).
+        for l in [0usize, 1, 7, 100, 4056, 4096] {
+            for g in [0usize, 512, 4096] {
+                for t in [0usize, 2048, 5795, 8192] {
+                    let (mut a, mut b, mut c) = (vec![0u32; l], vec![0u32; g], vec![0u32; t]);
+                    let best = [l.min(g), l.min(t), t.min(g), l / 2, t / 2, g / 2]
+                        .into_iter()
+                        .max()
+                        .unwrap();
+                    let (x, y) = detour(&mut a, &mut b, &mut c);
+                    assert_eq!((x.len(), y.len()), (best, best), "{l} {g} {t}");
+                }
+            }
+        }
+        // The F411's layouts: the full one (links and route words, 4,096 each) and the compact
+        // one at 512 x 512 (its tabu set halved) and at Nav2's depot (the links and the tabu set).
+        let sizes = |l, g, t| {
+            let (mut a, mut b, mut c) = (vec![0u32; l], vec![0u32; g], vec![0u32; t]);
+            detour(&mut a, &mut b, &mut c).0.len()
+        };
+        assert_eq!(sizes(4096, 4096, 2048), 4096);
+        assert_eq!(sizes(2048, 512, 8192), 4096);
+        assert_eq!(sizes(4056, 512, 5795), 4056);
     }
 }

@@ -23,8 +23,8 @@
 //! | `plan` | [`Plan`], [`RawPath`], [`CurvePoint`]: the result |
 //! | `placed` | [`Placed`], [`Bases`]: where a plan lies in its workspace, to read it again later (the firmware's path parts) |
 //! | `warm` | [`Memory`], [`Area`]: warm starts after map changes, and the pheromone repair |
-//! | `reuse` | [`reuse`]: a replan answered with the rest of the last answer, when no change can block or shorten it |
-//! | `repair` | the rest of the last answer with an exact detour around what blocks it ([`longest_detour`]), reached through [`reuse`] |
+//! | `reuse` | [`reuse`]: a replan answered with the rest of the last answer, when no change can block or shorten it; else why not ([`Fallback`]) |
+//! | `repair` | the rest of the last answer with an exact detour around what blocks it, in a box sized by the change ([`longest_detour`]), reached through [`reuse`]; else why not ([`GiveUp`]) |
 //! | [`arena`] | [`arena::carve`]: a map and a workspace laid out in one arena, per map size |
 //!
 //! [`Run::step`] does one iteration, so the firmware can yield to its executor between iterations
@@ -44,8 +44,8 @@ mod workspace;
 pub use params::{Algorithm, Params};
 pub use placed::{Bases, Placed};
 pub use plan::{CurvePoint, Origin, Plan, RawPath};
-pub use repair::{longest_detour, MARGIN as REPAIR_MARGIN};
-pub use reuse::reuse;
+pub use repair::{longest_detour, GiveUp, BOX_MARGIN, MARGIN as REPAIR_MARGIN, PLACE_RADIUS};
+pub use reuse::{reuse, Fallback};
 pub use run::{settled, Run, REFINE_GAIN};
 pub use warm::{Area, Memory, BLOCKED, FREED, REPAIR_RADIUS};
 #[cfg(any(feature = "alloc", test))]

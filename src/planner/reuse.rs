@@ -13,8 +13,8 @@
 //! 2. **Nothing blocks it**: every move of the raw rest is allowed on the map as it is now
 //!    ([`Grid::step`]: free cells, no corner cut) and every segment of the waypoints is clear
 //!    ([`segment_clear`]). So a cell blocked since the answer was planned is off it, or the
-//!    answer is not reused: it goes to [`super::repair`] (a local detour, large maps) and, if
-//!    that gives up, to the colony.
+//!    answer is not reused: it goes to [`super::repair`] (a local detour) and, if that gives up,
+//!    to the colony.
 //! 3. **No cleared cell can shorten it**: for every rectangle `R` of cells cleared since the
 //!    answer was planned, `d(s, R) + d(R, g)` is at least the answer's length, for the octile
 //!    distance against the raw length and the Euclidean distance to `R`'s squares against the
@@ -34,8 +34,14 @@
 //! instructions a path cell, no colony, no pruning, no route; the colony's memory is untouched,
 //! so the next warm run still repairs around every change since the colony last ran.
 //!
+//! **When it does not**: [`reuse`] returns why ([`Fallback`]: no answer for this goal, the robot
+//! off it, a cleared cell that may shorten it, or the repair's [`GiveUp`] reason); the firmware
+//! logs it and `ohaca replan` prints it, and the caller runs the warm colony.
+//!
 //! Host and device call the same function on the same workspace layout, so a reused answer is
 //! the same bit for bit on both. Panic-free like the rest of the core: indices are checked.
+
+use core::fmt;
 
 use crate::geometry::{bend, distance, segment_clear, steps_length};
 use crate::grid::{is_diagonal, neighbour, Dir, Grid, Point};
@@ -43,14 +49,43 @@ use crate::smoothing::SmoothingKind;
 
 use super::params::{Algorithm, Params};
 use super::plan::{Origin, Plan};
+use super::repair::GiveUp;
 use super::warm::{Answer, Memory};
 use super::workspace::Workspace;
 
+/// Why [`reuse`] did not answer a replan without a run (the caller then runs the colony, warm).
+/// Small, `Copy`, `Display`; `defmt::Format` with the `defmt` feature.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Fallback {
+    /// No answer is kept for this map, goal and parameters (no plan since the map was set, another
+    /// goal or other parameters), or the robot is on the goal.
+    NoAnswer,
+    /// The robot's cell is not a cell of the answer's raw path (rule 1).
+    OffAnswer,
+    /// A cell cleared since the answer was planned may shorten it (rule 3).
+    MayShorten,
+    /// Something blocks the answer (rule 2) and its repair gave up ([`super::repair`]).
+    Repair(GiveUp),
+}
+
+impl fmt::Display for Fallback {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Fallback::NoAnswer => f.write_str("no answer kept for this goal"),
+            Fallback::OffAnswer => f.write_str("the robot is off the answer"),
+            Fallback::MayShorten => f.write_str("a cleared cell may shorten the answer"),
+            Fallback::Repair(g) => write!(f, "the repair gave up: {g}"),
+        }
+    }
+}
+
 /// The rest of the last answer to `goal` from the robot's cell `start`, when `memory` says the
 /// workspace holds one planned with `params` (any seed) on a map of this size, and no change
-/// since can block or shorten it (see the module docs); `None` otherwise, and the caller plans
-/// (warm). On success the memory's answer becomes the returned one (the next replan starts from
-/// it), and the plan's [`Plan::origin`] is [`Origin::Reused`]: no iterations, no moves.
+/// since can block or shorten it (see the module docs), or its repair around what blocks it
+/// ([`Origin::Repaired`]); otherwise why not ([`Fallback`]), and the caller plans (warm). On
+/// success the memory's answer becomes the returned one (the next replan starts from it), and
+/// the plan's [`Plan::origin`] is [`Origin::Reused`] (or `Repaired`): no iterations, no moves.
 ///
 /// `ws` must be the workspace the last run planned in, laid out the same way (the firmware's
 /// storage, the host's arena or heap storage for the same map), unchanged since but for the map.
@@ -61,18 +96,19 @@ pub fn reuse<'a>(
     params: &Params,
     ws: &'a mut Workspace<'_>,
     memory: &mut Memory,
-) -> Option<Plan<'a>> {
+) -> Result<Plan<'a>, Fallback> {
+    use Fallback::{NoAnswer, OffAnswer};
     if !memory.is_warm_for(grid.width(), grid.height(), goal) || start == goal {
-        return None;
+        return Err(NoAnswer);
     }
-    let answer = memory.answer?;
+    let answer = memory.answer.ok_or(NoAnswer)?;
     if answer.params != (Params { seed: 0, ..*params }) {
-        return None;
+        return Err(NoAnswer);
     }
     let (from, steps) = (idx(answer.from), idx(answer.steps));
     let (first, end) = (idx(answer.first), idx(answer.end));
     // 1. The robot's cell on the raw path.
-    let tour: &[Dir] = ws.best.get(from..steps)?;
+    let tour: &[Dir] = ws.best.get(from..steps).ok_or(NoAnswer)?;
     let mut p = answer.start;
     let mut at = None;
     for (i, &d) in tour.iter().enumerate() {
@@ -82,10 +118,10 @@ pub fn reuse<'a>(
         }
         p = neighbour(p, d);
     }
-    let at = at?;
+    let at = at.ok_or(OffAnswer)?;
     // The waypoints after the segment nearest the robot.
-    let wps: &[Point] = ws.points.get(first..end)?;
-    let mut entry = nearest_segment(wps, start)?;
+    let wps: &[Point] = ws.points.get(first..end).ok_or(NoAnswer)?;
+    let mut entry = nearest_segment(wps, start).ok_or(NoAnswer)?;
     // Dropped when the robot's cell, it and the next are collinear (straight on).
     if let (Some(&a), Some(&b)) = (wps.get(entry), wps.get(entry.wrapping_add(1))) {
         let (cross, dot) = bend(start, a, b);
@@ -94,7 +130,7 @@ pub fn reuse<'a>(
         }
     }
     // 2. The rest of the raw path, move by move on the map as it is now ...
-    let rest = tour.get(at..)?;
+    let rest = tour.get(at..).ok_or(OffAnswer)?;
     let (mut straight, mut diagonal) = (0u32, 0u32);
     let mut p = Some(start);
     for &d in rest {
@@ -111,7 +147,7 @@ pub fn reuse<'a>(
     let mut prev = start;
     let mut polyline = 0.0f32;
     let mut clear = p == Some(goal);
-    for &w in wps.get(entry..)? {
+    for &w in wps.get(entry..).ok_or(NoAnswer)? {
         if !clear || !segment_clear(grid, prev, w) {
             clear = false;
             break;
@@ -120,8 +156,9 @@ pub fn reuse<'a>(
         prev = w;
     }
     if !clear {
-        // Blocked: repaired around what blocks it on large maps, else planned.
-        return super::repair::repair(grid, start, goal, params, ws, memory, answer, at, entry);
+        // Blocked: repaired around what blocks it, else planned.
+        return super::repair::repair(grid, start, goal, params, ws, memory, answer, at, entry)
+            .map_err(Fallback::Repair);
     }
     // 3. The lengths, against every cleared rectangle's lower bounds.
     let raw_length = steps_length(straight, diagonal);
@@ -129,23 +166,23 @@ pub fn reuse<'a>(
     let smoothed = params.algorithm == Algorithm::Ohaca && params.smoothing != SmoothingKind::None;
     let length = if smoothed { polyline } else { raw_length };
     if !memory.cannot_shorten(start, goal, raw_length, length) {
-        return None;
+        return Err(Fallback::MayShorten);
     }
     // The robot's cell goes into the slot before the entry: a waypoint it has passed.
-    let k0 = first.wrapping_add(entry).checked_sub(1)?;
-    *ws.points.get_mut(k0)? = start;
+    let k0 = first.wrapping_add(entry).checked_sub(1).ok_or(NoAnswer)?;
+    *ws.points.get_mut(k0).ok_or(NoAnswer)? = start;
     memory.answer = Some(Answer {
         start,
-        from: u32::try_from(from.wrapping_add(at)).ok()?,
+        from: u32::try_from(from.wrapping_add(at)).map_err(|_| NoAnswer)?,
         steps: answer.steps,
-        first: u32::try_from(k0).ok()?,
+        first: u32::try_from(k0).map_err(|_| NoAnswer)?,
         end: answer.end,
         params: answer.params,
     });
     let Workspace { best, points, .. } = ws;
-    let tour: &'a [Dir] = best.get(from.wrapping_add(at)..steps)?;
-    let waypoints: &'a [Point] = points.get(k0..end)?;
-    Some(Plan::without_run(
+    let tour: &'a [Dir] = best.get(from.wrapping_add(at)..steps).ok_or(NoAnswer)?;
+    let waypoints: &'a [Point] = points.get(k0..end).ok_or(NoAnswer)?;
+    Ok(Plan::without_run(
         (start, tour, waypoints),
         (raw_length, length),
         Origin::Reused,

@@ -666,41 +666,32 @@ impl Refiner {
     }
 }
 
-/// The exact shortest 8-connected path from `from` to `to` inside a box around the cells
-/// `lo..=hi` (a bounding box: `lo` its top-left, `hi` its bottom-right corner, both ends inside),
-/// grown by `margin` cells and then into whatever else `scratch` holds (as a local search window
-/// is, [`MAX_SIDE`] a side at most, clipped to the map). Writes its cells, `from` first and `to`
-/// last, to `out` and returns how many; `None` when the box does not fit the scratch, no path
-/// inside it exists, or `out` is too short. Used by [`crate::planner::reuse`] to repair a kept
-/// answer around a new obstacle ([`crate::planner`]'s `repair`).
+/// The exact shortest 8-connected path from `from` to `to` inside the box of cells `lo..=hi`
+/// (`lo` its top-left, `hi` its bottom-right corner, both on the map, `from` and `to` inside;
+/// at most [`MAX_SIDE`] a side and [`Scratch::cells`] cells). Writes its cells, `from` first and
+/// `to` last, to `out` and returns how many; `None` when the box is not such a box, no path inside
+/// it exists, or `out` is too short (then `out` is left as it was). The box is the caller's: a
+/// reused answer's repair sizes it by what blocks the answer ([`crate::planner`]'s `repair`).
 pub(crate) fn detour(
     grid: &Grid<'_>,
     from: Point,
     to: Point,
     (lo, hi): (Point, Point),
-    margin: usize,
     scratch: &mut Scratch<'_>,
     out: &mut [Point],
 ) -> Option<usize> {
-    let shape = Shape {
-        cells: scratch.cells(),
-        margin,
-        min_side: 1,
-        map_w: usize::from(grid.width()),
-        map_h: usize::from(grid.height()),
-    };
-    let ex = usize::from(hi.x.checked_sub(lo.x)?).saturating_add(1);
-    let ey = usize::from(hi.y.checked_sub(lo.y)?).saturating_add(1);
-    if !shape.fits(ex, ey) {
+    if hi.x >= grid.width() || hi.y >= grid.height() {
         return None;
     }
-    let (bw, bh) = shape.dims(ex, ey);
     let bbox = Box2 {
-        x0: place(lo.x, ex, shape.map_w, bw),
-        y0: place(lo.y, ey, shape.map_h, bh),
-        w: bw,
-        h: bh,
+        x0: lo.x,
+        y0: lo.y,
+        w: usize::from(hi.x.checked_sub(lo.x)?).saturating_add(1),
+        h: usize::from(hi.y.checked_sub(lo.y)?).saturating_add(1),
     };
+    if bbox.w > MAX_SIDE || bbox.h > MAX_SIDE {
+        return None;
+    }
     search(grid, &bbox, from, to, scratch, &mut Budget::unlimited())?;
     let ti = bbox.local(to)?;
     // Count the steps back to `from` (at most one per box cell), then write them back to front.

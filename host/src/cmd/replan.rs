@@ -100,6 +100,9 @@ struct Row {
     blocked: bool,
     warm: bool,
     origin: &'static str,
+    /// Why a warm plan was not answered without a run (the host core's reason).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    fallback: Option<String>,
     iterations: u16,
     moves: u64,
     ticks: Option<u64>,
@@ -134,6 +137,7 @@ fn rows(mode: &'static str, d: &Drive) -> Vec<Row> {
             blocked: s.blocked,
             warm: s.plan.origin.is_warm(),
             origin: s.plan.origin.name(),
+            fallback: s.plan.fallback.map(|f| f.to_string()),
             iterations: s.plan.iterations,
             moves: s.plan.moves,
             ticks: s.plan.ticks,
@@ -235,6 +239,9 @@ fn table(rows: &[Row]) -> String {
             opt,
             ratio
         );
+        if let Some(why) = &r.fallback {
+            out += &format!("{:<12}not reused: {why}\n", "");
+        }
     }
     out
 }

@@ -273,6 +273,7 @@ impl<T: Transport> Backend for DeviceBackend<T> {
             moves: p.moves,
             ticks: Some(p.ticks),
             origin: p.origin,
+            fallback: None,
         })
     }
 }
