@@ -4,11 +4,12 @@
 //! independent references (`reference::opt8`, `reference::any_angle`, `reference::segment_clear`,
 //! `reference::step_allowed`), on hand-made maps and as a property over random maps and changes.
 
+use ohaca::board::{Layout, F411};
 use ohaca::heap::HeapStorage;
-use ohaca::planner::{reuse, Memory, Origin, Run};
+use ohaca::planner::{arena, reuse, Fallback, GiveUp, Memory, Origin, Run};
 use ohaca::{Params, Point};
 use ohaca_host_tests::gen;
-use ohaca_host_tests::maps::Map;
+use ohaca_host_tests::maps::{maps_dir, Map};
 use ohaca_host_tests::reference::{any_angle, opt8, segment_clear, step_allowed};
 use proptest::prelude::*;
 use proptest::strategy::ValueTree;
@@ -22,13 +23,30 @@ struct Answer {
     length: f32,
     origin: Origin,
     moves: u64,
+    /// Why a warm plan was not answered without a run.
+    fallback: Option<Fallback>,
 }
+
+/// Where a robot's planner keeps its buffers between plans.
+enum Storage {
+    /// Every buffer for the map (the host's own storage).
+    Heap(Box<HeapStorage>),
+    /// The STM32F411's arena, laid out per map as its firmware does (`arena::carve`): the full
+    /// layout on maps of up to 68,256 cells, the compact one beyond.
+    F411(Vec<u32>),
+}
+
+/// The STM32F411's arena, in words.
+const F411_WORDS: usize = match F411.layout {
+    Layout::Arena { words } => words,
+    Layout::Separate { .. } => 0,
+};
 
 /// A robot's planner on the host core: the map, one storage for every plan (as the device's),
 /// the colony memory, told every change as the firmware tells it.
 struct Robot {
     map: Map,
-    storage: HeapStorage,
+    storage: Storage,
     memory: Memory,
     params: Params,
     goal: Point,
@@ -39,10 +57,34 @@ impl Robot {
         let storage = HeapStorage::for_run(map.cells(), &params).expect("storage");
         Robot {
             map,
-            storage,
+            storage: Storage::Heap(Box::new(storage)),
             memory: Memory::new(),
             params,
             goal,
+        }
+    }
+
+    /// A robot planning as the STM32F411 does: in its arena, with its path bound.
+    fn f411(map: Map, goal: Point, params: Params) -> Robot {
+        Robot {
+            map,
+            storage: Storage::F411(vec![0; F411_WORDS]),
+            memory: Memory::new(),
+            params,
+            goal,
+        }
+    }
+
+    /// True if the map takes the F411's compact layout.
+    fn compact(&mut self) -> bool {
+        let cells = self.map.cells();
+        match &mut self.storage {
+            Storage::Heap(_) => false,
+            Storage::F411(words) => {
+                arena::carve(words, cells, F411.max_steps)
+                    .expect("the F411 takes the map")
+                    .compact
+            }
         }
     }
 
@@ -58,7 +100,15 @@ impl Robot {
     /// `PlanWarm` (`warm`) or `Plan` from `start`, as the firmware answers it.
     fn plan(&mut self, start: Point, warm: bool) -> Option<Answer> {
         let grid = self.map.grid();
-        let mut ws = self.storage.workspace();
+        let cells = self.map.cells();
+        let mut ws = match &mut self.storage {
+            Storage::Heap(h) => h.workspace(),
+            Storage::F411(words) => {
+                arena::carve(words, cells, F411.max_steps)
+                    .expect("the F411 takes the map")
+                    .workspace
+            }
+        };
         let own = |p: &ohaca::Plan<'_>| Answer {
             raw: p.raw().collect(),
             waypoints: p.waypoints().to_vec(),
@@ -66,9 +116,11 @@ impl Robot {
             length: p.length,
             origin: p.origin,
             moves: p.moves,
+            fallback: None,
         };
+        let mut fallback = None;
         if warm {
-            if let Some(p) = reuse(
+            match reuse(
                 &grid,
                 start,
                 self.goal,
@@ -76,7 +128,8 @@ impl Robot {
                 &mut ws,
                 &mut self.memory,
             ) {
-                return Some(own(&p));
+                Ok(p) => return Some(own(&p)),
+                Err(why) => fallback = Some(why),
             }
         }
         let mut run = if warm {
@@ -88,7 +141,10 @@ impl Robot {
         while run.step() {}
         while run.polish_step() {}
         run.keep(&mut self.memory);
-        run.finish().ok().map(|p| own(&p))
+        run.finish().ok().map(|p| Answer {
+            fallback,
+            ..own(&p)
+        })
     }
 }
 
@@ -188,7 +244,7 @@ fn a_blocked_cell_on_the_path_or_a_segment_is_never_reused() {
     let ahead = first.raw[first.raw.len() / 2];
     r1.change(&[ahead], true);
     let a = r1.plan(first.raw[2], true).expect("replan");
-    assert_eq!(a.origin, Origin::Warm);
+    assert_ne!(a.origin, Origin::Reused, "{ahead:?} blocks the raw path");
     assert_valid(&r1.map, &a, first.raw[2], g);
     // A cell a smoothed segment touches while every move of the raw path stays allowed: only
     // the segment test can see it.
@@ -459,4 +515,210 @@ fn the_property_sees_reused_answers() {
         reused >= cases / 8,
         "only {reused} of {cases} replans reused"
     );
+}
+
+/// `cells` cells across `path` (free ones, never `path[at]` or the goal), centred `ahead` path
+/// cells after `path[at]`: `ohaca replan`'s `wall_ahead`.
+fn wall_ahead(map: &Map, path: &[Point], at: usize, cells: i64, ahead: usize) -> Vec<Point> {
+    let goal = *path.last().unwrap();
+    let centre = (at + ahead).min(path.len() - 2).max(at + 1);
+    let (c0, c1) = (path[centre], path[centre + 1]);
+    let (dx, dy) = (
+        i64::from(c1.x) - i64::from(c0.x),
+        i64::from(c1.y) - i64::from(c0.y),
+    );
+    (-(cells / 2)..cells - cells / 2)
+        .map(|k| (i64::from(c0.x) - k * dy, i64::from(c0.y) + k * dx))
+        .filter(|&(x, y)| map.free(x, y))
+        .map(|(x, y)| Point::new(x as u16, y as u16))
+        .filter(|&p| p != goal && p != path[at])
+        .collect()
+}
+
+/// A replan after a change, as the tests read it.
+#[derive(Debug)]
+struct Replan {
+    origin: Origin,
+    fallback: Option<Fallback>,
+    /// Raw length over the exact 8-connected optimum on the map of its time.
+    ratio: f64,
+}
+
+/// Issue 36's scenario on the STM32F411's arena: a plan from `s` to `g`, then a wall of 11 cells
+/// dropped 8 path cells ahead of the robot a quarter of the way along, then one of 5 cells 4
+/// ahead halfway along what is left (`scenarios/two-walls.json`); each replan warm and checked.
+fn two_walls(map: Map, s: Point, g: Point, compact: bool) -> Vec<Replan> {
+    let mut robot = Robot::f411(map, g, Params::default());
+    assert_eq!(robot.compact(), compact);
+    let mut path = robot.plan(s, true).expect("first plan").raw;
+    let mut out = Vec::new();
+    for (at, cells, ahead) in [(0.25, 11, 8), (0.5, 5, 4)] {
+        let to = ((at * (path.len() - 1) as f64).round() as usize).min(path.len() - 2);
+        let here = path[to];
+        let wall = wall_ahead(&robot.map, &path, to, cells, ahead);
+        assert!(!wall.is_empty());
+        robot.change(&wall, true);
+        let a = robot.plan(here, true).expect("replan");
+        assert_valid(&robot.map, &a, here, g);
+        let opt = opt8(&robot.map, here, g).expect("reachable");
+        out.push(Replan {
+            origin: a.origin,
+            fallback: a.fallback,
+            ratio: f64::from(a.raw_length) / opt,
+        });
+        path = a.raw;
+    }
+    out
+}
+
+/// Every replan repaired, within `bound` of the optimum.
+fn assert_repaired(what: &str, replans: &[Replan], bound: f64) {
+    for (i, r) in replans.iter().enumerate() {
+        assert_eq!(r.origin, Origin::Repaired, "{what}, wall {i}: {r:?}");
+        assert_eq!(r.fallback, None);
+        assert!(r.ratio <= bound, "{what}, wall {i}: {r:?}");
+    }
+}
+
+#[test]
+fn boston_s_walls_are_repaired_in_the_f411_s_arena() {
+    // 65,536 cells: the full layout. Before the detour's box was sized by the change, the 11-cell
+    // wall's blocked smoothed segment made a stretch of 98 raw cells, a box of 108 x 112 cells
+    // around it, and the warm colony ran.
+    let map = Map::load(maps_dir().join("large/Boston_0_256.map")).unwrap();
+    let r = two_walls(map, Point::new(184, 0), Point::new(8, 254), false);
+    assert_repaired("Boston_0_256", &r, 1.03);
+}
+
+#[test]
+fn newyork_s_walls_are_repaired_in_the_compact_layout() {
+    // 262,144 cells: the compact layout. Its waypoints lie up to 3 cells off the raw path (the
+    // taut pull); placing them within a cell of it gave up, and the warm colony ran.
+    let map = Map::load(maps_dir().join("large/NewYork_0_512.map")).unwrap();
+    let r = two_walls(map, Point::new(509, 443), Point::new(0, 9), true);
+    assert_repaired("NewYork_0_512", &r, 1.03);
+}
+
+/// `map` with every cell within `r` cells (Euclidean, centre to centre) of an obstacle blocked:
+/// `ohaca plan --inflate` on a map without a resolution.
+fn inflated(map: &Map, r: i64) -> Map {
+    let mut out = map.clone();
+    for i in 0..map.cells() {
+        let p = map.point(i);
+        if map.is_free(p) {
+            continue;
+        }
+        for dy in -r..=r {
+            for dx in -r..=r {
+                let (x, y) = (i64::from(p.x) + dx, i64::from(p.y) + dy);
+                if dx * dx + dy * dy <= r * r && map.free(x, y) {
+                    out.set(Point::new(x as u16, y as u16), true);
+                }
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn the_depot_s_walls_are_repaired_in_the_compact_layout() {
+    // Nav2's depot at 5 cm (604 x 307, 185,428 cells: the compact layout) inflated by 0.2 m
+    // (4 cells), three corner-to-corner pairs. Its open floor gives long smoothed segments: a
+    // wall on one blocked a stretch of 113 to 225 raw cells, too long for the box, and the warm
+    // colony ran.
+    let map = inflated(&Map::load(maps_dir().join("depot.map")).unwrap(), 4);
+    for (s, g) in [
+        ((11, 9), (592, 296)),
+        ((592, 6), (12, 296)),
+        ((12, 296), (592, 6)),
+    ] {
+        let (s, g) = (Point::new(s.0, s.1), Point::new(g.0, g.1));
+        let r = two_walls(map.clone(), s, g, true);
+        assert_repaired(&format!("depot {s:?} -> {g:?}"), &r, 1.03);
+    }
+}
+
+/// 160 x 160 open cells.
+fn open_square() -> Map {
+    Map::empty(160, 160)
+}
+
+#[test]
+fn a_blocked_stretch_longer_than_the_box_falls_back_and_says_why() {
+    // A diagonal run of 70 path cells blocked: the anchors' bounding box is about 94 cells a
+    // side, far more than the 2,730 cells the F411 lends a detour.
+    let (s, g) = (Point::new(5, 5), Point::new(154, 154));
+    let mut robot = Robot::f411(open_square(), g, Params::default());
+    let first = robot.plan(s, true).expect("first plan");
+    let here = first.raw[10];
+    robot.change(&first.raw[40..110], true);
+    let a = robot.plan(here, true).expect("planned");
+    assert_eq!(a.origin, Origin::Warm);
+    assert_valid(&robot.map, &a, here, g);
+    match a.fallback {
+        Some(Fallback::Repair(GiveUp::TooLong { needs, room })) => {
+            assert!(needs > room, "{needs} {room}");
+            assert_eq!(room, 2730, "two slices of 4,096 words: 2,730 box cells");
+        }
+        other => panic!("{other:?}"),
+    }
+    assert_eq!(
+        a.fallback.unwrap().to_string(),
+        format!(
+            "the repair gave up: the blocked stretch needs a box of {} cells, the scratch holds 2730",
+            match a.fallback {
+                Some(Fallback::Repair(GiveUp::TooLong { needs, .. })) => needs,
+                _ => 0,
+            }
+        )
+    );
+}
+
+#[test]
+fn the_box_grows_with_the_obstacle() {
+    // A wall of 31 cells across a straight path: the first box (the anchors' 25 cells grown by
+    // 6 a side) is 13 cells across and holds no way around it; the box doubles its margin until
+    // it does (here to the widest that fits the scratch, 39 cells across).
+    let (s, g) = (Point::new(5, 80), Point::new(154, 80));
+    let mut robot = Robot::f411(open_square(), g, Params::default());
+    let first = robot.plan(s, true).expect("first plan");
+    let at = first.raw.iter().position(|p| p.x == 40).unwrap();
+    let wall = wall_ahead(&robot.map, &first.raw, at, 31, 30);
+    assert_eq!(wall.len(), 31);
+    robot.change(&wall, true);
+    let here = first.raw[at];
+    let a = robot.plan(here, true).expect("replan");
+    assert_eq!(a.origin, Origin::Repaired, "{:?}", a.fallback);
+    assert_valid(&robot.map, &a, here, g);
+    let opt = opt8(&robot.map, here, g).unwrap();
+    assert!(
+        f64::from(a.raw_length) <= opt * 1.03,
+        "{} {opt}",
+        a.raw_length
+    );
+    // A wall the largest box cannot pass: no detour, and the reason.
+    let mut robot = Robot::f411(open_square(), g, Params::default());
+    robot.plan(s, true).unwrap();
+    let wall = wall_ahead(&robot.map, &first.raw, at, 61, 30);
+    robot.change(&wall, true);
+    let a = robot.plan(here, true).expect("planned");
+    assert_eq!(a.fallback, Some(Fallback::Repair(GiveUp::NoDetour)));
+    assert_valid(&robot.map, &a, here, g);
+}
+
+#[test]
+fn the_fallback_says_why_the_colony_runs() {
+    let (s, g) = (Point::new(2, 2), Point::new(37, 2));
+    let mut robot = Robot::new(door_map(), g, Params::default());
+    let first = robot.plan(s, true).expect("first plan");
+    assert_eq!(first.fallback, Some(Fallback::NoAnswer), "no colony yet");
+    let off = Point::new(2, 12);
+    assert!(!first.raw.contains(&off));
+    let a = robot.plan(off, true).unwrap();
+    assert_eq!(a.fallback, Some(Fallback::OffAnswer));
+    // A gap near the top of the wall: a shorter way (rule 3).
+    robot.change(&[Point::new(20, 3)], false);
+    let b = robot.plan(a.raw[1], true).unwrap();
+    assert_eq!(b.fallback, Some(Fallback::MayShorten));
+    assert_eq!(b.origin, Origin::Warm);
 }
