@@ -35,7 +35,7 @@ pub enum Origin {
     Reused,
     /// `3`: no run: the rest of the previous answer with a local detour around what blocks it
     /// (exact A* in a box, smoothed again), checked whole on the map as it is now and against
-    /// every cleared cell ([`super::reuse`], large maps).
+    /// every cleared cell ([`super::reuse`], any map; the box sized by what blocks it).
     Repaired,
 }
 
