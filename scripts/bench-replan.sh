@@ -8,7 +8,8 @@
 # (`maps/depot-r20.map`), driven by `ohaca replan --compare` over the emulated UART for seeds
 # 1..=N. Prints a Markdown table: the replan's instructions (ticks x 1000), iterations and raw
 # length over the exact optimum, warm and cold; with defmt-print installed also each plan's split
-# (the firmware's log: `Run::new` / the iterations / `finish`, mean; "reused" answers have none).
+# (the firmware's log: `Run::new` / the iterations / `finish`, mean; "reused" and "repaired"
+# answers have none).
 #
 #   scripts/bench-replan.sh [--no-build] [--seeds 3] [--host | --board f411] [--only NAME]...
 #
@@ -95,7 +96,7 @@ fi
 python3 - "$out" "$host" "$log" <<'PY'
 import json, re, sys, statistics as st
 # The firmware's line for each plan, in order: its ticks and, for a run, its split.
-pat = re.compile(r"plan \d+: (?:reused|\d+ iterations), length \S+, \d+ waypoints, (\d+) ticks"
+pat = re.compile(r"plan \d+: (?:reused|repaired|\d+ iterations), length \S+, \d+ waypoints, (\d+) ticks"
                  r"(?: \(new (\d+), steps (\d+), finish (\d+)\))?")
 logged = [tuple(int(g) if g else None for g in m.groups()) for m in pat.finditer(open(sys.argv[3]).read())]
 every = [p for line in open(sys.argv[1]) for p in json.loads(line.split("\t", 1)[1])]

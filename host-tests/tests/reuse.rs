@@ -545,14 +545,14 @@ struct Replan {
 }
 
 /// Issue 36's scenario on the STM32F411's arena: a plan from `s` to `g`, then a wall of 11 cells
-/// dropped 8 path cells ahead of the robot a quarter of the way along, then one of 5 cells 4
+/// dropped 8 path cells ahead of the robot a third of the way along, then one of 5 cells 4
 /// ahead halfway along what is left (`scenarios/two-walls.json`); each replan warm and checked.
 fn two_walls(map: Map, s: Point, g: Point, compact: bool) -> Vec<Replan> {
     let mut robot = Robot::f411(map, g, Params::default());
     assert_eq!(robot.compact(), compact);
     let mut path = robot.plan(s, true).expect("first plan").raw;
     let mut out = Vec::new();
-    for (at, cells, ahead) in [(0.25, 11, 8), (0.5, 5, 4)] {
+    for (at, cells, ahead) in [(0.33, 11, 8), (0.5, 5, 4)] {
         let to = ((at * (path.len() - 1) as f64).round() as usize).min(path.len() - 2);
         let here = path[to];
         let wall = wall_ahead(&robot.map, &path, to, cells, ahead);
