@@ -10,8 +10,9 @@
 //! 1. **What blocks it**: the raw offsets of the first and last invalid move of the raw rest, and
 //!    the blocked waypoint segments. Each waypoint is placed on a raw cell, in order: the nearest
 //!    of the raw path's first visit to within [`PLACE_RADIUS`] cells of it (the taut pull moves
-//!    waypoints off the raw cells by up to a cell a pass); one that is not gives up
-//!    ([`GiveUp::Unplaced`]).
+//!    waypoints off the raw cells by up to a cell a pass); the first one after the robot that the
+//!    raw path ahead never comes near is one the robot has passed (placed on its cell and smoothed
+//!    again); any other that is not gives up ([`GiveUp::Unplaced`]).
 //! 2. **The anchors**: [`MARGIN`] raw cells before the first blocked move and after the last,
 //!    clamped to the robot's cell and the goal. A blocked segment whose raw cells are all free
 //!    needs no anchors: the raw path stays, and only its waypoints are smoothed again.
@@ -362,7 +363,7 @@ pub(super) fn repair<'a>(
     let mut prev = (start, 0usize);
     for m in 1..n_l {
         let w = l_at(m)?;
-        let o = offsets.find(w).ok_or(Unplaced)?;
+        let (o, _) = offsets.place(m, w)?;
         if !segment_clear(grid, prev.0, w) {
             segs = Some((segs.map_or(m.wrapping_sub(1), |(s0, _)| s0), m));
         }
@@ -404,8 +405,8 @@ pub(super) fn repair<'a>(
     let mut j_found = false;
     let mut offsets = Offsets::new(start, rest);
     for m in 1..n_l {
-        let o = offsets.find(l_at(m)?).ok_or(Unplaced)?;
-        if m <= s0 && anchors.is_none_or(|(a, _)| o <= a) {
+        let (o, passed) = offsets.place(m, l_at(m)?)?;
+        if m <= s0 && !passed && anchors.is_none_or(|(a, _)| o <= a) {
             (i, oi) = (m, o);
         }
         if !j_found && m >= s1 && anchors.is_none_or(|(_, b)| o >= b) {
@@ -677,14 +678,16 @@ impl<'r> Offsets<'r> {
     /// The offset of the raw cell `w` is placed on: from the current cell on, the first visit of
     /// the raw path to within [`PLACE_RADIUS`] cells of `w` (Chebyshev), and its cell nearest to
     /// `w` (Euclidean; the first on a tie; `w` itself as soon as it is a raw cell). That cell
-    /// becomes the current one: the next waypoint may be placed on it too.
+    /// becomes the current one: the next waypoint may be placed on it too. `None` (the current
+    /// cell unchanged) when no raw cell from the current one on comes that near.
     fn find(&mut self, w: Point) -> Option<usize> {
-        while cheb(self.p, w) > PLACE_RADIUS {
-            let &d = self.dirs.get(self.t)?;
-            self.p = neighbour(self.p, d);
-            self.t = self.t.wrapping_add(1);
+        let (mut p, mut t) = (self.p, self.t);
+        while cheb(p, w) > PLACE_RADIUS {
+            let &d = self.dirs.get(t)?;
+            p = neighbour(p, d);
+            t = t.wrapping_add(1);
         }
-        let (mut near, mut q, mut u) = (dist2(self.p, w), self.p, self.t);
+        let (mut near, mut q, mut u) = (dist2(p, w), p, t);
         while near > 0 {
             let Some(&d) = self.dirs.get(u) else { break };
             q = neighbour(q, d);
@@ -694,10 +697,23 @@ impl<'r> Offsets<'r> {
             }
             let e = dist2(q, w);
             if e < near {
-                (near, self.p, self.t) = (e, q, u);
+                (near, p, t) = (e, q, u);
             }
         }
-        Some(self.t)
+        (self.p, self.t) = (p, t);
+        Some(t)
+    }
+
+    /// [`Offsets::find`] for L[`m`]; the first waypoint after the robot's cell (`m` 1) that the
+    /// raw path from the robot on never comes near is one the robot has passed (it lies nearer
+    /// the segment it ends than the next one does, [`super::reuse`]'s entry rule): placed on the
+    /// robot's cell, `true` (then smoothed again, never kept). Any other is [`GiveUp::Unplaced`].
+    fn place(&mut self, m: usize, w: Point) -> Result<(usize, bool), GiveUp> {
+        match self.find(w) {
+            Some(o) => Ok((o, false)),
+            None if m == 1 => Ok((0, true)),
+            None => Err(GiveUp::Unplaced),
+        }
     }
 }
 
@@ -734,6 +750,15 @@ mod tests {
         let mut o = Offsets::new(start, &dirs);
         assert_eq!(o.find(Point::new(20, 10 + PLACE_RADIUS)), Some(20));
         assert_eq!(o.find(Point::new(30, 10)), Some(30));
+        // The raw path from the robot on (here from x = 10) never comes near a waypoint behind
+        // it: the first one after the robot is one it has passed (placed on its cell, not kept);
+        // a later one gives up. A failed look-up leaves the current cell where it was.
+        let robot = Point::new(10, 10);
+        let mut o = Offsets::new(robot, &dirs[10..]);
+        assert_eq!(o.place(1, Point::new(0, 12)), Ok((0, true)));
+        assert_eq!(o.place(2, Point::new(14, 10)), Ok((4, false)));
+        assert_eq!(o.place(3, Point::new(0, 12)), Err(GiveUp::Unplaced));
+        assert_eq!(o.place(3, Point::new(15, 10)), Ok((5, false)));
     }
 
     #[test]
