@@ -9,7 +9,9 @@
 # cells 4 ahead) on Boston_0_256, NewYork_0_512 and Nav2's depot at 5 cm with 0.2 m inflation
 # (three corner-to-corner pairs), cold then warm (`ohaca replan --compare`), seeds 1..=N. Prints
 # one Markdown row per replan: the cold and warm instructions (mean over the seeds), the warm
-# answers' origins (seed in brackets; a seed whose walls cut the goal off is left out), warm / cold, and raw / optimum of both. The JSON of every drive stays in DIR.
+# answers' origins (seed in brackets; a seed whose walls cut the goal off is left out), warm /
+# cold, and raw / optimum of both. The JSON of every drive stays in DIR. Figures:
+# docs/bench/repair-issue36.md.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -21,7 +23,7 @@ while [ $# -gt 0 ]; do
     --elf) elf="$2"; shift 2 ;;
     --seeds) seeds="$2"; shift 2 ;;
     --out) out="$2"; shift 2 ;;
-    -h|--help) sed -n '2,13p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,14p' "$0"; exit 0 ;;
     *) echo "unknown option $1" >&2; exit 2 ;;
   esac
 done
