@@ -27,9 +27,9 @@ while [ $# -gt 0 ]; do
     *) echo "unknown option $1" >&2; exit 2 ;;
   esac
 done
-ohaca=${OHACA:-target/x86_64-unknown-linux-gnu/release/ohaca}
+ohaca=${OHACA:-target/$(rustc -vV | sed -n 's/^host: //p')/host/ohaca}
 if [ ! -x "$ohaca" ]; then
-  echo "build the host tool first: cargo build --release -p ohaca-host --target host-tuple" >&2
+  echo "build the host tool first: cargo build --profile host -p ohaca-host --target host-tuple" >&2
   exit 2
 fi
 mkdir -p "$out"
