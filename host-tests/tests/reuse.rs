@@ -665,7 +665,8 @@ fn a_blocked_stretch_longer_than_the_box_falls_back_and_says_why() {
     assert_eq!(
         a.fallback.unwrap().to_string(),
         format!(
-            "the repair gave up: the blocked stretch needs a box of {} cells, the scratch holds 2730",
+            "the repair gave up: the blocked stretch needs a box of {} cells, \
+             the scratch holds 2730",
             match a.fallback {
                 Some(Fallback::Repair(GiveUp::TooLong { needs, .. })) => needs,
                 _ => 0,

@@ -44,7 +44,9 @@ mod workspace;
 pub use params::{Algorithm, Params};
 pub use placed::{Bases, Placed};
 pub use plan::{CurvePoint, Origin, Plan, RawPath};
-pub use repair::{longest_detour, GiveUp, BOX_MARGIN, MARGIN as REPAIR_MARGIN, PLACE_RADIUS};
+pub use repair::{
+    longest_detour, GiveUp, BOX_MARGIN, MARGIN as REPAIR_MARGIN, PLACE_RADIUS, STRIDE,
+};
 pub use reuse::{reuse, Fallback};
 pub use run::{settled, Run, REFINE_GAIN};
 pub use warm::{Area, Memory, BLOCKED, FREED, REPAIR_RADIUS};

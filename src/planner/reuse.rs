@@ -65,7 +65,7 @@ pub enum Fallback {
     OffAnswer,
     /// A cell cleared since the answer was planned may shorten it (rule 3).
     MayShorten,
-    /// Something blocks the answer (rule 2) and its repair gave up ([`super::repair`]).
+    /// Something blocks the answer (rule 2) and its repair gave up (why: [`GiveUp`]).
     Repair(GiveUp),
 }
 

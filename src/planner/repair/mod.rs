@@ -49,12 +49,20 @@
 //! next warm run repairs its colony as after any other replan. Host and device run the same code
 //! on the same layout, and the scratch lent depends only on the buffers' lengths, so a repaired
 //! answer is the same bit for bit on both. Panic-free: every index is checked.
+//!
+//! | file | owns |
+//! | --- | --- |
+//! | `mod.rs` | [`GiveUp`], the bounds, the repair itself (steps 1, 2 and 4) |
+//! | `detour.rs` | the box sized by the change and the detour in it (step 3) |
+//! | `input.rs` | where each waypoint lies on the raw path, and the smoothing's sparse input |
 
 use core::fmt;
 
 use crate::geometry::{distance, segment_clear, steps_length};
 use crate::grid::{direction, is_diagonal, neighbour, Dir, Grid, Point};
-use crate::refine::{self, Scratch, MAX_SIDE, MIN_SIDE};
+use crate::refine::Scratch;
+#[cfg(doc)]
+use crate::refine::{MAX_SIDE, MIN_SIDE};
 use crate::smoothing::{Smoother, SmoothingKind};
 
 use super::lend::Polishing;
@@ -62,6 +70,13 @@ use super::params::{Algorithm, Params};
 use super::plan::{Origin, Plan};
 use super::warm::{Answer, Memory};
 use super::workspace::Workspace;
+
+mod detour;
+mod input;
+
+use detour::sized_detour;
+pub use input::STRIDE;
+use input::{cell_at, sparse, Offsets};
 
 /// Raw cells kept between the blocked stretch and each anchor of the detour: room for the detour
 /// to leave the old path at an angle instead of turning at the obstacle.
@@ -135,166 +150,6 @@ pub fn longest_detour(old: f32) -> f32 {
     old + (old / 4.0).max(20.0)
 }
 
-/// The box of cells `min..=max` grown by `margin` on every side, clipped to a `w x h` map.
-fn grown(min: Point, max: Point, margin: u16, w: u16, h: u16) -> (Point, Point) {
-    (
-        Point::new(min.x.saturating_sub(margin), min.y.saturating_sub(margin)),
-        Point::new(
-            max.x.saturating_add(margin).min(w.saturating_sub(1)),
-            max.y.saturating_add(margin).min(h.saturating_sub(1)),
-        ),
-    )
-}
-
-/// Cells of the box `lo..=hi`, and whether both sides are at most [`MAX_SIDE`].
-fn box_cells((lo, hi): (Point, Point)) -> (usize, bool) {
-    let w = usize::from(hi.x.saturating_sub(lo.x)).saturating_add(1);
-    let h = usize::from(hi.y.saturating_sub(lo.y)).saturating_add(1);
-    (w.saturating_mul(h), w <= MAX_SIDE && h <= MAX_SIDE)
-}
-
-/// True if one of `cells` lies on a side of the box `lo..=hi` that is not the map's edge: the
-/// box may have cut a shorter detour off there.
-fn hugs((lo, hi): (Point, Point), cells: &[Point], w: u16, h: u16) -> bool {
-    cells.iter().any(|p| {
-        (p.x == lo.x && lo.x > 0)
-            || (p.y == lo.y && lo.y > 0)
-            || (p.x == hi.x && hi.x.saturating_add(1) < w)
-            || (p.y == hi.y && hi.y.saturating_add(1) < h)
-    })
-}
-
-/// The raw path between two anchors: offsets `a..=b` of the raw path from `start` by `rest`.
-#[derive(Clone, Copy, Debug, PartialEq)]
-struct Stretch {
-    a: usize,
-    b: usize,
-    /// The bounding box of its cells.
-    min: Point,
-    max: Point,
-    /// Its end cells (the anchors).
-    ca: Point,
-    cb: Point,
-    /// Its raw length.
-    old: f32,
-}
-
-impl Stretch {
-    fn new(start: Point, rest: &[Dir], a: usize, b: usize) -> Stretch {
-        let (mut min, mut max) = (Point::new(u16::MAX, u16::MAX), Point::new(0, 0));
-        let (mut ca, mut cb) = (start, start);
-        let (mut straight, mut diagonal) = (0u32, 0u32);
-        let mut p = start;
-        for t in 0..=b {
-            if t >= a {
-                min = Point::new(min.x.min(p.x), min.y.min(p.y));
-                max = Point::new(max.x.max(p.x), max.y.max(p.y));
-            }
-            if t == a {
-                ca = p;
-            }
-            if t == b {
-                cb = p;
-            }
-            let Some(&d) = rest.get(t) else { break };
-            if t >= a && t < b {
-                if is_diagonal(d) {
-                    diagonal = diagonal.wrapping_add(1);
-                } else {
-                    straight = straight.wrapping_add(1);
-                }
-            }
-            p = neighbour(p, d);
-        }
-        Stretch {
-            a,
-            b,
-            min,
-            max,
-            ca,
-            cb,
-            old: steps_length(straight, diagonal),
-        }
-    }
-
-    /// The stretch around the blocked raw moves `lo..hi` for a box margin `m`: anchors
-    /// [`MARGIN`] raw cells before and after them, or `m` when that is more (so the detour can
-    /// leave the path as far ahead as it must go sideways), clamped to the rest.
-    fn around(start: Point, rest: &[Dir], (lo, hi): (usize, usize), m: u16) -> Stretch {
-        let reach = MARGIN.max(usize::from(m));
-        let b = hi.saturating_add(reach).min(rest.len());
-        Stretch::new(start, rest, lo.saturating_sub(reach), b)
-    }
-}
-
-/// A detour found by [`sized_detour`]: its cells (`out[..cells]`) and the stretch it replaces.
-#[derive(Clone, Copy, Debug)]
-struct Detour {
-    cells: usize,
-    stretch: Stretch,
-}
-
-/// The detour around the blocked raw moves `lo..hi` of the raw path from `start` by `rest`, in a
-/// box sized by the change (see the module docs): the anchors' stretch's bounding box grown by a
-/// margin of [`BOX_MARGIN`] cells, doubled (the anchors moving out with it) while the detour found
-/// hugs the box's inner sides or none was found, as far as `scratch` holds; the last and largest
-/// box takes the widest margin that still fits. Writes the detour's cells to `out`.
-fn sized_detour(
-    grid: &Grid<'_>,
-    start: Point,
-    rest: &[Dir],
-    blocked: (usize, usize),
-    scratch: &mut Scratch<'_>,
-    out: &mut [Point],
-) -> Result<Detour, GiveUp> {
-    let room = scratch.cells();
-    if room < MIN_SIDE.saturating_mul(MIN_SIDE) {
-        return Err(GiveUp::NoScratch);
-    }
-    let (w, h) = (grid.width(), grid.height());
-    let bx = |s: &Stretch, m: u16| grown(s.min, s.max, m, w, h);
-    let fits = |s: &Stretch, m: u16| {
-        let (cells, sides) = box_cells(bx(s, m));
-        sides && cells <= room
-    };
-    let mut m = BOX_MARGIN;
-    let mut s = Stretch::around(start, rest, blocked, m);
-    if !fits(&s, m) {
-        let (needs, _) = box_cells(bx(&s, m));
-        return Err(GiveUp::TooLong {
-            needs: u32::try_from(needs).unwrap_or(u32::MAX),
-            room: u32::try_from(room).unwrap_or(u32::MAX),
-        });
-    }
-    let mut found = None;
-    loop {
-        let b = bx(&s, m);
-        match refine::detour(grid, s.ca, s.cb, b, scratch, out) {
-            Some(cells) => {
-                found = Some(Detour { cells, stretch: s });
-                if !hugs(b, out.get(..cells).unwrap_or_default(), w, h) {
-                    break;
-                }
-            }
-            // Keep the one found (`out` is left as it was).
-            None if found.is_some() => break,
-            None => {}
-        }
-        // The next margin: doubled, else the widest that fits; done when none grows the box.
-        let mut next = m.saturating_mul(2);
-        let mut t = Stretch::around(start, rest, blocked, next);
-        while next > m && !fits(&t, next) {
-            next = m.saturating_add(next.wrapping_sub(m) / 2);
-            t = Stretch::around(start, rest, blocked, next);
-        }
-        if next <= m || (bx(&t, next) == b && (t.a, t.b) == (s.a, s.b)) {
-            break;
-        }
-        (m, s) = (next, t);
-    }
-    found.ok_or(GiveUp::NoDetour)
-}
-
 /// Repair the kept answer around what blocks it (see the module docs); `Err` gives the replan to
 /// the colony and says why. `answer` is the memory's answer, the robot's cell `start` is raw cell
 /// `at` of it, and the waypoints after the robot's are `points[first + entry..end]`
@@ -315,8 +170,9 @@ pub(super) fn repair<'a>(
     let idx = |v: u32| usize::try_from(v).unwrap_or(usize::MAX);
     let (from, steps) = (idx(answer.from), idx(answer.steps));
     let (first, end) = (idx(answer.first), idx(answer.end));
-    let base = from.checked_add(at).ok_or(Unplaced)?; // the robot's direction in `best`
-                                                      // The answer, the increments and the buffers idle between plans (`lend::Polishing`).
+    // The robot's direction in `best`.
+    let base = from.checked_add(at).ok_or(Unplaced)?;
+    // The answer, the increments and the buffers idle between plans (`lend::Polishing`).
     let Polishing {
         best,
         points,
@@ -429,9 +285,9 @@ pub(super) fn repair<'a>(
     let new_steps = base.checked_add(new_n).ok_or(NoRoom)?;
     let oj_new = grow(oj).ok_or(NoRoom)?;
     // The smoothing's input: L[i]; the raw cells after it up to the first anchor, sparse; the
-    // detour's cells; the raw cells after it up to L[j]'s, sparse or none; L[j] ([`sparse`]: on open
-    // floor the waypoints around a wall can lie hundreds of cells apart, and the DP costs the
-    // cells of its input, not the old segments' length). Counted here on the kept raw path,
+    // detour's cells; the raw cells after it up to L[j]'s, sparse or none; L[j] ([`sparse`]: on
+    // open floor the waypoints around a wall can lie hundreds of cells apart, and the DP costs
+    // the cells of its input, not the old segments' length). Counted here on the kept raw path,
     // written below on the new one: the same cells, the same choices.
     let b_new = grow(b).ok_or(NoRoom)?;
     let cell_oi = cell_at(start, rest, oi).ok_or(Unplaced)?;
@@ -575,150 +431,9 @@ pub(super) fn repair<'a>(
     ))
 }
 
-/// The cell at offset `t` of the raw path from `start` by `dirs`.
-fn cell_at(start: Point, dirs: &[Dir], t: usize) -> Option<Point> {
-    Some(dirs.get(..t)?.iter().fold(start, |p, &d| neighbour(p, d)))
-}
-
-/// Raw cells one step of the smoothing's input may span outside the detour (see [`sparse`]).
-pub const STRIDE: usize = 16;
-
-/// The smoothing's input along the raw cells after `at` by `dirs` (`at` itself is not one), the
-/// last input cell so far being `p`: none when `p` sees `then` (the input cell after them, if
-/// any), only the last when `p` sees it; else from `p` on, the farthest of the cells [`STRIDE`],
-/// half that, a quarter ... cells on (not past the last) that `p` sees, else the next one, and
-/// the last cell always. So each input cell sees
-/// the one before it (the DP's assumption; where `p` is not a raw cell and sees no cell it is
-/// tested with, the final check catches it), and a stretch of open floor costs the DP a cell in
-/// [`STRIDE`], or none, instead of every one. Calls `emit` with each cell; returns the last input
-/// cell (`p` if none).
-fn sparse(
-    grid: &Grid<'_>,
-    mut p: Point,
-    at: Point,
-    dirs: &[Dir],
-    then: Option<Point>,
-    emit: &mut impl FnMut(Point) -> Result<(), GiveUp>,
-) -> Result<Point, GiveUp> {
-    let m = dirs.len();
-    if m == 0 {
-        return Ok(p);
-    }
-    match then {
-        Some(e) if segment_clear(grid, p, e) => return Ok(p),
-        None => {
-            let last = dirs.iter().fold(at, |q, &d| neighbour(q, d));
-            if segment_clear(grid, p, last) {
-                emit(last)?;
-                return Ok(last);
-            }
-        }
-        Some(_) => {}
-    }
-    // `ahead[k]`: the cell `k` steps after the last input cell (`ahead[0]`), at raw step `t`.
-    let mut ahead = [at; STRIDE + 1];
-    let mut t = 0usize;
-    while t < m {
-        let span = m.wrapping_sub(t).min(STRIDE); // t < m: no wrap; at least 1
-        for k in 1..=span {
-            let (Some(&q), Some(&d)) = (
-                ahead.get(k.wrapping_sub(1)),
-                dirs.get(t.wrapping_add(k).wrapping_sub(1)),
-            ) else {
-                return Err(GiveUp::Unplaced);
-            };
-            if let Some(slot) = ahead.get_mut(k) {
-                *slot = neighbour(q, d);
-            }
-        }
-        // The farthest of `span`, `span / 2`, `span / 4`, ... steps that `p` sees, else one.
-        let mut k = span;
-        while k > 1 && !ahead.get(k).is_some_and(|&q| segment_clear(grid, p, q)) {
-            k /= 2;
-        }
-        let c = ahead.get(k).copied().ok_or(GiveUp::Unplaced)?;
-        emit(c)?;
-        p = c;
-        t = t.saturating_add(k.max(1));
-        if let Some(first) = ahead.first_mut() {
-            *first = c;
-        }
-    }
-    Ok(p)
-}
-
-/// Cells between two points (Chebyshev).
-fn cheb(a: Point, b: Point) -> u16 {
-    a.x.abs_diff(b.x).max(a.y.abs_diff(b.y))
-}
-
-/// Squared distance between two cells within [`PLACE_RADIUS`] of each other (saturating).
-fn dist2(a: Point, b: Point) -> u32 {
-    let (dx, dy) = (u32::from(a.x.abs_diff(b.x)), u32::from(a.y.abs_diff(b.y)));
-    dx.saturating_mul(dx).saturating_add(dy.saturating_mul(dy))
-}
-
-/// Raw offsets of waypoints along a raw path, in order ([`Offsets::find`]).
-struct Offsets<'r> {
-    dirs: &'r [Dir],
-    /// The raw cell at offset `t`.
-    p: Point,
-    t: usize,
-}
-
-impl<'r> Offsets<'r> {
-    fn new(start: Point, dirs: &'r [Dir]) -> Self {
-        Offsets {
-            dirs,
-            p: start,
-            t: 0,
-        }
-    }
-
-    /// The offset of the raw cell `w` is placed on: from the current cell on, the first visit of
-    /// the raw path to within [`PLACE_RADIUS`] cells of `w` (Chebyshev), and its cell nearest to
-    /// `w` (Euclidean; the first on a tie; `w` itself as soon as it is a raw cell). That cell
-    /// becomes the current one: the next waypoint may be placed on it too. `None` (the current
-    /// cell unchanged) when no raw cell from the current one on comes that near.
-    fn find(&mut self, w: Point) -> Option<usize> {
-        let (mut p, mut t) = (self.p, self.t);
-        while cheb(p, w) > PLACE_RADIUS {
-            let &d = self.dirs.get(t)?;
-            p = neighbour(p, d);
-            t = t.wrapping_add(1);
-        }
-        let (mut near, mut q, mut u) = (dist2(p, w), p, t);
-        while near > 0 {
-            let Some(&d) = self.dirs.get(u) else { break };
-            q = neighbour(q, d);
-            u = u.wrapping_add(1);
-            if cheb(q, w) > PLACE_RADIUS {
-                break;
-            }
-            let e = dist2(q, w);
-            if e < near {
-                (near, p, t) = (e, q, u);
-            }
-        }
-        (self.p, self.t) = (p, t);
-        Some(t)
-    }
-
-    /// [`Offsets::find`] for L[`m`]; the first waypoint after the robot's cell (`m` 1) that the
-    /// raw path from the robot on never comes near is one the robot has passed (it lies nearer
-    /// the segment it ends than the next one does, [`super::reuse`]'s entry rule): placed on the
-    /// robot's cell, `true` (then smoothed again, never kept). Any other is [`GiveUp::Unplaced`].
-    fn place(&mut self, m: usize, w: Point) -> Result<(usize, bool), GiveUp> {
-        match self.find(w) {
-            Some(o) => Ok((o, false)),
-            None if m == 1 => Ok((0, true)),
-            None => Err(GiveUp::Unplaced),
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
+    use super::detour::{box_cells, grown, hugs, Stretch};
     use super::*;
     use crate::planner::arena::carve;
     use crate::planner::{reuse, Fallback, Run};
@@ -867,7 +582,8 @@ mod tests {
         });
         assert_eq!(
             alloc::format!("{r}"),
-            "the repair gave up: the blocked stretch needs a box of 9000 cells, the scratch holds 2730"
+            "the repair gave up: the blocked stretch needs a box of 9000 cells, \
+             the scratch holds 2730"
         );
         assert_eq!(
             alloc::format!("{}", Fallback::OffAnswer),
