@@ -18,7 +18,6 @@ use core::sync::atomic::Ordering;
 
 use embassy_futures::yield_now;
 use embassy_time::Instant;
-use embedded_io_async::Write;
 
 use ohaca::planner::{reuse, Placed, Plan, Run};
 use ohaca::protocol::{
@@ -29,7 +28,7 @@ use ohaca::protocol::{
 use super::buffers;
 use super::stack;
 use super::state::{self, count, Job, PlanStorage, Small, TxPort, JOBS, MAP, PLANNING};
-use super::tx::sent_one;
+use super::tx::send_path_frame;
 
 /// Room for a path frame: a whole path of at most [`PART_BYTES`] body bytes, or a part (id,
 /// variant, offset, length and byte-string length as the longest varints, the CRC).
@@ -268,7 +267,8 @@ fn ready(
 }
 
 /// Send a planned path: whole, or a part at a time with the small replies passing between the
-/// parts. A `Cancel` or a map upload since `stops` stops a path in parts (`Cancelled`).
+/// parts. A `Cancel` or a map upload since `stops` stops it (`Cancelled`): no frame of it follows
+/// their `Ack` (`super::tx::send_path_frame`).
 async fn send(
     storage: &mut PlanStorage,
     job: &Job,
@@ -279,12 +279,7 @@ async fn send(
 ) -> Result<(), ErrorReply> {
     let (fixed, placed, size, total) = match ready {
         Ready::Whole(n) => {
-            state::wait_for_small().await;
-            let mut tx = port.lock().await;
-            let sent = tx.write_all(frame.get(..n).unwrap_or(&[])).await.is_ok();
-            drop(tx);
-            sent_one(sent);
-            return Ok(());
+            return send_path_frame(port, frame.get(..n).unwrap_or(&[]), stops).await;
         }
         Ready::Parts {
             fixed,
@@ -297,6 +292,7 @@ async fn send(
     let mut offset = 0;
     let mut bytes = [0u8; PART_BYTES];
     while offset < total {
+        let at = offset;
         // Read the part under the map's lock, from the workspace lent again as it was.
         let n = {
             let mut map = MAP.lock().await;
@@ -330,12 +326,16 @@ async fn send(
             offset = offset.saturating_add(k.max(1));
             n
         };
-        // The small replies queued meanwhile go first; then this part.
-        state::wait_for_small().await;
-        let mut tx = port.lock().await;
-        let sent = tx.write_all(frame.get(..n).unwrap_or(&[])).await.is_ok();
-        drop(tx);
-        sent_one(sent);
+        // The small replies queued meanwhile go first; then this part, unless stopped since.
+        if let Err(e) = send_path_frame(port, frame.get(..n).unwrap_or(&[]), stops).await {
+            defmt::info!(
+                "plan {}: path stopped after {} of {} bytes",
+                job.id,
+                at,
+                total
+            );
+            return Err(e);
+        }
     }
     Ok(())
 }

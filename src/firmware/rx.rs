@@ -43,6 +43,7 @@ pub async fn rx_task(mut rx: board::Rx) {
             match decoded {
                 Ok((id, req)) => {
                     count(|s| s.frames_ok = s.frames_ok.wrapping_add(1));
+                    board::log_request(id);
                     session.handle(id, req).await;
                 }
                 Err(e) => {

@@ -1,7 +1,16 @@
-//! The transmit task: sends the small replies queued in `OUT`, each encoded as it goes out (a
-//! `Stats` reply carries the counters of that moment). Paths do not come through here: the
-//! planner sends their frames itself ([`super::plan`]) and lets these pass between the frames
-//! of a long one. Both take the port's lock for a whole frame, so frames never interleave.
+//! The transmit task: sends the small replies queued in `OUT`, each encoded once it holds the
+//! port (a `Stats` reply carries the counters of that moment: every frame before it in the byte
+//! stream counted in `tx_frames`, itself not). Paths do not come through here: the planner sends
+//! their frames itself ([`super::plan`]) through [`send_path_frame`] and lets these pass between
+//! the frames of a long one. Both take the port's lock for a whole frame, so frames never
+//! interleave.
+//!
+//! **A Cancel is final.** [`send_path_frame`] is the only way a path's bytes reach the UART, and
+//! it looks at `STOPS` (`super::state::stopped`) while it holds the port, after it took the
+//! lock: the receiver bumps `STOPS` before it queues the `Ack` of a `Cancel` (or of a map's first
+//! chunk), and that `Ack` can reach the UART only through the same lock. So either the frame was
+//! in the port before the `Ack` was even queued, or the planner sees the stop and sends nothing:
+//! no frame of a stopped path ever follows the `Ack`.
 
 use core::sync::atomic::Ordering;
 
@@ -11,9 +20,11 @@ use ohaca::planner::Params;
 use ohaca::protocol::{encode_reply, Capacity, HelloReply, Reply, MAX_CHUNK, MAX_REQUEST, VERSION};
 
 use super::board::{self, Board};
+use ohaca::protocol::{ErrorCode, ErrorReply};
+
 use super::state::{
-    count, stats, Out, Small, TxPort, MAX_CELLS, MAX_SIDE, OUT, PLAN_CELLS, PLAN_QUEUE, PLAN_STEPS,
-    RX_RING, SENDING_SMALL, WINDOW,
+    self, count, small_sent, stats, Out, Small, TxPort, MAX_CELLS, MAX_SIDE, OUT, PLAN_CELLS,
+    PLAN_QUEUE, PLAN_STEPS, RX_RING, SENDING_SMALL, WINDOW,
 };
 
 /// Room for every reply but a path (Hello is the largest, under 110 bytes).
@@ -25,6 +36,8 @@ pub async fn tx_task(port: &'static TxPort) {
     loop {
         let Out(id, small) = OUT.receive().await;
         SENDING_SMALL.store(true, Ordering::Release);
+        // The port first, then the reply: a `Stats` counts every frame before it on the line.
+        let mut tx = port.lock().await;
         let reply = match small {
             Small::Ack => Reply::Ack,
             Small::Error(e) => Reply::Error(e),
@@ -33,7 +46,7 @@ pub async fn tx_task(port: &'static TxPort) {
         };
         let sent = match encode_reply(id, &reply, &mut buf) {
             Ok(n) => {
-                let mut tx = port.lock().await;
+                board::log_reply(id);
                 tx.write_all(buf.get(..n).unwrap_or(&[])).await.is_ok()
             }
             Err(e) => {
@@ -41,9 +54,24 @@ pub async fn tx_task(port: &'static TxPort) {
                 false
             }
         };
-        SENDING_SMALL.store(false, Ordering::Release);
         sent_one(sent);
+        drop(tx);
+        small_sent();
     }
+}
+
+/// Send one frame of a path (a whole `Path` or a `PathPart`) of a plan whose sending began under
+/// `stops`: after the small replies queued meanwhile, and only if no `Cancel` or map upload
+/// stopped it (checked under the port's lock: see the module's docs). `Cancelled` if stopped.
+pub async fn send_path_frame(port: &TxPort, frame: &[u8], stops: u32) -> Result<(), ErrorReply> {
+    state::wait_for_small().await;
+    let mut tx = port.lock().await;
+    if state::stopped(stops) {
+        return Err(ErrorReply::new(ErrorCode::Cancelled));
+    }
+    let sent = tx.write_all(frame).await.is_ok();
+    sent_one(sent);
+    Ok(())
 }
 
 /// What the device is and can do.

@@ -68,6 +68,29 @@ pub trait Board {
     fn rx_overruns() -> u32;
     /// Stop: leave the emulator, or reset the chip.
     fn exit(failure: bool) -> !;
+    /// The tick at which the receiver's interrupt took the last frame delimiter (`00`), if the
+    /// board records it (the QEMU board does, for the latency log: [`log_request`]).
+    fn frame_end() -> Option<u64> {
+        None
+    }
+}
+
+/// Log when request `id`'s frame ended on the line, on a board that records it: with
+/// [`log_reply`], the device-side latency of each answer in ticks (under `qemu-system-arm -icount
+/// shift=0` one tick is 1000 instructions; `host/tests/qemu_paced.rs` reads these lines).
+pub fn log_request(id: u32) {
+    if let Some(t) = Active::frame_end() {
+        defmt::info!("request {=u32} in at {=u64}", id, t);
+    }
+}
+
+/// Log when a small reply to `id` is handed to the UART, on a board that logs requests
+/// ([`log_request`]).
+pub fn log_reply(id: u32) {
+    if Active::frame_end().is_some() {
+        let now = embassy_time::Instant::now().as_ticks();
+        defmt::info!("reply {=u32} out at {=u64}", id, now);
+    }
 }
 
 pub type Rx = <Active as Board>::Rx;

@@ -23,7 +23,9 @@ pub use jobs::{
     cancel_all, cancelled, stop_all, stopped, stops, Job, GENERATION, JOBS, PLANNING, PLAN_QUEUE,
 };
 pub use map::{colony, map_size, set_colony, set_map_size, MAP};
-pub use replies::{reply, wait_for_small, Out, Small, TxPort, OUT, SENDING_SMALL, WINDOW};
+pub use replies::{
+    reply, small_sent, wait_for_small, Out, Small, TxPort, OUT, SENDING_SMALL, WINDOW,
+};
 pub use stats::{count, count_boot, stats};
 
 /// The planner's storage (`super::buffers`): nothing of its own on the small boards (its

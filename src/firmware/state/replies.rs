@@ -13,9 +13,9 @@
 
 use core::sync::atomic::{AtomicBool, Ordering};
 
-use embassy_futures::yield_now;
 use embassy_sync::channel::Channel;
 use embassy_sync::mutex::Mutex;
+use embassy_sync::signal::Signal;
 
 use ohaca::protocol::ErrorReply;
 
@@ -48,6 +48,9 @@ pub type TxPort = Mutex<Raw, board::Tx>;
 pub static OUT: Channel<Raw, Out, WINDOW> = Channel::new();
 /// True while the transmitter holds a small reply it took from [`OUT`] and has not sent yet.
 pub static SENDING_SMALL: AtomicBool = AtomicBool::new(false);
+/// Raised by the transmitter each time it has handed a small reply to the UART: what
+/// [`wait_for_small`] sleeps on.
+static SMALL_SENT: Signal<Raw, ()> = Signal::new();
 
 /// Queue a small reply; never waits. A full queue (a host beyond its window) drops it, counted.
 pub fn reply(id: u32, r: Small) {
@@ -58,9 +61,19 @@ pub fn reply(id: u32, r: Small) {
 }
 
 /// Wait until no small reply is queued or being sent: the planner calls it before each frame of
-/// a path, so a small reply waits for at most the frame on the wire when it was queued.
+/// a path, so a small reply waits for at most the frame on the wire when it was queued. It
+/// sleeps (no polling) until the transmitter says it sent one ([`small_sent`]), then looks again.
 pub async fn wait_for_small() {
     while !OUT.is_empty() || SENDING_SMALL.load(Ordering::Acquire) {
-        yield_now().await;
+        // One waiter (the planner); a signal raised before it waits is kept, so none is missed
+        // (the executor runs one task at a time: nothing sends between the check and the wait).
+        SMALL_SENT.wait().await;
     }
+}
+
+/// The transmitter has handed a small reply to the UART (or given up on it): wake
+/// [`wait_for_small`].
+pub fn small_sent() {
+    SENDING_SMALL.store(false, Ordering::Release);
+    SMALL_SENT.signal(());
 }

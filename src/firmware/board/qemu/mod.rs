@@ -1,6 +1,6 @@
 //! QEMU `mps2-an386`: Cortex-M4 at 25 MHz, 4 MiB flash at 0, 4 MiB RAM at 0x2000_0000 (the
 //! firmware uses 512 KiB and 128 KiB of them, as on the STM32F411: `memory.x`), CMSDK APB UART0 at
-//! 0x4000_4000 (its RX interrupt is IRQ 0). Logs and exit go through semihosting, so run QEMU with
+//! 0x4000_4000 (its RX interrupt is IRQ 0, its TX interrupt IRQ 1). Logs and exit go through semihosting, so run QEMU with
 //! `-semihosting-config enable=on,target=native`.
 
 mod systick;
@@ -43,6 +43,10 @@ impl Board for Qemu {
         uart::overruns()
     }
 
+    fn frame_end() -> Option<u64> {
+        Some(uart::last_delimiter())
+    }
+
     fn exit(failure: bool) -> ! {
         use cortex_m_semihosting::debug::{exit, EXIT_FAILURE, EXIT_SUCCESS};
         exit(if failure { EXIT_FAILURE } else { EXIT_SUCCESS });
@@ -57,6 +61,7 @@ impl Board for Qemu {
 unsafe fn DefaultHandler(irqn: i16) {
     match irqn {
         uart::RX_IRQ_NUMBER => uart::on_rx_interrupt(),
+        uart::TX_IRQ_NUMBER => uart::on_tx_interrupt(),
         _ => defmt::panic!("unexpected interrupt {}", irqn),
     }
 }
