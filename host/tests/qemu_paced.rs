@@ -16,12 +16,12 @@ mod qemu;
 
 use std::time::{Duration, Instant};
 
-use ohaca::protocol::{decode_reply, ReplyReader, Request, MAX_REPLY_WIRE};
+use ohaca::protocol::Request;
 use ohaca::{Params, Point};
-use ohaca_host::link::relay::{byte_time, Arrival, Counters, RelayStream, Stamp, MAX_CATCH_UP};
+use ohaca_host::link::relay::{byte_time, Counters, RelayStream, Stamp, MAX_CATCH_UP};
 use ohaca_host::link::{Link, Response};
 use ohaca_host::Map;
-use qemu::{boot_paced, have_qemu, longest_scenario, maps, TIMEOUT};
+use qemu::{boot_paced, frames, have_qemu, longest_scenario, maps, Frame, TIMEOUT};
 
 const BAUD: u32 = 115_200;
 
@@ -32,47 +32,6 @@ const MAX_BACKLOG: u64 = 32;
 
 fn load(name: &str) -> Map {
     Map::load(maps().join(name)).expect("map")
-}
-
-/// One reply frame as it arrived: its id, its length on the wire (with the delimiter), and the
-/// clocks of its first and last byte.
-#[derive(Debug)]
-struct Frame {
-    id: u32,
-    kind: &'static str,
-    len: u64,
-    first: Stamp,
-    last: Stamp,
-}
-
-/// Split what arrived into reply frames (the protocol's own reader and decoder).
-fn frames(arrivals: &[Arrival]) -> Vec<Frame> {
-    let mut reader = Box::new(ReplyReader::new());
-    let mut out = Vec::new();
-    let mut start = 0;
-    for (i, a) in arrivals.iter().enumerate() {
-        if a.byte == 0 && start == i {
-            // A delimiter with no frame before it.
-            start = i + 1;
-            let _ = reader.push(0);
-            continue;
-        }
-        if let Some(f) = reader.push(a.byte).into_frame(MAX_REPLY_WIRE) {
-            let (id, kind) = match f.and_then(decode_reply) {
-                Ok((id, r)) => (id, Response::from(&r).kind()),
-                Err(_) => (0, "undecodable"),
-            };
-            out.push(Frame {
-                id,
-                kind,
-                len: (i + 1 - start) as u64,
-                first: arrivals[start].stamp,
-                last: a.stamp,
-            });
-            start = i + 1;
-        }
-    }
-    out
 }
 
 /// The least time `bytes` bytes take on the line, from the first's start to the last's end.

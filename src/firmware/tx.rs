@@ -46,8 +46,10 @@ pub async fn tx_task(port: &'static TxPort) {
         };
         let sent = match encode_reply(id, &reply, &mut buf) {
             Ok(n) => {
+                let sent = tx.write_all(buf.get(..n).unwrap_or(&[])).await.is_ok();
+                // Every byte of it is the transmitter's now: it goes out at the line's rate.
                 board::log_reply(id);
-                tx.write_all(buf.get(..n).unwrap_or(&[])).await.is_ok()
+                sent
             }
             Err(e) => {
                 defmt::error!("reply {}: {}", id, defmt::Display2Format(&e));

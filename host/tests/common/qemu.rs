@@ -9,6 +9,7 @@
 //! `common/mod.rs`, so the other tests do not compile it).
 #![allow(dead_code)]
 
+use std::collections::HashMap;
 use std::io::{BufRead, BufReader, Read};
 use std::net::{TcpListener, TcpStream};
 use std::path::{Path, PathBuf};
@@ -20,7 +21,7 @@ use ohaca::protocol::{
     crc32, decode_request, ErrorCode, ErrorReply, RequestReader, MAX_REQUEST_WIRE,
 };
 use ohaca::{Params, Point};
-use ohaca_host::link::relay::{Counters, Relay, RelayStream};
+use ohaca_host::link::relay::{Arrival, Counters, Relay, RelayStream, Stamp};
 use ohaca_host::link::{DevicePath, Link};
 use ohaca_host::{HeapStorage, Map};
 
@@ -327,6 +328,62 @@ pub fn boot_paced(baud: u32) -> (PacedQemu, Link<RelayStream>, Arc<Counters>) {
 pub fn boot_paced_with(elf: &Path, baud: u32) -> (PacedQemu, Link<RelayStream>, Arc<Counters>) {
     let mut c = qemu_base(elf);
     c.stdout(defmt_log()).stderr(Stdio::inherit());
+    paced(c, baud)
+}
+
+/// [`boot_paced`] under `-icount shift=0` (one device tick = 1000 instructions), the firmware's
+/// defmt log (QEMU's stdout) kept in `log` for [`device_log`].
+pub fn boot_paced_icount(
+    baud: u32,
+    log: &Path,
+) -> (PacedQemu, Link<RelayStream>, Arc<Counters>) {
+    let mut c = qemu_base(firmware());
+    c.args(["-icount", "shift=0"]);
+    let file = std::fs::File::create(log).expect("create the defmt log file");
+    c.stdout(Stdio::from(file)).stderr(Stdio::inherit());
+    paced(c, baud)
+}
+
+/// The firmware's defmt log so far, decoded by `defmt-print` (message only, one line each).
+pub fn device_log(log: &Path) -> Vec<String> {
+    let input = std::fs::File::open(log).expect("open the defmt log");
+    let out = Command::new("defmt-print")
+        .arg("-e")
+        .arg(firmware())
+        .args(["--log-format", "{s}"])
+        .stdin(Stdio::from(input))
+        .stderr(Stdio::null())
+        .output()
+        .expect("run defmt-print (scripts/install-defmt-print.sh installs it)");
+    String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .map(str::to_string)
+        .collect()
+}
+
+/// The device-side times in the log ([`device_log`]) of the QEMU board's latency lines
+/// (`request ID in at TICK`, `reply ID out at TICK`: `src/firmware/board/mod.rs`), by id: when
+/// each request's frame ended, and when each small reply to it was handed to the UART.
+pub fn device_times(lines: &[String]) -> (HashMap<u32, u64>, HashMap<u32, Vec<u64>>) {
+    let mut ins = HashMap::new();
+    let mut outs: HashMap<u32, Vec<u64>> = HashMap::new();
+    for l in lines {
+        let w: Vec<&str> = l.split_whitespace().collect();
+        let num = |i: usize| w.get(i).and_then(|v| v.parse::<u64>().ok());
+        match (w.first().copied(), num(1), w.get(2).copied(), num(4)) {
+            (Some("request"), Some(id), Some("in"), Some(t)) => {
+                ins.insert(id as u32, t);
+            }
+            (Some("reply"), Some(id), Some("out"), Some(t)) => {
+                outs.entry(id as u32).or_default().push(t);
+            }
+            _ => {}
+        }
+    }
+    (ins, outs)
+}
+
+fn paced(mut c: Command, baud: u32) -> (PacedQemu, Link<RelayStream>, Arc<Counters>) {
     let (child, relay) = Relay::spawn_qemu(&mut c, baud).expect("start QEMU behind the relay");
     let counters = relay.counters();
     let q = PacedQemu { child, relay };
@@ -347,6 +404,49 @@ pub fn boot_paced_with(elf: &Path, baud: u32) -> (PacedQemu, Link<RelayStream>, 
     link.set_timeout(PACED_TIMEOUT);
     link.take_strays();
     (q, link, counters)
+}
+
+// ---- reply frames on the line ---------------------------------------------------------
+
+/// One reply frame as it arrived: its id, its length on the wire (with the delimiter), and the
+/// clocks of its first and last byte.
+#[derive(Debug)]
+pub struct Frame {
+    pub id: u32,
+    pub kind: &'static str,
+    pub len: u64,
+    pub first: Stamp,
+    pub last: Stamp,
+}
+
+/// Split what arrived into reply frames (the protocol's own reader and decoder).
+pub fn frames(arrivals: &[Arrival]) -> Vec<Frame> {
+    let mut reader = Box::new(ohaca::protocol::ReplyReader::new());
+    let mut out = Vec::new();
+    let mut start = 0;
+    for (i, a) in arrivals.iter().enumerate() {
+        if a.byte == 0 && start == i {
+            // A delimiter with no frame before it.
+            start = i + 1;
+            let _ = reader.push(0);
+            continue;
+        }
+        if let Some(f) = reader.push(a.byte).into_frame(ohaca::protocol::MAX_REPLY_WIRE) {
+            let (id, kind) = match f.and_then(ohaca::protocol::decode_reply) {
+                Ok((id, r)) => (id, ohaca_host::link::Response::from(&r).kind()),
+                Err(_) => (0, "undecodable"),
+            };
+            out.push(Frame {
+                id,
+                kind,
+                len: (i + 1 - start) as u64,
+                first: arrivals[start].stamp,
+                last: a.stamp,
+            });
+            start = i + 1;
+        }
+    }
+    out
 }
 
 // ---- frames --------------------------------------------------------------------------------

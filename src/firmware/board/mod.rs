@@ -84,7 +84,8 @@ pub fn log_request(id: u32) {
     }
 }
 
-/// Log when a small reply to `id` is handed to the UART, on a board that logs requests
+/// Log when the last byte of a small reply to `id` was handed to the UART's transmitter (which
+/// then sends it at the line's rate, whatever the planner does), on a board that logs requests
 /// ([`log_request`]).
 pub fn log_reply(id: u32) {
     if Active::frame_end().is_some() {
