@@ -11,7 +11,8 @@ source scripts/setup.sh
 # run in the background while the rest builds in target/ (on a fresh clone that saves a minute or
 # two of the first run): the STM32H743's QEMU capacity twin (the H743's capacity and RAM regions
 # on the same QEMU board) that host/tests/qemu_twin.rs boots, and defmt-print, if missing, which
-# golden-boot.sh decodes the boot log with (scripts/install-defmt-print.sh). Their output goes to
+# golden-boot.sh decodes the boot log with and host/tests/qemu_responsive.rs the firmware's
+# latency log (scripts/install-defmt-print.sh). Their output goes to
 # a log that is shown if they fail.
 logs=$(mktemp -d)
 twin_pid=""
@@ -46,16 +47,17 @@ cargo test -p ohaca --target host-tuple
 cargo build --release
 join twin-h743 "$twin_pid"
 twin_pid=""
+# defmt-print before the host tests: qemu_responsive.rs reads the firmware's log with it.
+if [ -n "$defmt_pid" ]; then
+  join defmt-print "$defmt_pid"
+  defmt_pid=""
+fi
 # Host tool (incl. QEMU end-to-end tests, the twin's on 1024 x 1024 and 2048 x 1024 maps),
 # references, properties, shared maps. Profile `host` (Cargo.toml): optimised, since the
 # shared-map checks plan thousands of times, without the firmware's fat LTO. It also builds the
 # `ohaca` tool the tests run, target/<host>/host/ohaca, which ros-test.sh below reuses.
 cargo test --profile host -p ohaca-host -p ohaca-host-tests --target host-tuple
 # The firmware's boot log against tests/golden/boot.txt, and the protocol selftest over QEMU.
-if [ -n "$defmt_pid" ]; then
-  join defmt-print "$defmt_pid"
-  defmt_pid=""
-fi
 scripts/golden-boot.sh --no-build
 scripts/qemu-selftest.sh --no-build
 # `ohaca ros` as a ROS 2 node against Eclipse Cyclone DDS, loopback only: on the QEMU firmware,

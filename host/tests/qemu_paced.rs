@@ -450,7 +450,8 @@ fn stats_and_a_cell_update_pass_a_long_path() {
 }
 
 /// A Cancel sent while a long path goes out is answered within 50 ms of the line, the path stops
-/// (no part after the Cancel's answer but the one on the wire) and its plan gets `Cancelled`;
+/// (no part after the Cancel's answer: `qemu_responsive.rs` repeats it 200 times) and its plan
+/// gets `Cancelled`;
 /// the device then plans and answers as before.
 #[test]
 fn a_cancel_stops_a_long_path_at_once() {
@@ -473,7 +474,7 @@ fn a_cancel_stops_a_long_path_at_once() {
     let ack = fs.iter().find(|f| f.id == cancel).expect("the Ack");
     let after: Vec<&Frame> = fs
         .iter()
-        .filter(|f| f.id == plan && f.kind == "PathPart" && f.first.to_host > ack.last.to_host)
+        .filter(|f| f.id == plan && f.kind == "PathPart" && f.first.to_host > ack.first.to_host)
         .collect();
     let parts = fs.iter().filter(|f| f.kind == "PathPart").count();
     println!(
@@ -482,7 +483,7 @@ fn a_cancel_stops_a_long_path_at_once() {
         after.len()
     );
     assert!(w <= FIFTY_MS, "{w}: {fs:?}");
-    assert!(after.len() <= 1, "{after:?}");
+    assert!(after.is_empty(), "{after:?}");
     assert!(parts < 13, "the whole path went out: {fs:?}");
     let s = link.stats().expect("stats");
     assert_eq!((s.cancelled, s.replies_dropped, s.rx_overruns), (1, 0, 0));
@@ -611,13 +612,13 @@ fn the_twins_16000_step_path_lets_replies_pass_and_stops_at_a_cancel() {
     let w3 = waited(&fs, cancel, sent);
     println!("twin: Cancel during it answered after {w3} host-bound bytes");
     assert!(w3 <= FIFTY_MS, "{w3}");
-    // At most the part already going out follows the Ack.
+    // No part follows the Ack (issue 38: a Cancel is final).
     let ack = fs.iter().find(|f| f.id == cancel).expect("the Ack");
     let after = fs
         .iter()
-        .filter(|f| f.id == plan && f.kind == "PathPart" && f.first.to_host > ack.last.to_host)
+        .filter(|f| f.id == plan && f.kind == "PathPart" && f.first.to_host > ack.first.to_host)
         .count();
-    assert!(after <= 1, "{after} parts after the Ack");
+    assert_eq!(after, 0, "{after} parts after the Ack");
     let s = link.stats().expect("stats");
     assert_eq!((s.parted, s.cancelled, s.replies_dropped), (2, 1, 0));
 }

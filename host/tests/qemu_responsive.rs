@@ -195,7 +195,10 @@ fn while_planning(map: &Map, start: Point, goal: Point, params: &Params) -> (Vec
         match link.wait_for(id, "Stats").expect("stats") {
             Response::Stats(s) if s.planning => during.push(id),
             Response::Stats(s) if s.plans > 0 || s.plan_errors > 0 => {
-                panic!("the plan ended after {} samples: make it longer", during.len())
+                panic!(
+                    "the plan ended after {} samples: make it longer",
+                    during.len()
+                )
             }
             Response::Stats(_) => {}
             other => panic!("{other:?}"),
@@ -213,7 +216,9 @@ fn while_planning(map: &Map, start: Point, goal: Point, params: &Params) -> (Vec
     let (ins, outs) = qemu::device_times(&qemu::device_log(&log));
     let _ = std::fs::remove_file(&log);
     let latency = |req: u32, reply: u32| -> u64 {
-        let t_in = *ins.get(&req).unwrap_or_else(|| panic!("no log of request {req}"));
+        let t_in = *ins
+            .get(&req)
+            .unwrap_or_else(|| panic!("no log of request {req}"));
         let t_out = outs
             .get(&reply)
             .and_then(|v| v.iter().copied().find(|&t| t >= t_in))
@@ -234,7 +239,10 @@ fn check(what: &str, (answers, cancel): (Vec<u64>, u64)) {
         cancel as f64 / 1e3
     );
     assert!(worst <= BOUND, "{what}: a Stats waited {worst} ticks");
-    assert!(cancel <= BOUND, "{what}: the Cancel took {cancel} ticks to stop it");
+    assert!(
+        cancel <= BOUND,
+        "{what}: the Cancel took {cancel} ticks to stop it"
+    );
 }
 
 /// A plan that runs long (4000 iterations, no early stop) on a 26 x 26 map: answered and
@@ -278,4 +286,75 @@ fn requests_are_answered_while_new_york_plans() {
         "NewYork_0_512",
         while_planning(&map, Point::new(509, 443), Point::new(0, 9), &params),
     );
+}
+
+/// The QEMU board's receive side, measured (docs/FIRMWARE.md, "Receiving"): while New York
+/// plans (planner pieces of 7-20 M instructions today), a burst of empty frames as large as the
+/// window (1,024 bytes) and then one of 8,192 bytes, each at the line's rate. Within the window
+/// nothing is lost. Beyond it, what is lost is counted: by the firmware (`rx_overruns`, its
+/// 1 KiB ring full) or by the relay (QEMU's socket full: QEMU's UART model holds bytes back in
+/// its character device while the firmware has not read the last, which a board's UART does
+/// not). Printed: what QEMU held back at most, and who dropped what.
+#[test]
+fn the_receive_side_within_and_beyond_the_window() {
+    need_qemu!();
+    let (mut q, mut link, counters) = boot_paced(BAUD);
+    link.hello().expect("hello");
+    let map = Map::load(maps().join("large/NewYork_0_512.map")).expect("map");
+    link.set_map(&map).expect("upload New York");
+    let params = Params {
+        iterations: 4000,
+        patience: 0,
+        refine_patience: 0,
+        refine: false,
+        seed: 1,
+        ..Params::default()
+    };
+    link.set_params(&params).expect("params");
+    let plan = link
+        .send(&Request::Plan {
+            start: Point::new(509, 443),
+            goal: Point::new(0, 9),
+            seed: Some(1),
+        })
+        .expect("send the plan");
+    link.transport().wait_sent(TIMEOUT).expect("plan sent");
+    for burst in [1024usize, 8192] {
+        let before = link.stats().expect("stats");
+        assert!(before.planning, "the plan ended: make it longer");
+        let line0 = counters.snapshot();
+        counters.reset_backlog_max();
+        link.send_raw(&vec![0u8; burst]).expect("burst");
+        link.transport().wait_sent(TIMEOUT).expect("burst sent");
+        // A Stats (after a `00`, should a dropped byte have left a partial frame).
+        let after = (0..3)
+            .find_map(|_| {
+                let _ = link.send_raw(&[0]);
+                link.stats().ok()
+            })
+            .expect("stats after the burst");
+        let line = counters.snapshot().since(&line0);
+        let relay_lost = line.to_device_dropped;
+        let device_lost = u64::from(after.rx_overruns - before.rx_overruns);
+        // The Stats request itself is in rx_bytes too.
+        let device_got = u64::from(after.rx_bytes - before.rx_bytes);
+        println!(
+            "burst of {burst} bytes at {BAUD} while New York plans: QEMU held back up to {} \
+             bytes; the relay lost {relay_lost} (QEMU's socket full), the firmware dropped \
+             {device_lost} (its ring full) and read {device_got}; still planning: {}",
+            counters.held_max(),
+            after.planning
+        );
+        assert!(
+            device_got + device_lost + relay_lost >= line.to_device,
+            "{line}"
+        );
+        if burst <= 1024 {
+            assert_eq!((relay_lost, device_lost), (0, 0), "lost inside the window");
+        }
+    }
+    link.send(&Request::Cancel).expect("cancel");
+    let r = link.wait_for(plan, "Plan").expect("the plan's answer");
+    assert_eq!(r, Response::Error(ErrorReply::new(ErrorCode::Cancelled)));
+    assert!(q.is_running());
 }

@@ -94,6 +94,7 @@ pub struct Counters {
     to_device_dropped: AtomicU64,
     to_host_line: AtomicU64,
     backlog_max: AtomicU64,
+    held_max: AtomicU64,
     closed: AtomicBool,
     /// Recent device-bound deliveries, for [`Counters::stamp_of`], and their signal.
     stamps: Mutex<VecDeque<Stamp>>,
@@ -151,6 +152,7 @@ impl Counters {
             to_device_dropped: AtomicU64::new(0),
             to_host_line: AtomicU64::new(0),
             backlog_max: AtomicU64::new(0),
+            held_max: AtomicU64::new(0),
             closed: AtomicBool::new(false),
             stamps: Mutex::new(VecDeque::new()),
             delivered: Condvar::new(),
@@ -200,9 +202,19 @@ impl Counters {
         self.backlog_max.load(Ordering::Acquire)
     }
 
-    /// Start [`Counters::backlog_max`] again from 0.
+    /// Start [`Counters::backlog_max`] and [`Counters::held_max`] again from 0.
     pub fn reset_backlog_max(&self) {
         self.backlog_max.store(0, Ordering::Release);
+        self.held_max.store(0, Ordering::Release);
+    }
+
+    /// The most device-bound bytes delivered to QEMU's end of the socket that QEMU had not yet
+    /// taken (its UART takes one when the firmware has read the last): what QEMU held back, since
+    /// the start or the last [`Counters::reset_backlog_max`]. Estimated from the socket's send
+    /// queue (`SIOCOUTQ`, which counts the kernel's memory per one-byte write: divided by that
+    /// cost, measured once on a spare socket pair); 0 where the kernel does not say.
+    pub fn held_max(&self) -> u64 {
+        self.held_max.load(Ordering::Acquire)
     }
 
     /// True once the device side has closed (QEMU exited) or failed.
@@ -528,6 +540,7 @@ fn to_device_loop(
     let sock = SockRef::from(device);
     let flags = libc::MSG_DONTWAIT | libc::MSG_NOSIGNAL;
     let mut line = Line::new(counters.baud);
+    let per_byte = send_queue_per_byte();
     let mut queue: VecDeque<u8> = VecDeque::new();
     let mut ready = Instant::now();
     while !stop.load(Ordering::Acquire) {
@@ -564,7 +577,38 @@ fn to_device_loop(
             }
         };
         counters.record_to_device(dropped);
+        if per_byte > 0 {
+            let held = send_queue(device) / per_byte;
+            counters.held_max.fetch_max(held, Ordering::AcqRel);
+        }
     }
+}
+
+/// The kernel's count for `s`'s send queue (`SIOCOUTQ`): for a Unix stream socket, the memory of
+/// the writes its peer has not read yet; 0 if it does not say. The host tool's one `unsafe`: no
+/// safe wrapper of `SIOCOUTQ` is among its dependencies.
+#[allow(unsafe_code)]
+fn send_queue(s: &UnixStream) -> u64 {
+    let mut n: libc::c_int = 0;
+    // SAFETY: SIOCOUTQ writes one c_int through the pointer, which points at `n`.
+    let r = unsafe { libc::ioctl(s.as_raw_fd(), libc::TIOCOUTQ, &mut n) };
+    if r == 0 {
+        u64::try_from(n).unwrap_or(0)
+    } else {
+        0
+    }
+}
+
+/// What [`send_queue`] counts for one one-byte write its peer has not read (measured on a spare
+/// socket pair); 0 if it cannot be measured.
+fn send_queue_per_byte() -> u64 {
+    let Ok((a, _b)) = UnixStream::pair() else {
+        return 0;
+    };
+    if (&a).write(&[0]).is_err() {
+        return 0;
+    }
+    send_queue(&a)
 }
 
 /// The host-bound direction: one byte at a time from the device, read only when the line is free

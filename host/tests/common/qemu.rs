@@ -333,10 +333,7 @@ pub fn boot_paced_with(elf: &Path, baud: u32) -> (PacedQemu, Link<RelayStream>, 
 
 /// [`boot_paced`] under `-icount shift=0` (one device tick = 1000 instructions), the firmware's
 /// defmt log (QEMU's stdout) kept in `log` for [`device_log`].
-pub fn boot_paced_icount(
-    baud: u32,
-    log: &Path,
-) -> (PacedQemu, Link<RelayStream>, Arc<Counters>) {
+pub fn boot_paced_icount(baud: u32, log: &Path) -> (PacedQemu, Link<RelayStream>, Arc<Counters>) {
     let mut c = qemu_base(firmware());
     c.args(["-icount", "shift=0"]);
     let file = std::fs::File::create(log).expect("create the defmt log file");
@@ -431,7 +428,10 @@ pub fn frames(arrivals: &[Arrival]) -> Vec<Frame> {
             let _ = reader.push(0);
             continue;
         }
-        if let Some(f) = reader.push(a.byte).into_frame(ohaca::protocol::MAX_REPLY_WIRE) {
+        if let Some(f) = reader
+            .push(a.byte)
+            .into_frame(ohaca::protocol::MAX_REPLY_WIRE)
+        {
             let (id, kind) = match f.and_then(ohaca::protocol::decode_reply) {
                 Ok((id, r)) => (id, ohaca_host::link::Response::from(&r).kind()),
                 Err(_) => (0, "undecodable"),

@@ -7,9 +7,9 @@
 //! board does when a host sends beyond its window). Hardware overruns (STATE.RXOVERRUN) are
 //! counted too. Transmit polls TXFULL and yields while the UART is busy.
 
+use core::cell::Cell;
 use core::convert::Infallible;
 use core::ptr::{read_volatile, write_volatile};
-use core::cell::Cell;
 use core::sync::atomic::{AtomicU32, Ordering};
 
 use cortex_m::interrupt::InterruptNumber;
@@ -83,7 +83,10 @@ fn write(off: usize, v: u32) {
 
 pub fn init() -> (Rx, Tx) {
     write(BAUDDIV, SYSCLK_HZ / BAUD);
-    write(CTRL, CTRL_TX_EN | CTRL_RX_EN | CTRL_TX_INT_EN | CTRL_RX_INT_EN);
+    write(
+        CTRL,
+        CTRL_TX_EN | CTRL_RX_EN | CTRL_TX_INT_EN | CTRL_RX_INT_EN,
+    );
     // SAFETY: the handlers (`on_rx_interrupt`, `on_tx_interrupt`) only touch the rings and the
     // UART, both safe to use from interrupt context; no critical section relies on these
     // interrupts being masked.
