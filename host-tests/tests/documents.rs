@@ -6,12 +6,15 @@
 //!   counted), `TooLarge` reporting the frame's whole length, and the largest request's size;
 //! - its reply limits: `MAX_STEPS`, `MAX_WAYPOINTS`, `MAX_DIRECTIONS`, `MAX_REPLY` and
 //!   `MAX_REPLY_WIRE`, and that the widest path reply is exactly `MAX_REPLY` bytes;
+//! - the widest path reply in parts (its body, its parts, the largest part and all of them on the
+//!   wire) and the STM32F411's path steps per layout, in `docs/PROTOCOL.md` and
+//!   `docs/FIRMWARE.md`;
 //! - the parameter table of `docs/ALGORITHM.md` against `Params::default()` and `Params::paper()`.
 
 use ohaca::protocol::{
-    encode_reply, encode_request, Feed, PathReply, Reply, Request, RequestReader, Waypoints,
-    MAX_CHUNK, MAX_DIRECTIONS, MAX_REPLY, MAX_REPLY_WIRE, MAX_REQUEST, MAX_REQUEST_WIRE, MAX_STEPS,
-    MAX_UPDATE_CELLS, MAX_WAYPOINTS, VERSION,
+    encode_reply, encode_request, Feed, PathBody, PathPart, PathReply, Reply, Request,
+    RequestReader, Waypoints, MAX_CHUNK, MAX_DIRECTIONS, MAX_REPLY, MAX_REPLY_WIRE, MAX_REQUEST,
+    MAX_REQUEST_WIRE, MAX_STEPS, MAX_UPDATE_CELLS, MAX_WAYPOINTS, PART_BYTES, VERSION,
 };
 use ohaca::{DeadEnd, Params, Point, SmoothingKind};
 
@@ -130,7 +133,15 @@ fn the_reply_size_limits_are_the_documents() {
     // exactly MAX_REPLY bytes of payload, and fits MAX_REPLY_WIRE on the wire.
     let points = vec![Point::new(u16::MAX, u16::MAX); MAX_WAYPOINTS];
     let dirs = vec![7u8; MAX_DIRECTIONS];
-    let widest = Reply::Path(PathReply {
+    let widest = Reply::Path(widest_path(&points, &dirs));
+    let mut buf = vec![0u8; MAX_REPLY_WIRE];
+    let n = encode_reply(u32::MAX, &widest, &mut buf).expect("the widest path fits");
+    assert_eq!(decoded_len(&buf[..n - 1]), MAX_REPLY);
+}
+
+/// The widest path reply: every field at its longest varint, every step a waypoint.
+fn widest_path<'a>(points: &'a [Point], dirs: &'a [u8]) -> PathReply<'a> {
+    PathReply {
         raw_length: f32::MAX,
         length: f32::MAX,
         turns: u32::MAX,
@@ -140,12 +151,105 @@ fn the_reply_size_limits_are_the_documents() {
         ticks: u64::MAX,
         raw_cells: u32::MAX,
         origin: ohaca::planner::Origin::Reused,
-        waypoints: Waypoints::Points(&points),
-        directions: &dirs,
-    });
-    let mut buf = vec![0u8; MAX_REPLY_WIRE];
-    let n = encode_reply(u32::MAX, &widest, &mut buf).expect("the widest path fits");
-    assert_eq!(decoded_len(&buf[..n - 1]), MAX_REPLY);
+        waypoints: Waypoints::Points(points),
+        directions: dirs,
+    }
+}
+
+/// `n` with a space between thousands, as the documents write figures ("81 975").
+fn spaced(n: usize) -> String {
+    let digits = n.to_string();
+    let mut out = String::new();
+    for (i, c) in digits.chars().enumerate() {
+        if i > 0 && (digits.len() - i) % 3 == 0 {
+            out.push(' ');
+        }
+        out.push(c);
+    }
+    out
+}
+
+/// The widest path reply in parts, as a device sends it: its body (`MAX_REPLY` less the id, the
+/// variant and the CRC), how many parts, the largest part on the wire (offset and `total_len`
+/// fit three varint bytes, not the five `PART_BYTES`' bound allows), and every part on the wire.
+#[test]
+fn the_widest_reply_in_parts_is_the_documents() {
+    let points = vec![Point::new(u16::MAX, u16::MAX); MAX_WAYPOINTS];
+    let dirs = vec![7u8; MAX_DIRECTIONS];
+    let path = widest_path(&points, &dirs);
+    let body = PathBody::new(&path).expect("the widest body");
+    let total = body.len();
+    let (mut offset, mut parts, mut largest, mut wire) = (0, 0, 0, 0);
+    let mut bytes = [0u8; PART_BYTES];
+    let mut frame = vec![0u8; 512];
+    while offset < total {
+        let k = body.read(offset, &mut bytes);
+        let part = PathPart {
+            offset: offset as u32,
+            total_len: total as u32,
+            bytes: &bytes[..k],
+        };
+        let n = encode_reply(u32::MAX, &Reply::PathPart(part), &mut frame).expect("a part");
+        (parts, largest, wire) = (parts + 1, largest.max(n), wire + n);
+        offset += k;
+    }
+    assert_eq!((total, parts, largest, wire), (81_975, 427, 212, 90_428));
+    let text = doc("PROTOCOL.md");
+    for want in [
+        format!("{} bytes of body", spaced(total)),
+        format!("{parts} parts, {} bytes on the wire", spaced(wire)),
+        format!("a part is at most {largest} bytes on the wire"),
+        format!("at most {largest} bytes on the wire: "),
+    ] {
+        assert!(text.contains(&want), "PROTOCOL.md lacks {want:?}");
+    }
+}
+
+/// The STM32F411's (and the default QEMU board's) path steps: `Hello`'s `max_steps`, the full
+/// layout's steps up to the largest map that has it, and the compact layout's on the largest maps,
+/// as docs/PROTOCOL.md's `Capacity` and docs/FIRMWARE.md say.
+#[test]
+fn the_f411_steps_are_the_documents() {
+    use ohaca::board::{Layout, F411};
+    use ohaca::planner::arena::steps_for;
+    let Layout::Arena { words } = F411.layout else {
+        panic!("the F411 has an arena")
+    };
+    let steps = |cells| steps_for(words, cells, F411.max_steps).expect("it takes the map");
+    assert_eq!(F411.max_steps, 4095);
+    // The full layout's largest map, and the compact layout's first and largest.
+    let full = (1..=F411.cells)
+        .rev()
+        .find(|&c| !steps(c).1)
+        .expect("a map in the full layout");
+    assert_eq!((full, steps(full)), (68_256, (2047, false)));
+    for cells in [full + 1, 512 * 506, 512 * 512] {
+        assert_eq!(steps(cells), (4095, true), "{cells} cells");
+    }
+    let capacity = format!(
+        "{} on the QEMU board and the STM32F411 (ant paths of up to {} steps on maps of up to {} \
+         cells, the full layout; {} on every larger map they take, 512 x 512 included)",
+        spaced(F411.max_steps),
+        spaced(steps(full).0),
+        spaced(full),
+        spaced(steps(F411.cells).0)
+    );
+    let protocol = doc("PROTOCOL.md").replace('\n', " ");
+    assert!(
+        protocol.contains(&capacity),
+        "PROTOCOL.md lacks {capacity:?}"
+    );
+    let firmware = doc("FIRMWARE.md").replace('\n', " ");
+    for want in [
+        format!("`max_steps` = {}", spaced(F411.max_steps)),
+        format!(
+            "{} steps on maps of up to {} cells",
+            spaced(steps(full).0),
+            spaced(full)
+        ),
+    ] {
+        assert!(firmware.contains(&want), "FIRMWARE.md lacks {want:?}");
+    }
 }
 
 /// Payload bytes (postcard + CRC) of `req` with the longest id.

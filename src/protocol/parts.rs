@@ -20,9 +20,9 @@ use serde::{Deserialize, Serialize};
 
 use super::{EncodeError, PathReply, Waypoints, MAX_REPLY, WAYPOINT_BYTES};
 
-/// Most body bytes in one [`PathPart`]: its frame is at most 213 bytes on the wire (id, variant,
-/// offset, length and byte-string length as the longest varints, CRC, COBS and delimiter), 18.5
-/// ms at 115,200 baud. A path whose body is at most this long goes whole, as one `Path` frame.
+/// Most body bytes in one [`PathPart`]: its frame is at most 212 bytes on the wire (id, variant,
+/// offset and length under 2^21 (three varint bytes each, as no body exceeds `MAX_REPLY`),
+/// byte-string length, CRC, COBS and delimiter), 18.4 ms at 115,200 baud. A path whose body is at most this long goes whole, as one `Path` frame.
 pub const PART_BYTES: usize = 192;
 
 /// Room for the fixed fields of a path (at most 50 bytes) and the length of the waypoints.
