@@ -71,7 +71,8 @@ fn wait_host_bytes(counters: &Counters, base: u64, n: u64) {
 /// `Cancel` sent together after a different number of the answer's bytes each time (0 to 250 of
 /// its 489: during the plan, between and inside parts, after the last part was committed). No `Path` or `PathPart`
 /// of the plan ever starts after the `Ack`; the plan's answer is `Cancelled` or the whole path;
-/// the device counts them exactly.
+/// the device counts them exactly, and each `Stats` (answered before, between or after the parts)
+/// counts in `tx_frames` exactly the frames before it on the line.
 ///
 /// The `Stats` in front makes the old race likely: the transmitter holds it while the planner,
 /// past its stop check, waits for it; the `Ack` queued meanwhile went out first, then the part.
@@ -101,6 +102,13 @@ fn a_cancel_is_final() {
     let total: u64 = whole.iter().map(|f| f.len).sum();
     assert_eq!(whole.len(), 3, "{whole:?}");
     let before = link.stats().expect("stats");
+    // Reply frames the device has sent so far: those before `before` and `before` itself (no
+    // other reply is outstanding).
+    let mut sent = before.tx_frames + 1;
+    let last = frames(&link.transport().take_arrivals())
+        .last()
+        .map(|f| f.id);
+    assert_eq!(last, Some(link.next_id() - 1), "the Stats reply came last");
     let (mut stopped, mut unstarted, mut complete) = (0u32, 0u32, 0u32);
     for round in 0..ROUNDS {
         // 0, 7, 14, ... host-bound bytes into the answer, wrapping at SPAN: the last part is in
@@ -123,9 +131,18 @@ fn a_cancel_is_final() {
         let cancel = link.send(&Request::Cancel).expect("send Cancel");
         assert_eq!(link.wait_for(cancel, "Cancel").expect("ack"), Response::Ack);
         let answer = link.wait_for(plan, "Plan").expect("the plan's answer");
-        link.wait_for(stats, "Stats").expect("stats");
-
+        let Response::Stats(counted) = link.wait_for(stats, "Stats").expect("stats") else {
+            panic!("round {round}: not a Stats reply")
+        };
         let fs = frames(&link.transport().take_arrivals());
+        // The Stats counts exactly the frames before it on the line (a part just before it
+        // included), not itself.
+        for f in &fs {
+            if f.id == stats {
+                assert_eq!(counted.tx_frames, sent, "round {round}: tx_frames: {fs:?}");
+            }
+            sent += 1;
+        }
         let ack = fs.iter().find(|f| f.id == cancel).expect("the Ack's frame");
         let ours: Vec<_> = fs
             .iter()
