@@ -577,8 +577,7 @@ fn to_device_loop(
             }
         };
         counters.record_to_device(dropped);
-        if per_byte > 0 {
-            let held = send_queue(device) / per_byte;
+        if let Some(held) = send_queue(device).checked_div(per_byte) {
             counters.held_max.fetch_max(held, Ordering::AcqRel);
         }
     }
