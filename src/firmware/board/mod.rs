@@ -4,7 +4,7 @@
 //!
 //! | board | feature | UART | time driver | logs | exit |
 //! | --- | --- | --- | --- | --- | --- |
-//! | [`qemu`] (default) | `board-qemu` | CMSDK APB UART0, RX interrupt + ring | SysTick, 1 tick = 1 µs | semihosting | semihosting exit |
+//! | [`qemu`] (default) | `board-qemu` | CMSDK APB UART0, RX and TX interrupts + rings | SysTick, 1 tick = 1 µs | semihosting | semihosting exit |
 //! | [`stm32f411`] | `board-stm32f411` | USART1 `BufferedUart` (PA9 TX, PA10 RX) | embassy-stm32 (TIM) | RTT | system reset |
 
 //! | [`stm32h743`] | `board-stm32h743` | USART3 `BufferedUart` (PD8 TX, PD9 RX: the ST-LINK's virtual COM port) | embassy-stm32 (TIM) | RTT | system reset |
