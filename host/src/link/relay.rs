@@ -824,6 +824,13 @@ mod tests {
         let c = relay.counters();
         assert_eq!(c.to_device_line(), n);
         assert!(c.to_device_dropped() >= 400, "{:?}", c.snapshot());
+        // What the device side held untaken: every byte delivered (the device never read).
+        let held = c.held_max();
+        let delivered = c.to_device_delivered();
+        assert!(
+            held * 10 >= delivered * 9 && held <= delivered,
+            "held {held} of {delivered}"
+        );
     }
 
     /// Toward the host: paced, each byte with its clock, read one at a time from the device.
