@@ -115,6 +115,8 @@ pub(super) struct Iteration {
     worst_replay: Option<Replay>,
     sum: f32,
     arrived: u32,
+    /// An ant of this iteration proved the goal unreachable (the run ends with `NoPath`).
+    no_path: bool,
 }
 
 /// The iteration's best and worst paths for [`wolves`], each from where it is: `iter_best` and
@@ -195,7 +197,7 @@ impl Run<'_, '_> {
     /// them, or, on a workspace without those buffers (empty), walked again from their ants'
     /// [`Replay`] once every ant has walked: two more walks an iteration for two tours fewer,
     /// the same increments and the same best path bit for bit (`docs/ALGORITHM.md`, "Memory").
-    pub(super) fn walk_ants(&mut self, mut on_tour: impl FnMut(&[Dir])) -> Iteration {
+    pub(super) fn walk_ants(&mut self, on_tour: &mut dyn FnMut(&[Dir])) -> Iteration {
         let p = self.params;
         // Every buffer an ant reads or writes (`lend::Colony`).
         let Colony {
@@ -243,7 +245,7 @@ impl Run<'_, '_> {
                     Err(Lost::Exhausted) => {
                         // The goal is not reachable, proved by this ant: backtracking ants run
                         // without the setup's flood fill (`setup.rs`).
-                        self.no_path = true;
+                        it.no_path = true;
                         break;
                     }
                     Err(Lost::Died) => continue,
@@ -263,7 +265,7 @@ impl Run<'_, '_> {
                             self.reach_checked = true;
                             let grid = self.grid;
                             if grid.reachable(self.start, self.goal, tabu, links) == Reach::No {
-                                self.no_path = true;
+                                it.no_path = true;
                                 break;
                             }
                         }
@@ -412,7 +414,9 @@ impl Run<'_, '_> {
         // works in windows along the path (on a small map it is one exact search of the whole
         // map, and the colony's corridor does not matter at all).
         let agreed = self.refines && self.blocks.shift() > 0 && settled(&point, p.ants);
-        self.done = self.no_path || self.iteration >= p.iterations || early || agreed;
+        if it.no_path || self.iteration >= p.iterations || early || agreed {
+            self.phase = self.after_colony(it.no_path);
+        }
     }
 }
 

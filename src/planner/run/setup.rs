@@ -1,29 +1,27 @@
 //! The setup of a run before its first iteration, one piece at a time: the flood fill (is the
 //! goal reachable at all?), dead-end pruning, the coarse route of a large map. The fill and the
 //! pruning read the map (the default preset skips the fill; only the full layout prunes), the
-//! route only the blocks its search closes ([`crate::route::search`]); the firmware yields
-//! between the pieces.
+//! route only the blocks its search closes ([`crate::route::search`]); each is a piece of
+//! [`Run::poll`].
 
 use crate::ant::DeadEnd;
 use crate::grid::{Moves, Reach};
 use crate::prune::{self, prune};
 use crate::route;
 
-use super::{Area, Run, Setup};
+use super::{Area, End, Phase, Run, Setup};
 
 impl Run<'_, '_> {
-    /// Do the next piece of the setup, if any is left: the flood fill (a goal found unreachable
-    /// ends the run: [`Run::finish`] gives [`crate::Error::NoPath`]), the dead-end pruning, the coarse
-    /// route. Returns `true` while setup remains. The flood fill and the pruning read the whole
-    /// map once, the route only the blocks its bounded search closes; the firmware yields between
-    /// the pieces;
-    /// [`Run::step`] does whatever setup is left itself, so other callers never need this.
-    pub fn setup_step(&mut self) -> bool {
+    /// Do the piece `piece` of the setup and move to the next: the flood fill (a goal found
+    /// unreachable ends the run: [`Run::finish`] gives [`crate::Error::NoPath`]), the dead-end
+    /// pruning, the coarse route (then the colony). The flood fill and the pruning read the whole
+    /// map once, the route only the blocks its bounded search closes.
+    pub(super) fn setup_piece(&mut self, piece: Setup) {
         let grid = self.grid;
         let p = &self.params;
         // What the setup owns and the buffers it borrows until the first ant (`lend::Setting`).
         let mut ws = self.ws.setting();
-        match self.setup {
+        match piece {
             Setup::Reach => {
                 // Backtracking ants skip the flood fill, cold or warm: if the goal is cut off,
                 // the first ant backs out of every branch of the start's component and proves it
@@ -38,12 +36,10 @@ impl Run<'_, '_> {
                 if !proved_by_ants
                     && grid.reachable(self.start, self.goal, visited, ring) == Reach::No
                 {
-                    self.no_path = true;
-                    self.done = true;
-                    self.setup = Setup::Done;
-                    return false;
+                    self.phase = Phase::Ended(End::NoPath);
+                    return;
                 }
-                self.setup = Setup::Prune;
+                self.phase = Phase::Setup(Setup::Prune);
             }
             Setup::Prune => {
                 // A workspace without pruning marks (`dead` empty) plans without pruning.
@@ -82,7 +78,7 @@ impl Run<'_, '_> {
                     crate::bitmap::clear(ws.dead, grid.cells());
                     0
                 };
-                self.setup = Setup::Route;
+                self.phase = Phase::Setup(Setup::Route);
             }
             Setup::Route => {
                 // Large maps: the potential field pulls along a coarse route (not for ACA, which
@@ -145,10 +141,8 @@ impl Run<'_, '_> {
                     }
                 };
                 crate::fmt::debug!("plan: {} cells pruned", self.pruned);
-                self.setup = Setup::Done;
+                self.phase = Phase::Colony;
             }
-            Setup::Done => {}
         }
-        self.setup != Setup::Done
     }
 }
