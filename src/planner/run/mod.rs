@@ -52,7 +52,7 @@ use super::plan::Origin;
 use super::plan::{CurvePoint, Plan};
 use super::warm::{self, Answer, Area, Kept, Memory};
 use super::workspace::Workspace;
-use colony::Best;
+use colony::{Best, Walking};
 use polish::{Polish, SMALL_REFINE_WORDS};
 
 /// A warm start whose changed cells' bounding box holds more than `1 / REBUILD_SHARE` of the
@@ -144,12 +144,12 @@ impl Stage {
 }
 
 /// Where a run is: the one value that says which piece [`Run::poll`] does next.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 enum Phase {
     /// The setup, at this piece.
     Setup(Setup),
-    /// The colony's iterations.
-    Colony,
+    /// The colony's iterations, the current one where it stands.
+    Colony(Walking),
     /// The work after the last iteration, at this piece.
     Polish(Polish),
     /// Nothing left: how the run ended.
@@ -217,7 +217,7 @@ impl<'g, 'a> Run<'g, 'a> {
         }
         // The answer, once the polish laid out its waypoints, for a replan to reuse
         // ([`super::reuse`]).
-        if let (Some(best), Phase::Ended(End::Path { waypoints })) = (self.best, self.phase) {
+        if let (Some(best), &Phase::Ended(End::Path { waypoints })) = (self.best, &self.phase) {
             memory.answer = Some(Answer {
                 start: self.start,
                 from: 0,
@@ -464,22 +464,24 @@ impl<'g, 'a> Run<'g, 'a> {
     /// [`Run::poll`], calling `on_tour` for every ant of a colony piece that arrived (see
     /// [`Run::step_observed`]).
     fn poll_observed(&mut self, on_tour: &mut dyn FnMut(&[Dir])) -> Poll {
-        match self.phase {
+        // The phase is taken out for the piece, which sets the next one.
+        match core::mem::replace(&mut self.phase, Phase::Ended(End::NoArrival)) {
             Phase::Setup(s) => {
                 self.setup_piece(s);
                 Poll::Working(Stage::Setup)
             }
-            Phase::Colony => {
-                let it = self.walk_ants(on_tour);
-                self.update();
-                self.record(&it);
+            Phase::Colony(w) => {
+                self.colony_piece(w, on_tour);
                 Poll::Working(Stage::Colony)
             }
             Phase::Polish(p) => {
                 self.polish_piece(p);
                 Poll::Working(Stage::Polish)
             }
-            Phase::Ended(_) => Poll::Done,
+            Phase::Ended(end) => {
+                self.phase = Phase::Ended(end);
+                Poll::Done
+            }
         }
     }
 
@@ -496,10 +498,12 @@ impl<'g, 'a> Run<'g, 'a> {
     /// tests do.
     pub fn step_observed(&mut self, mut on_tour: impl FnMut(&[Dir])) -> bool {
         let iteration = self.iteration;
-        while matches!(self.phase, Phase::Setup(_) | Phase::Colony) && self.iteration == iteration {
+        while matches!(self.phase, Phase::Setup(_) | Phase::Colony(_))
+            && self.iteration == iteration
+        {
             self.poll_observed(&mut on_tour);
         }
-        matches!(self.phase, Phase::Colony)
+        matches!(self.phase, Phase::Colony(_))
     }
 
     /// The phase after the colony stopped: the polish of the best path, or the end when no ant
@@ -532,8 +536,15 @@ impl<'g, 'a> Run<'g, 'a> {
     /// if ants were dropped for paths longer than the workspace keeps, and with [`Error::NoPath`]
     /// if an unreachable goal ended the run.
     pub fn finish(mut self) -> Result<Plan<'a>, Error> {
-        // Stopped early (before the colony ended by itself): the polish of the best so far.
-        if let Phase::Setup(_) | Phase::Colony = self.phase {
+        // Stopped early (before the colony ended by itself): the iteration under way is ended
+        // first (its best path may be half placed), then the polish of the best so far.
+        while let Phase::Colony(w) = &self.phase {
+            if !w.started() {
+                break;
+            }
+            self.poll();
+        }
+        if let Phase::Setup(_) | Phase::Colony(_) = self.phase {
             self.phase = self.after_colony(false);
         }
         while let Poll::Working(_) = self.poll() {}

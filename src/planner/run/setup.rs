@@ -141,7 +141,7 @@ impl Run<'_, '_> {
                     }
                 };
                 crate::fmt::debug!("plan: {} cells pruned", self.pruned);
-                self.phase = Phase::Colony;
+                self.phase = Phase::Colony(Default::default());
             }
         }
     }
