@@ -31,8 +31,8 @@ MAPS = [
     ("maps/large/Sydney_0_1024.map", None, None),
 ]
 LINE = re.compile(r"plan (\d+): (\d+) iterations, .* (\d+) ticks \(new \d+, steps \d+, finish \d+\), "
-                  r"largest piece (\d+) ticks \((\w+); new (\d+), setup (\d+), colony (\d+), "
-                  r"polish (\d+), finish (\d+)\)")
+                  r"largest piece (\d+) ticks \((\w+); new (\d+), setup (\d+) (\w*), "
+                  r"colony (\d+) (\w*), polish (\d+) (\w*), finish (\d+)\)")
 
 
 def longest(map_path):
@@ -92,8 +92,8 @@ def main():
         k += 1
         m = lambda t: f"{int(t) / 1000:.3f}"
         print(f"| `{os.path.basename(path)}` | {start} -> {goal} | {seed} | {g[1]} | {m(r['ticks'])} "
-              f"| **{m(g[3])}** ({g[4]}) | {m(g[5])} | {m(g[6])} | {m(g[7])} | {m(g[8])} "
-              f"| {m(g[9])} | `{digest}` |")
+              f"| **{m(g[3])}** ({g[4]}) | {m(g[5])} | {m(g[6])} {g[7]} | {m(g[8])} {g[9]} "
+              f"| {m(g[10])} {g[11]} | {m(g[12])} | `{digest}` |")
     return 0
 
 

@@ -151,16 +151,17 @@ async fn plan(
     let t_new = Instant::now();
     let mut spent = [0u64; 3];
     // The largest piece of each stage.
-    let mut most = [0u64; 3];
+    let mut most = [(0u64, ""); 3];
     let mut largest = (t_new.saturating_duration_since(t0).as_ticks(), "new");
     loop {
+        let name = run.piece();
         let t = Instant::now();
         let Poll::Working(stage) = run.poll() else {
             break;
         };
         let piece = Instant::now().saturating_duration_since(t).as_ticks();
         if piece > largest.0 {
-            largest = (piece, stage.name());
+            largest = (piece, name);
         }
         let i = match stage {
             Stage::Setup => 0,
@@ -169,7 +170,9 @@ async fn plan(
         };
         if let (Some(s), Some(m)) = (spent.get_mut(i), most.get_mut(i)) {
             *s = s.saturating_add(piece);
-            *m = (*m).max(piece);
+            if piece > m.0 {
+                *m = (piece, name);
+            }
         }
         yield_now().await;
         if state::cancelled(job.generation) {
@@ -199,7 +202,7 @@ async fn plan(
     // `new` is `Run::new` and the setup, `finish` the polish and `Run::finish`
     // (scripts/bench_device.py reads this line).
     defmt::info!(
-        "plan {}: {} iterations, length {}, {} waypoints, {} ticks (new {}, steps {}, finish {}), largest piece {} ticks ({}; new {}, setup {}, colony {}, polish {}, finish {})",
+        "plan {}: {} iterations, length {}, {} waypoints, {} ticks (new {}, steps {}, finish {}), largest piece {} ticks ({}; new {}, setup {} {}, colony {} {}, polish {} {}, finish {})",
         job.id,
         plan.iterations,
         plan.length,
@@ -211,9 +214,12 @@ async fn plan(
         largest.0,
         largest.1,
         t_new.saturating_duration_since(t0).as_ticks(),
-        most_setup,
-        most_colony,
-        most_polish,
+        most_setup.0,
+        most_setup.1,
+        most_colony.0,
+        most_colony.1,
+        most_polish.0,
+        most_polish.1,
         last
     );
     let ready = ready(job, &plan, ticks, bases, (width, height), frame)?;

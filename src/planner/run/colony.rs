@@ -162,6 +162,16 @@ impl Walking {
     pub(super) fn started(&self) -> bool {
         self.ant > 0 || self.now.is_some() || self.close != Close::Ants
     }
+
+    /// The name of the next piece ([`Run::piece`]).
+    pub(super) fn piece(&self) -> &'static str {
+        match self.close {
+            Close::Ants => "walk",
+            Close::Best | Close::Worst => "wolves",
+            Close::Place => "place",
+            Close::Update => "update",
+        }
+    }
 }
 
 /// The steps of an iteration after its ants, in order.

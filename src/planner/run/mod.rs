@@ -175,8 +175,8 @@ enum Setup {
     Reach,
     /// Dead-end pruning ([`Params::prune`]).
     Prune,
-    /// The coarse route on large maps.
-    Route,
+    /// The coarse route on large maps: its search where it paused (`None`: not started).
+    Route(Option<route::Searching>),
 }
 
 impl<'g, 'a> Run<'g, 'a> {
@@ -447,6 +447,22 @@ impl<'g, 'a> Run<'g, 'a> {
     /// [`Run::finish`]): the polish or the end is next.
     pub fn is_done(&self) -> bool {
         matches!(self.phase, Phase::Polish(_) | Phase::Ended(_))
+    }
+
+    /// The name of the piece the next [`Run::poll`] does, for logs: `"reach"`, `"prune"`,
+    /// `"route"`, `"walk"` (the ants), `"wolves"` (the wolves rule's paths), `"place"` (the new
+    /// best's path), `"update"`, `"lay"` (the path laid out), `"refine"`, `"smooth"`, `"end"`.
+    pub fn piece(&self) -> &'static str {
+        match &self.phase {
+            Phase::Setup(Setup::Reach) => "reach",
+            Phase::Setup(Setup::Prune) => "prune",
+            Phase::Setup(Setup::Route(_)) => "route",
+            Phase::Colony(w) => w.piece(),
+            Phase::Polish(Polish::Start) => "lay",
+            Phase::Polish(Polish::Refine(_)) => "refine",
+            Phase::Polish(Polish::Smooth(_)) => "smooth",
+            Phase::Ended(_) => "end",
+        }
     }
 
     /// Do one bounded piece of the run's work and say what it was: [`Poll::Working`] with the

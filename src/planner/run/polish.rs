@@ -41,10 +41,10 @@ pub const SMALL_REFINE_SIDE: usize = 32;
 pub(super) const SMALL_REFINE_WORDS: usize = Scratch::words(SMALL_REFINE_SIDE);
 /// Cells the local search expands in one piece of [`Run::poll`] (a window expands
 /// at most `REFINE_SIDE^2` = 2,704).
-const REFINE_SLICE: u64 = 8192;
+const REFINE_SLICE: u64 = 1;
 /// Raw cells of the smoothing DP in one piece of [`Run::poll`] (each tests at most
 /// [`crate::smoothing::LOOKBACK`] segments).
-const SMOOTH_SLICE: usize = 48;
+const SMOOTH_SLICE: usize = 4;
 
 /// Words at the end of the pheromone increments that the route's stash holds (the local
 /// search's memo stays before them).
