@@ -124,7 +124,7 @@ pub(super) struct Iteration {
 /// depositing a path are charged on the same budget (see [`START_COST`], [`PATH_COST`]).
 /// Measured under `-icount` (`scripts/bench_pieces.py`, `BENCHMARKS.md`): a move costs 100-200
 /// instructions, so a piece stays below 1 M instructions.
-pub(super) const MOVES_A_PIECE: u32 = 2048;
+pub(super) const MOVES_A_PIECE: u32 = 1536;
 /// Moves a walk's start is charged for: its copy of the pruning marks into the tabu set, one word
 /// for 32 cells (a 512 x 512 map: 8,192 words, as much as about 512 moves).
 const fn start_cost(cells: usize) -> u32 {

@@ -451,7 +451,8 @@ impl<'g, 'a> Run<'g, 'a> {
 
     /// The name of the piece the next [`Run::poll`] does, for logs: `"reach"`, `"prune"`,
     /// `"route"`, `"walk"` (the ants), `"wolves"` (the wolves rule's paths), `"place"` (the new
-    /// best's path), `"update"`, `"lay"` (the path laid out), `"refine"`, `"smooth"`, `"end"`.
+    /// best's path), `"update"`, `"lay"` (the path laid out), `"refine"`, `"smooth"` (the DP), `"tail"` (the
+    /// smoothing's trace and taut pull, the corridor), `"end"`.
     pub fn piece(&self) -> &'static str {
         match &self.phase {
             Phase::Setup(Setup::Reach) => "reach",
@@ -461,6 +462,7 @@ impl<'g, 'a> Run<'g, 'a> {
             Phase::Polish(Polish::Start) => "lay",
             Phase::Polish(Polish::Refine(_)) => "refine",
             Phase::Polish(Polish::Smooth(_)) => "smooth",
+            Phase::Polish(Polish::Tail(_)) => "tail",
             Phase::Ended(_) => "end",
         }
     }

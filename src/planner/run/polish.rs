@@ -66,6 +66,8 @@ pub(super) enum Polish {
     Refine(Refiner),
     /// The smoothing of the raw path in `points`, a stretch at a time.
     Smooth(Smoother),
+    /// The smoothing's steps after its DP ([`Smoother::finish_piece`]), then the corridor.
+    Tail(Smoother),
 }
 
 impl Run<'_, '_> {
@@ -184,20 +186,29 @@ impl Run<'_, '_> {
                 if sm.resume(grid, ws.points, dist, links, SMOOTH_SLICE) {
                     Phase::Polish(Polish::Smooth(sm))
                 } else {
-                    let k = sm.finish(grid, ws.points, dist, links);
-                    let waypoints = if corridor {
-                        crate::corridor::shortest(
-                            grid,
-                            ws.points,
-                            k,
-                            crate::corridor::RADIUS,
-                            ws.delta,
-                            ws.idle.links(),
-                        )
-                    } else {
-                        k
-                    };
-                    Phase::Ended(End::Path { waypoints })
+                    Phase::Polish(Polish::Tail(sm))
+                }
+            }
+            Polish::Tail(mut sm) => {
+                let dist = ws.delta.as_flattened_mut();
+                let links = ws.idle.smoothing(sm.cells());
+                match sm.finish_piece(grid, ws.points, dist, links) {
+                    None => Phase::Polish(Polish::Tail(sm)),
+                    Some(k) => {
+                        let waypoints = if corridor {
+                            crate::corridor::shortest(
+                                grid,
+                                ws.points,
+                                k,
+                                crate::corridor::RADIUS,
+                                ws.delta,
+                                ws.idle.links(),
+                            )
+                        } else {
+                            k
+                        };
+                        Phase::Ended(End::Path { waypoints })
+                    }
                 }
             }
         };
