@@ -46,16 +46,18 @@ cargo test -p ohaca --target host-tuple
 cargo build --release
 join twin-h743 "$twin_pid"
 twin_pid=""
+# defmt-print decodes the firmware's log for host/tests/qemu_pieces.rs (the largest piece of a
+# plan, counted under -icount) and for golden-boot.sh below.
+if [ -n "$defmt_pid" ]; then
+  join defmt-print "$defmt_pid"
+  defmt_pid=""
+fi
 # Host tool (incl. QEMU end-to-end tests, the twin's on 1024 x 1024 and 2048 x 1024 maps),
 # references, properties, shared maps. Profile `host` (Cargo.toml): optimised, since the
 # shared-map checks plan thousands of times, without the firmware's fat LTO. It also builds the
 # `ohaca` tool the tests run, target/<host>/host/ohaca, which ros-test.sh below reuses.
 cargo test --profile host -p ohaca-host -p ohaca-host-tests --target host-tuple
 # The firmware's boot log against tests/golden/boot.txt, and the protocol selftest over QEMU.
-if [ -n "$defmt_pid" ]; then
-  join defmt-print "$defmt_pid"
-  defmt_pid=""
-fi
 scripts/golden-boot.sh --no-build
 scripts/qemu-selftest.sh --no-build
 # `ohaca ros` as a ROS 2 node against Eclipse Cyclone DDS, loopback only: on the QEMU firmware,

@@ -5,7 +5,7 @@
 
 use crate::ant::{Ant, DeadEnd, Lost, Trail, Walk};
 use crate::geometry::steps_length;
-use crate::grid::{Dir, Moves, Point, Reach};
+use crate::grid::{Dir, Filling, Moves, Point, Reach};
 use crate::pheromone::Table;
 use crate::rng::Xoshiro128pp;
 use crate::tighten::tighten;
@@ -135,6 +135,9 @@ const fn start_cost(cells: usize) -> u32 {
         words as u32
     }
 }
+/// Cells of the flood fill a move of the budget pays for (a cell costs about 15 instructions, a
+/// move a few hundred).
+const FILL_CELLS: usize = 32;
 /// Path steps a move of the budget pays for in tightening and depositing a path (each step is
 /// read a few times: tightening's index, the deposit).
 const PATH_COST: usize = 2;
@@ -155,12 +158,15 @@ pub(super) struct Walking {
     again: Option<(Trail, Xoshiro128pp)>,
     /// The best path was walked again into `best` for the wolves rule.
     placed: bool,
+    /// The flood fill an ant that outgrew its tour started (see `Lost::Overflow` below), where it
+    /// paused; it ends before the next ant walks (it uses the tabu set and the links).
+    filling: Option<Filling>,
 }
 
 impl Walking {
     /// Whether this iteration has begun (an ant walked or walks).
     pub(super) fn started(&self) -> bool {
-        self.ant > 0 || self.now.is_some() || self.close != Close::Ants
+        self.ant > 0 || self.now.is_some() || self.close != Close::Ants || self.filling.is_some()
     }
 
     /// The name of the next piece ([`Run::piece`]).
@@ -309,6 +315,21 @@ impl Run<'_, '_> {
         while left > 0 {
             match w.close {
                 Close::Ants => {
+                    if let Some(mut fill) = w.filling.take() {
+                        let cells = (left as usize).saturating_mul(FILL_CELLS);
+                        let grid = self.grid;
+                        match grid.reach_resume(self.goal, tabu, links, &mut fill, cells) {
+                            None => {
+                                w.filling = Some(fill);
+                                left = 0;
+                            }
+                            Some(reach) => {
+                                left = left.saturating_sub(1);
+                                w.it.no_path |= reach == Reach::No;
+                            }
+                        }
+                        continue;
+                    }
                     let (mut trail, before, budget) = match w.now.take() {
                         Some(now) => now,
                         None if w.ant < p.ants && !w.it.no_path => {
@@ -364,11 +385,11 @@ impl Run<'_, '_> {
                                         && !self.reach_checked
                                     {
                                         self.reach_checked = true;
+                                        // A piece at a time, before the next ant.
                                         let grid = self.grid;
-                                        if grid.reachable(self.start, self.goal, tabu, links)
-                                            == Reach::No
-                                        {
-                                            w.it.no_path = true;
+                                        match grid.reach_begin(self.start, self.goal, tabu, links) {
+                                            Ok(fill) => w.filling = Some(fill),
+                                            Err(reach) => w.it.no_path |= reach == Reach::No,
                                         }
                                     }
                                 }

@@ -144,6 +144,9 @@ impl Stage {
 }
 
 /// Where a run is: the one value that says which piece [`Run::poll`] does next.
+// The colony's variant is the largest (its iteration's replays: about 260 bytes); the core has no
+// heap to box it in, and a run holds one phase.
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Debug)]
 enum Phase {
     /// The setup, at this piece.
