@@ -131,7 +131,7 @@ pub(super) fn search(
     }
 }
 
-/// Where a search stands between two pieces ([`begin`], [`resume`]): the heap's length,
+/// Where a search stands between two pieces ([`super::begin_build`], [`super::resume`]): the heap's length,
 /// the widening's bounds and the counts so far; the words and the heap hold the rest.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Searching {

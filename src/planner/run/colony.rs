@@ -119,11 +119,13 @@ pub(super) struct Iteration {
     no_path: bool,
 }
 
-/// Turns of the ants' walk loops (a move forward, a move back) one piece of the colony makes at
-/// most ([`Run::poll`]); starting a walk (a pass over the tabu set's words), tightening and
-/// depositing a path are charged on the same budget (see [`START_COST`], [`PATH_COST`]).
-/// Measured under `-icount` (`scripts/bench_pieces.py`, `BENCHMARKS.md`): a move costs 100-200
-/// instructions, so a piece stays below 1 M instructions.
+/// Moves of the ants' walks (forward or back) one piece of the colony makes at most
+/// ([`Run::poll`]); starting a walk (a pass over the tabu set's words), tightening and depositing
+/// a path, and the flood fill of an ant that outgrew its tour are charged on the same budget
+/// (`start_cost`, [`PATH_COST`], [`FILL_CELLS`]). Measured under `-icount`
+/// (`scripts/bench_pieces.py`, `BENCHMARKS.md` 4d): the largest walk piece is 0.64-0.92 M
+/// instructions on NewYork, the depot and Sydney (2,048 moves gave 0.96 M on NewYork); a piece
+/// that ends a long walk also tightens it, about 1.5 M on maze512's 4,000-step path.
 pub(super) const MOVES_A_PIECE: u32 = 1536;
 /// Moves a walk's start is charged for: its copy of the pruning marks into the tabu set, one word
 /// for 32 cells (a 512 x 512 map: 8,192 words, as much as about 512 moves).

@@ -39,11 +39,14 @@ const _: () = assert!(REFINE_WORDS <= GUIDE_BLOCKS);
 /// [`GUIDE_BLOCKS`] have them; a smaller one keeps the colony's path, as before).
 pub const SMALL_REFINE_SIDE: usize = 32;
 pub(super) const SMALL_REFINE_WORDS: usize = Scratch::words(SMALL_REFINE_SIDE);
-/// Cells the local search expands in one piece of [`Run::poll`] (a window expands
-/// at most `REFINE_SIDE^2` = 2,704).
+/// The local search's budget of expanded cells in one piece of [`Run::poll`]. It is checked
+/// before each window, so 1 is one window a piece (at most `REFINE_SIDE^2` = 2,704 expanded
+/// cells; the largest measured under `-icount`, `BENCHMARKS.md` 4d: 0.8 M instructions on
+/// Sydney, 0.5 M on NewYork; 8,192 cells a piece were 2.6 M).
 const REFINE_SLICE: u64 = 1;
 /// Raw cells of the smoothing DP in one piece of [`Run::poll`] (each tests at most
-/// [`crate::smoothing::LOOKBACK`] segments).
+/// [`crate::smoothing::LOOKBACK`] segments, or the bounded scan's fewer; 48 were up to 2.8 M
+/// instructions on maze512's 4,000-cell path, 4 keep the DP's pieces under 0.4 M).
 const SMOOTH_SLICE: usize = 4;
 
 /// Words at the end of the pheromone increments that the route's stash holds (the local
