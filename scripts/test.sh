@@ -47,7 +47,9 @@ cargo test -p ohaca --target host-tuple
 cargo build --release
 join twin-h743 "$twin_pid"
 twin_pid=""
-# defmt-print before the host tests: qemu_responsive.rs reads the firmware's log with it.
+# defmt-print decodes the firmware's log for host/tests/qemu_responsive.rs (request and reply
+# ticks) and qemu_pieces.rs (the largest piece of a plan, counted under -icount), and for
+# golden-boot.sh below.
 if [ -n "$defmt_pid" ]; then
   join defmt-print "$defmt_pid"
   defmt_pid=""

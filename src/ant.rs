@@ -16,6 +16,10 @@
 //!
 //! The path is recorded as one direction byte per step, so a tour costs one byte per step whatever
 //! the map size.
+//!
+//! A walk can be done a bounded number of moves at a time ([`Ant::begin`], [`Ant::resume`]: the
+//! planner's pieces, `planner::run`): its state between pieces is a [`Trail`], and the pieces
+//! make the same moves with the same draws as one [`Ant::walk`], bit for bit.
 
 use crate::bitmap;
 use crate::grid::{is_diagonal, neighbour, opposite, Dir, Moves, Point};
@@ -57,6 +61,20 @@ pub struct Walk {
     /// The walk passed next to a cell it had visited before (other than the one it came from),
     /// so [`crate::tighten::tighten`] may find a shortcut; when false, tightening cannot change the path.
     pub may_tighten: bool,
+}
+
+/// Where a walk stands between two pieces ([`Ant::begin`], [`Ant::resume`]): its cell, its
+/// path's length, its moves so far, and the sub-goal it pulls toward. The tabu set and the tour
+/// hold the rest.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Trail {
+    cur: Point,
+    ci: usize,
+    steps: usize,
+    moves: u32,
+    may_tighten: bool,
+    block: usize,
+    target: Point,
 }
 
 /// What the tour's last slot holds until the path fills the tour (no direction is 255).
@@ -129,40 +147,25 @@ impl Ant<'_, '_, '_> {
         tabu: &mut [u32],
         tour: &mut [Dir],
     ) -> Result<Walk, Lost> {
-        // The common exponent gets its own copy of the loop, without a test per candidate;
-        // `pow_alpha(t, 1.0)` is `t`, so both give the same weights.
-        if self.alpha == 1.0 {
-            self.walk_with(rng, tabu, tour, |t| t)
-        } else {
-            let alpha = self.alpha;
-            self.walk_with(rng, tabu, tour, |t| pow_alpha(t, alpha))
+        let mut trail = self.begin(tabu, tour);
+        loop {
+            let mut left = u32::MAX;
+            if let Some(walk) = self.resume(&mut trail, rng, tabu, tour, &mut left)? {
+                return Ok(walk);
+            }
         }
     }
 
-    /// [`Ant::walk`] with `tau^alpha` computed by `pow`.
-    #[inline(always)]
-    fn walk_with(
-        &self,
-        rng: &mut Xoshiro128pp,
-        tabu: &mut [u32],
-        tour: &mut [Dir],
-        pow: impl Fn(f32) -> f32,
-    ) -> Result<Walk, Lost> {
+    /// Start a walk to be done a piece at a time ([`Ant::resume`]): the tabu set becomes the dead
+    /// cells and the start (a pass over the set's words), the ant stands at the start.
+    pub fn begin(&self, tabu: &mut [u32], tour: &mut [Dir]) -> Trail {
         let grid = self.moves.grid();
         if self.dead.is_empty() {
             bitmap::clear(tabu, grid.cells());
         } else {
             bitmap::copy(tabu, self.dead, grid.cells());
         }
-        let offsets = grid.offsets();
-        let blocks = self.tau.blocks();
-        let tau = self.tau.flat();
-        let goal = grid.index(self.goal);
-        let mut cur = self.start;
-        let mut ci = grid.index(cur);
-        let mut steps = 0usize;
-        let mut moves = 0u32;
-        let mut may_tighten = false;
+        let ci = grid.index(self.start);
         // The tour's last slot, unwritten until the path fills the tour: only then can a cell be
         // refused for the tour's length (below), and a walk that backs out of everything proves
         // nothing. A mark in the buffer, not a flag in the loop: the loop keeps its registers.
@@ -170,14 +173,75 @@ impl Ant<'_, '_, '_> {
             *last = UNFILLED;
         }
         bitmap::set(tabu, ci);
-        // The sub-goal changes only when the ant enters another block.
-        let mut block = usize::MAX;
-        let mut target = self.goal;
+        Trail {
+            cur: self.start,
+            ci,
+            steps: 0,
+            moves: 0,
+            may_tighten: false,
+            // The sub-goal changes only when the ant enters another block.
+            block: usize::MAX,
+            target: self.goal,
+        }
+    }
+
+    /// Go on with the walk at `trail` ([`Ant::begin`]) for at most `left` moves (forward or back;
+    /// `left` is decreased by the moves made; a cell refused for the tour's length is not a move,
+    /// and marks a cell, so there are fewer of those than cells): `Ok(Some(walk))` once
+    /// it arrived, `Ok(None)` when it paused (`trail` says where; resume with the same `rng`,
+    /// `tabu` and `tour`), `Err` when it ended without arriving. The pieces together make the
+    /// moves and draws of one [`Ant::walk`].
+    pub fn resume(
+        &self,
+        trail: &mut Trail,
+        rng: &mut Xoshiro128pp,
+        tabu: &mut [u32],
+        tour: &mut [Dir],
+        left: &mut u32,
+    ) -> Result<Option<Walk>, Lost> {
+        // The common exponent gets its own copy of the loop, without a test per candidate;
+        // `pow_alpha(t, 1.0)` is `t`, so both give the same weights.
+        if self.alpha == 1.0 {
+            self.walk_with(trail, rng, tabu, tour, left, |t| t)
+        } else {
+            let alpha = self.alpha;
+            self.walk_with(trail, rng, tabu, tour, left, |t| pow_alpha(t, alpha))
+        }
+    }
+
+    /// [`Ant::resume`] with `tau^alpha` computed by `pow`.
+    #[inline(always)]
+    fn walk_with(
+        &self,
+        trail: &mut Trail,
+        rng: &mut Xoshiro128pp,
+        tabu: &mut [u32],
+        tour: &mut [Dir],
+        limit: &mut u32,
+        pow: impl Fn(f32) -> f32,
+    ) -> Result<Option<Walk>, Lost> {
+        let grid = self.moves.grid();
+        let offsets = grid.offsets();
+        let blocks = self.tau.blocks();
+        let tau = self.tau.flat();
+        let goal = grid.index(self.goal);
+        let Trail {
+            mut cur,
+            mut ci,
+            mut steps,
+            mut moves,
+            mut may_tighten,
+            mut block,
+            mut target,
+        } = *trail;
         // Only the first `n` entries are read, each written first in the same step.
         let mut cand_dir = [0u8; 8];
         let mut cand_w = [0.0f32; 8];
         let width = usize::from(grid.width());
         let last_row = usize::from(grid.height()).wrapping_sub(1);
+        // The walk stops at its budget or after `limit` more moves, whichever comes first.
+        let first = moves;
+        let stop = self.budget.min(moves.saturating_add(*limit));
         while ci != goal {
             let allowed = self.moves.at(ci, cur);
             // The allowed moves into visited (or pruned) cells: from a 3 x 3 read of the tabu
@@ -260,18 +324,41 @@ impl Ant<'_, '_, '_> {
                 }
             }
             moves = moves.saturating_add(1);
-            if moves > self.budget {
-                return Err(Lost::Budget);
+            // One test a move for both the walk's budget and the piece's end (`stop`, the
+            // smaller of the two).
+            if moves > stop {
+                if moves > self.budget {
+                    *limit = limit.saturating_sub(moves.wrapping_sub(first));
+                    return Err(Lost::Budget);
+                }
+                // The piece is over: this move is made in the next one, which finds the same
+                // candidates (nothing above changed the walk but the `may_tighten` it sets
+                // again).
+                *trail = Trail {
+                    cur,
+                    ci,
+                    steps,
+                    moves: moves.wrapping_sub(1),
+                    may_tighten,
+                    block,
+                    target,
+                };
+                *limit = 0;
+                return Ok(None);
             }
             let d = if n == 0 {
                 match self.dead_end {
-                    DeadEnd::Die => return Err(Lost::Died),
+                    DeadEnd::Die => {
+                        *limit = limit.saturating_sub(moves.wrapping_sub(first));
+                        return Err(Lost::Died);
+                    }
                     DeadEnd::Backtrack => {
                         // Back at the start with nothing left: no path, unless the path once
                         // filled the tour, when its length may have cut ways off (then nothing
                         // is proved; the colony's flood fill decides).
                         let Some(s) = steps.checked_sub(1) else {
                             let filled = tour.last().is_none_or(|&d| d != UNFILLED);
+                            *limit = limit.saturating_sub(moves.wrapping_sub(first));
                             return Err(if filled {
                                 Lost::Overflow
                             } else {
@@ -298,7 +385,10 @@ impl Ant<'_, '_, '_> {
                 // takes that cell for a wall (tabu for the rest of its walk) and goes on, so a
                 // long dead-end branch of a maze costs it the branch, not the walk. Not a move.
                 match self.dead_end {
-                    DeadEnd::Die => return Err(Lost::Overflow),
+                    DeadEnd::Die => {
+                        *limit = limit.saturating_sub(moves.wrapping_sub(first));
+                        return Err(Lost::Overflow);
+                    }
                     DeadEnd::Backtrack => {
                         let ni = ci
                             .wrapping_add_signed(offsets.get(usize::from(d)).copied().unwrap_or(0));
@@ -314,6 +404,7 @@ impl Ant<'_, '_, '_> {
             cur = neighbour(cur, d);
             bitmap::set(tabu, ci);
         }
+        *limit = limit.saturating_sub(moves.wrapping_sub(first));
         // The loop checks for a second visited neighbour at every cell but the goal; a detour
         // whose only shortcut ends at the goal (e.g. (0,0) -> (0,1) -> (1,0) on an empty map) is
         // caught here.
@@ -332,7 +423,7 @@ impl Ant<'_, '_, '_> {
         }
         let path = tour.get(..steps).ok_or(Lost::Overflow)?;
         let diagonal = path.iter().filter(|&&d| is_diagonal(d)).count() as u32;
-        Ok(Walk {
+        Ok(Some(Walk {
             steps,
             // diagonal <= steps, and steps < cells < 2^32 (each step enters an unvisited cell), so
             // the cast is lossless and the difference does not wrap.
@@ -340,7 +431,7 @@ impl Ant<'_, '_, '_> {
             diagonal,
             moves,
             may_tighten,
-        })
+        }))
     }
 }
 

@@ -362,16 +362,36 @@ impl<'a> Grid<'a> {
         mark: &mut [u32],
         queue: &mut [u32],
     ) -> Reach {
+        match self.reach_begin(start, goal, mark, queue) {
+            Err(decided) => decided,
+            Ok(mut fill) => loop {
+                if let Some(r) = self.reach_resume(goal, mark, queue, &mut fill, usize::MAX) {
+                    return r;
+                }
+            },
+        }
+    }
+
+    /// [`Grid::reachable`] a piece at a time: mark the blocked cells (a pass over the marks'
+    /// words) and queue the start; `Err` when that decides already (a blocked end, no room).
+    /// Then [`Grid::reach_resume`] with the same buffers until it answers.
+    pub fn reach_begin(
+        &self,
+        start: Point,
+        goal: Point,
+        mark: &mut [u32],
+        queue: &mut [u32],
+    ) -> Result<Filling, Reach> {
         let cells = self.cells();
         if !self.is_free(start) || !self.is_free(goal) {
-            return Reach::No;
+            return Err(Reach::No);
         }
         let cap = queue.len();
         let Some(mark) = mark.get_mut(..crate::bitmap::words(cells)) else {
-            return Reach::Unknown;
+            return Err(Reach::Unknown);
         };
         if cap == 0 {
-            return Reach::Unknown;
+            return Err(Reach::Unknown);
         }
         // Blocked cells start marked (bytes beyond the buffer read as blocked; bits beyond the
         // map are never asked about: the fill stays on the map).
@@ -385,19 +405,43 @@ impl<'a> Grid<'a> {
                 }
             };
         }
-        // Ring buffer: `head` is the next to pop, `len` how many are queued (both < cap).
-        let (mut head, mut len) = (0usize, 0usize);
         let si = self.index(start);
         crate::bitmap::set(mark, si);
         if let Some(s) = queue.get_mut(0) {
             *s = si as u32; // < cells < 2^32
         }
-        len = len.wrapping_add(1);
+        Ok(Filling { head: 0, len: 1 })
+    }
+
+    /// Go on with the fill at `fill` ([`Grid::reach_begin`]) for at most `limit` cells taken
+    /// from the queue: `Some` with the answer, `None` when it paused (resume with the same
+    /// buffers). The pieces answer as one [`Grid::reachable`].
+    pub fn reach_resume(
+        &self,
+        goal: Point,
+        mark: &mut [u32],
+        queue: &mut [u32],
+        fill: &mut Filling,
+        limit: usize,
+    ) -> Option<Reach> {
+        if !self.is_free(goal) {
+            return Some(Reach::No);
+        }
+        let cells = self.cells();
+        let cap = queue.len();
+        // Ring buffer: `head` is the next to pop, `len` how many are queued (both < cap).
+        let Filling { mut head, mut len } = *fill;
+        let mut left = limit;
         let gi = self.index(goal);
         let w = usize::from(self.width);
         // Cells of the first and last row: no neighbour above / below.
         let last_row = cells.wrapping_sub(w); // cells >= w
         while len > 0 {
+            if left == 0 {
+                *fill = Filling { head, len };
+                return None;
+            }
+            left = left.wrapping_sub(1);
             let Some(&i) = queue.get(head) else { break };
             head = head.wrapping_add(1);
             if head == cap {
@@ -406,7 +450,7 @@ impl<'a> Grid<'a> {
             len = len.wrapping_sub(1); // > 0
             let i = i as usize;
             if i == gi {
-                return Reach::Yes;
+                return Some(Reach::Yes);
             }
             // `w > 0` (checked in `Grid::new`), so the remainder exists.
             let x = i.checked_rem(w).unwrap_or(0);
@@ -424,7 +468,7 @@ impl<'a> Grid<'a> {
             for ni in next {
                 if crate::bitmap::insert(mark, ni) {
                     if len == cap {
-                        return Reach::Unknown;
+                        return Some(Reach::Unknown);
                     }
                     // head < cap and len < cap: the sum is below 2 cap, one subtraction wraps it.
                     let mut t = head.wrapping_add(len);
@@ -438,8 +482,16 @@ impl<'a> Grid<'a> {
                 }
             }
         }
-        Reach::No
+        Some(Reach::No)
     }
+}
+
+/// Where a flood fill ([`Grid::reach_begin`], [`Grid::reach_resume`]) stands between pieces: its
+/// queue's head and length (the marks and the queue hold the rest).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Filling {
+    head: usize,
+    len: usize,
 }
 
 /// The cell one move `d` from `p`, without checks (callers move along allowed moves only; a move

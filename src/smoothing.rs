@@ -117,6 +117,18 @@ pub struct Smoother {
     ring: usize,
     /// A path longer than the ring takes the bounded candidate scan ([`Smoother::bounded`]).
     bounded: bool,
+    /// Where [`Smoother::finish_piece`] stands after the DP.
+    tail: Tail,
+}
+
+/// The steps of [`SmoothingKind::Shortest`] after the DP, one a piece
+/// ([`Smoother::finish_piece`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Tail {
+    /// The trace of the DP's links (and the merge of a bounded scan) is next.
+    Trace,
+    /// Passes of [`crate::taut::pull`] over the first `k` waypoints, `passes` done.
+    Pull { k: usize, passes: u8 },
 }
 
 impl Smoother {
@@ -143,6 +155,7 @@ impl Smoother {
             },
             ring,
             bounded: false,
+            tail: Tail::Trace,
         }
     }
 
@@ -185,6 +198,50 @@ impl Smoother {
         }
         self.j = to.max(self.j);
         self.j < n
+    }
+
+    /// [`Smoother::finish`] a piece at a time, once the DP is done ([`Smoother::resume`]
+    /// returned `false`): the trace (and merge), then each pass of the taut pull; `Some(k)` with
+    /// the waypoint count once done (the pieces write what `finish` writes), `None` while
+    /// pieces remain. The other kinds finish in one piece.
+    pub fn finish_piece(
+        &mut self,
+        grid: &Grid<'_>,
+        pts: &mut [Point],
+        dist: &mut [f32],
+        prev: &mut [u32],
+    ) -> Option<usize> {
+        let n = self.n.min(pts.len());
+        if n < 3 || self.kind != SmoothingKind::Shortest {
+            return Some(self.finish(grid, pts, dist, prev));
+        }
+        match self.tail {
+            Tail::Trace => {
+                while self.resume(grid, pts, dist, prev, usize::MAX) {}
+                let k = trace(pts, n, prev);
+                let k = if self.ring < n {
+                    merge(grid, pts, k)
+                } else {
+                    k
+                };
+                self.tail = Tail::Pull {
+                    k: drop_collinear(pts, k),
+                    passes: 0,
+                };
+                None
+            }
+            Tail::Pull { k, passes } => {
+                let (k, changed) = crate::taut::pass(grid, pts, k);
+                let passes = passes.saturating_add(1);
+                if changed && passes < crate::taut::MAX_PASSES {
+                    self.tail = Tail::Pull { k, passes };
+                    return None;
+                }
+                // `taut::pull`'s end, then `finish`'s.
+                let k = drop_collinear(pts, k);
+                Some(drop_collinear(pts, k))
+            }
+        }
     }
 
     /// Finish the DP if needed and write the waypoints to the front of `pts`; returns how many.

@@ -33,10 +33,25 @@ pub const MAX_PASSES: u8 = 8;
 /// at least about `1 / (2 L)` for segments of length `L`).
 pub const MIN_GAIN: f32 = 1e-4;
 
-/// Pull `pts[..n]` taut in place (see the module docs); returns the new waypoint count.
+/// Pull `pts[..n]` taut in place (see the module docs); returns the new waypoint count. The
+/// same as [`pass`] until one changes nothing (at most [`MAX_PASSES`]), then
+/// [`drop_collinear`]: the planner does it a pass a piece.
 pub fn pull(grid: &Grid<'_>, pts: &mut [Point], n: usize) -> usize {
     let mut n = n.min(pts.len());
     for _ in 0..MAX_PASSES {
+        let (m, changed) = pass(grid, pts, n);
+        n = m;
+        if !changed {
+            break;
+        }
+    }
+    drop_collinear(pts, n)
+}
+
+/// One pass of [`pull`] over `pts[..n]`: returns the new count and whether it changed anything.
+pub fn pass(grid: &Grid<'_>, pts: &mut [Point], n: usize) -> (usize, bool) {
+    let mut n = n.min(pts.len());
+    {
         let mut changed = false;
         let mut i = 1usize;
         // Bounds: 1 <= i and i + 1 < n <= pts.len() inside the loop.
@@ -69,11 +84,8 @@ pub fn pull(grid: &Grid<'_>, pts: &mut [Point], n: usize) -> usize {
             }
             i = i.wrapping_add(1);
         }
-        if !changed {
-            break;
-        }
+        (n, changed)
     }
-    drop_collinear(pts, n)
 }
 
 /// The neighbour `q` of `b` (in direction order) that makes `a - q - c` the shortest, if it is at

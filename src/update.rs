@@ -110,8 +110,9 @@ pub fn wolves(
 }
 
 /// The amounts [`wolves`] deposits, in its order: `b * q / l_best` on the best path, then
-/// `-(w * q / l_worst)` on the worst; `None` when `l_worst <= l_best` (or `l_best <= 0`).
-fn wolves_amounts(q: f32, best: (f32, u32), worst: (f32, u32)) -> Option<(f32, f32)> {
+/// `-(w * q / l_worst)` on the worst; `None` when `l_worst <= l_best` (or `l_best <= 0`). The
+/// colony's pieces (`planner::run`) deposit them a path at a time.
+pub fn wolves_amounts(q: f32, best: (f32, u32), worst: (f32, u32)) -> Option<(f32, f32)> {
     let ((l_best, b), (l_worst, w)) = (best, worst);
     if l_worst <= l_best || l_best <= 0.0 {
         return None;

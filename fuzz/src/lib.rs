@@ -12,7 +12,7 @@ pub mod wire_frame;
 use arbitrary::{Arbitrary, Unstructured};
 use ohaca::geometry::{polyline_length, segment_clear, steps_length};
 use ohaca::grid::{is_diagonal, Grid, Point};
-use ohaca::planner::{Area, Buffers, CurvePoint, Memory, Plan, Run, Workspace};
+use ohaca::planner::{Area, Buffers, CurvePoint, Memory, Plan, Poll, Run, Workspace};
 use ohaca::{Algorithm, DeadEnd, Error, Params, SmoothingKind};
 
 /// A planner input: a small map, endpoints and parameters including extremes.
@@ -212,7 +212,7 @@ pub fn check_planner(input: &PlannerInput) {
                 warm && was_warm,
                 "warm exactly when the memory matches"
             );
-            while run.step() {}
+            while let Poll::Working(_) = run.poll() {}
             run.finish()
         });
         check_result(&grid, start, input.goal, p, result);

@@ -19,7 +19,7 @@ use std::hash::{DefaultHasher, Hash, Hasher};
 
 use ohaca::grid::Point;
 use ohaca::heap::HeapStorage;
-use ohaca::planner::Run;
+use ohaca::planner::{Poll, Run};
 use ohaca::Params;
 use ohaca_host_tests::maps::Map;
 
@@ -71,7 +71,7 @@ fn main() {
             None => st.workspace(),
         };
         let mut run = Run::new(&grid, start, goal, &p, ws).expect("plan");
-        while run.step() {}
+        while let Poll::Working(_) = run.poll() {}
         let pl = run.finish().expect("a path");
         let mut h = DefaultHasher::new();
         pl.raw().collect::<Vec<_>>().hash(&mut h);

@@ -6,7 +6,7 @@
 
 use ohaca::board::{Layout, F411};
 use ohaca::heap::HeapStorage;
-use ohaca::planner::{arena, reuse, Fallback, GiveUp, Memory, Origin, Run};
+use ohaca::planner::{arena, reuse, Fallback, GiveUp, Memory, Origin, Poll, Run};
 use ohaca::{Params, Point};
 use ohaca_host_tests::gen;
 use ohaca_host_tests::maps::{maps_dir, Map};
@@ -138,8 +138,7 @@ impl Robot {
             Run::cold(&grid, start, self.goal, &self.params, ws, &mut self.memory)
         }
         .ok()?;
-        while run.step() {}
-        while run.polish_step() {}
+        while let Poll::Working(_) = run.poll() {}
         run.keep(&mut self.memory);
         run.finish().ok().map(|p| Answer {
             fallback,

@@ -7,6 +7,7 @@
 
 use std::time::Instant;
 
+use ohaca::planner::Poll;
 use ohaca::{Error, Params, Point, Run};
 
 use crate::board::{BoardError, BoardStorage};
@@ -129,7 +130,7 @@ pub fn plan_map_in<S: Lend + ?Sized>(
     let grid = map.grid()?;
     let t0 = Instant::now();
     let mut run = Run::new(&grid, start, goal, params, ws)?;
-    while run.step() {}
+    while let Poll::Working(_) = run.poll() {}
     let iterations = run.iteration();
     match run.finish() {
         Ok(plan) => Ok(PlanReport::from_plan(&plan, t0.elapsed())),

@@ -31,7 +31,7 @@ use std::collections::BinaryHeap;
 use serde::Deserialize;
 
 use ohaca::board::{Board, F411};
-use ohaca::planner::{reuse, Fallback, Memory, Origin, Run};
+use ohaca::planner::{reuse, Fallback, Memory, Origin, Poll, Run};
 use ohaca::{Grid, Params, Point};
 
 use crate::board::BoardStorage;
@@ -291,9 +291,9 @@ impl Planner for HostPlanner {
             Run::cold(&grid, start, goal, &self.params, ws, &mut self.memory)
         }
         .map_err(|e| e.to_string())?;
-        while run.step() {}
-        // As the firmware does: record what the run leaves for the next warm start.
-        while run.polish_step() {}
+        // The one loop (the firmware's, without its yields); then, as the firmware does, record
+        // what the run leaves for the next warm start.
+        while let Poll::Working(_) = run.poll() {}
         run.keep(&mut self.memory);
         let plan = run.finish().map_err(|e| e.to_string())?;
         Ok(Planned {

@@ -9,6 +9,7 @@
 
 use std::time::Instant;
 
+use ohaca::planner::Poll;
 use ohaca::{Error, Params, Point, Run};
 
 use crate::map::Map;
@@ -48,7 +49,7 @@ pub fn plan_traced<S: Lend + ?Sized>(
     let grid = map.grid()?;
     let t0 = Instant::now();
     let mut run = Run::new(&grid, start, goal, params, ws)?;
-    while run.step() {}
+    while let Poll::Working(_) = run.poll() {}
     let iterations = run.iteration();
     let ants_sent = u64::from(iterations) * u64::from(params.ants);
     let finished = run.finish();

@@ -1,6 +1,7 @@
-//! The planning task: takes plan requests from the queue and runs them a piece at a time (each
-//! piece of the setup, each iteration, each piece of the local search and the smoothing),
-//! yielding to the executor after every piece so frames keep arriving and `Cancel` works.
+//! The planning task: takes plan requests from the queue and runs them a piece at a time, one
+//! `Run::poll` a piece (`ohaca::planner::Run`'s docs: each piece is bounded), yielding to the
+//! executor after every piece so frames keep arriving and `Cancel` works. It logs each plan's
+//! largest piece in ticks (with `-icount shift=0`, a tick is 1,000 instructions) and its stage.
 //!
 //! The planner reads the map in place: it holds [`MAP`]'s lock from `Run::new` until its path is
 //! planned (on the small boards the planner's buffers share the map's arena), and a writer (a map
@@ -19,7 +20,7 @@ use core::sync::atomic::Ordering;
 use embassy_futures::yield_now;
 use embassy_time::Instant;
 
-use ohaca::planner::{reuse, Placed, Plan, Run};
+use ohaca::planner::{reuse, Placed, Plan, Poll, Run, Stage};
 use ohaca::protocol::{
     encode_reply, wire_len, ErrorCode, ErrorReply, PathBody, PathPart, PathReply, Reply, Waypoints,
     PART_BYTES,
@@ -144,62 +145,81 @@ async fn plan(
     if job.warm {
         defmt::info!("plan {}: warm start asked, warm {}", job.id, run.is_warm());
     }
-    // The setup a piece at a time (flood fill, pruning, coarse route: each reads the whole map),
-    // yielding between the pieces like between iterations.
-    while run.setup_step() {
-        yield_now().await;
-        if state::cancelled(job.generation) {
-            defmt::info!("plan {} cancelled during its setup", job.id);
-            return Err(cancelled());
-        }
-    }
+    // The one loop: a bounded piece a poll, a yield after each, a cancel check. Ticks inside the
+    // polls by stage (without the yields) and the largest piece.
     let t_new = Instant::now();
-    // Ticks spent inside `Run::step`, without the yields between iterations.
-    let mut in_steps = 0u64;
+    let mut spent = [0u64; 3];
+    // The largest piece of each stage.
+    let mut most = [(0u64, ""); 3];
+    let mut largest = (t_new.saturating_duration_since(t0).as_ticks(), "new");
     loop {
+        let name = run.piece();
         let t = Instant::now();
-        let more = run.step();
-        in_steps += Instant::now().saturating_duration_since(t).as_ticks();
+        let Poll::Working(stage) = run.poll() else {
+            break;
+        };
+        let piece = Instant::now().saturating_duration_since(t).as_ticks();
+        if piece > largest.0 {
+            largest = (piece, name);
+        }
+        let i = match stage {
+            Stage::Setup => 0,
+            Stage::Colony => 1,
+            Stage::Polish => 2,
+        };
+        if let (Some(s), Some(m)) = (spent.get_mut(i), most.get_mut(i)) {
+            *s = s.saturating_add(piece);
+            if piece > m.0 {
+                *m = (piece, name);
+            }
+        }
         yield_now().await;
         if state::cancelled(job.generation) {
             defmt::info!(
-                "plan {} cancelled after {} iterations",
+                "plan {} cancelled in its {} after {} iterations",
                 job.id,
+                stage.name(),
                 run.iteration()
             );
             return Err(cancelled());
         }
-        if !more {
-            break;
-        }
     }
-    let t_finish = Instant::now();
-    // The local search and the smoothing a piece at a time too (each piece a fraction of an
-    // iteration on a 256 x 256 map).
-    while run.polish_step() {
-        yield_now().await;
-        if state::cancelled(job.generation) {
-            defmt::info!("plan {} cancelled while finishing", job.id);
-            return Err(cancelled());
-        }
-    }
+    let [in_setup, in_steps, in_polish] = spent;
+    let [most_setup, most_colony, most_polish] = most;
     // What the run leaves in the storage for the next warm start to repair rather than rebuild
     // (its pruning marks and route links), recorded only now that it is complete.
     run.keep(&mut memory);
     state::set_colony(memory);
+    let t_finish = Instant::now();
     let plan = run.finish()?;
     let t_end = Instant::now();
     let ticks = t_end.saturating_duration_since(t0).as_ticks();
+    let last = t_end.saturating_duration_since(t_finish).as_ticks();
+    if last > largest.0 {
+        largest = (last, "finish");
+    }
+    // `new` is `Run::new` and the setup, `finish` the polish and `Run::finish`
+    // (scripts/bench_device.py reads this line).
     defmt::info!(
-        "plan {}: {} iterations, length {}, {} waypoints, {} ticks (new {}, steps {}, finish {})",
+        "plan {}: {} iterations, length {}, {} waypoints, {} ticks (new {}, steps {}, finish {}), largest piece {} ticks ({}; new {}, setup {} {}, colony {} {}, polish {} {}, finish {})",
         job.id,
         plan.iterations,
         plan.length,
         plan.waypoints().len(),
         ticks,
-        t_new.saturating_duration_since(t0).as_ticks(),
+        t_new.saturating_duration_since(t0).as_ticks() + in_setup,
         in_steps,
-        t_end.saturating_duration_since(t_finish).as_ticks()
+        in_polish + last,
+        largest.0,
+        largest.1,
+        t_new.saturating_duration_since(t0).as_ticks(),
+        most_setup.0,
+        most_setup.1,
+        most_colony.0,
+        most_colony.1,
+        most_polish.0,
+        most_polish.1,
+        last
     );
     let ready = ready(job, &plan, ticks, bases, (width, height), frame)?;
     Ok((ticks, ready))

@@ -459,8 +459,7 @@ mod tests {
                     crate::planner::Run::cold(&g, s, goal, &p, ws, m)
                 }
                 .unwrap();
-                while r.step() {}
-                while r.polish_step() {}
+                while let crate::planner::Poll::Working(_) = r.poll() {}
                 r.keep(m);
                 r.finish().map(|pl| {
                     (

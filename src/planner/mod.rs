@@ -3,7 +3,7 @@
 //!
 //! ```text
 //! validate parameters, map size, start and goal
-//! flood fill: goal unreachable -> the run ends, Err(NoPath)  (first step, or setup_step)
+//! flood fill: goal unreachable -> the run ends, Err(NoPath)  (the first polls)
 //! prune the cells no shortest path needs                 (prune)
 //! tau = tau0 everywhere (a warm start keeps the previous run's tau, reset near map changes: warm)
 //! repeat `iterations` times (or until the best has not improved for `patience` iterations):
@@ -19,7 +19,7 @@
 //! | `params` | [`Algorithm`], [`Params`] and their ranges |
 //! | `workspace` | [`Workspace`], [`Buffers`], [`Storage`]: every buffer, one layout |
 //! | `lend` | one typed view of the workspace per phase (setup, colony, polish) and what a buffer idle in a phase lends to it |
-//! | `run` | [`Run`]: the loop as a state machine (setup, walk + update + record, polish) |
+//! | `run` | [`Run`]: the loop as a state machine ([`Run::poll`]: setup, walk + update + record, polish) |
 //! | `plan` | [`Plan`], [`RawPath`], [`CurvePoint`]: the result |
 //! | `placed` | [`Placed`], [`Bases`]: where a plan lies in its workspace, to read it again later (the firmware's path parts) |
 //! | `warm` | [`Memory`], [`Area`]: warm starts after map changes, and the pheromone repair |
@@ -27,8 +27,8 @@
 //! | `repair` | the rest of the last answer with an exact detour around what blocks it, in a box sized by the change ([`longest_detour`]), reached through [`reuse`]; else why not ([`GiveUp`]) |
 //! | [`arena`] | [`arena::carve`]: a map and a workspace laid out in one arena, per map size |
 //!
-//! [`Run::step`] does one iteration, so the firmware can yield to its executor between iterations
-//! and cancel a plan by dropping (or finishing) the run. [`plan`] runs it to the end.
+//! [`Run::poll`] does one bounded piece of work, so the firmware can yield to its executor between
+//! pieces and cancel a plan by dropping (or finishing) the run. [`plan`] runs it to the end.
 
 pub mod arena;
 mod lend;
@@ -48,7 +48,7 @@ pub use repair::{
     longest_detour, GiveUp, BOX_MARGIN, MARGIN as REPAIR_MARGIN, PLACE_RADIUS, STRIDE,
 };
 pub use reuse::{reuse, Fallback};
-pub use run::{settled, Run, REFINE_GAIN};
+pub use run::{settled, Poll, Run, Stage, REFINE_GAIN};
 pub use warm::{Area, Memory, BLOCKED, FREED, REPAIR_RADIUS};
 #[cfg(any(feature = "alloc", test))]
 pub(crate) use workspace::OwnedBuffers;
@@ -57,7 +57,7 @@ pub use workspace::{Buffers, Storage, Workspace};
 use crate::error::Error;
 use crate::grid::{Grid, Point};
 
-/// Plan a path: [`Run::new`], [`Run::step`] until done, [`Run::finish`].
+/// Plan a path: [`Run::new`], [`Run::poll`] until done, [`Run::finish`].
 pub fn plan<'a>(
     grid: &Grid<'_>,
     start: Point,
@@ -68,7 +68,7 @@ pub fn plan<'a>(
     // The run borrows the grid only while it runs; the plan keeps the workspace's buffers.
     let grid = *grid;
     let mut run = Run::new(&grid, start, goal, params, ws)?;
-    while run.step() {}
+    while let Poll::Working(_) = run.poll() {}
     run.finish()
 }
 

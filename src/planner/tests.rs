@@ -451,7 +451,7 @@ fn a_warm_start_after_a_change_that_cuts_the_goal_off_ends_with_no_path() {
     // Cold with backtracking ants: no flood fill either, the first ant proves it in the first
     // iteration (and no second ant walks).
     let mut run = Run::cold(&g, Point::new(0, 0), goal, &p, st.workspace(), &mut memory).unwrap();
-    assert!(run.setup_step());
+    assert_eq!(run.poll(), Poll::Working(Stage::Setup));
     assert!(!run.is_done());
     assert!(!run.step());
     assert_eq!(run.iteration(), 1);
@@ -471,8 +471,9 @@ fn a_warm_start_after_a_change_that_cuts_the_goal_off_ends_with_no_path() {
         &mut memory,
     )
     .unwrap();
-    assert!(!run.setup_step());
+    assert_eq!(run.poll(), Poll::Working(Stage::Setup));
     assert!(run.is_done());
+    assert_eq!(run.poll(), Poll::Done);
     assert!(!run.step());
     assert_eq!(run.moves(), 0);
     assert_eq!(run.finish().err(), Some(Error::NoPath));
@@ -702,18 +703,22 @@ fn the_polish_runs_in_pieces_and_equals_finish() {
         .unwrap();
     let p = with_seed(seed);
     let mut run = Run::new(&g, s, goal, &p, st1.workspace()).unwrap();
-    assert!(
-        !run.polish_step(),
-        "nothing to polish before the run is done"
-    );
     assert!(run.step());
-    assert!(!run.polish_step(), "nor while it runs");
-    while run.step() {}
-    let mut pieces = 1;
-    while run.polish_step() {
-        pieces += 1;
+    assert!(!run.is_done());
+    // The pieces come in phase order: setup, colony, then polish only.
+    let (mut colony, mut pieces) = (0, 0);
+    while let Poll::Working(stage) = run.poll() {
+        match stage {
+            Stage::Setup => panic!("the setup was done before the first iteration"),
+            Stage::Colony => {
+                assert_eq!(pieces, 0, "nothing to polish before the colony is done");
+                colony += 1;
+            }
+            Stage::Polish => pieces += 1,
+        }
     }
-    assert!(pieces >= 3, "{pieces}");
+    assert!(colony >= 1 && pieces >= 3, "{colony} {pieces}");
+    assert_eq!(run.poll(), Poll::Done);
     let a = run.finish().unwrap();
     let mut st2 = Box::new(SLarge::new());
     let b = plan(&g, s, goal, &p, st2.workspace()).unwrap();
@@ -767,8 +772,7 @@ fn warm_starts_that_repair_the_marks_and_the_route_plan_what_rebuilding_ones_do(
                     Run::warm(&g, start, goal, &p, st.workspace(), memory)
                 };
                 let Ok(mut run) = run else { return };
-                while run.step() {}
-                while run.polish_step() {}
+                while let Poll::Working(_) = run.poll() {}
                 let pruned = run.pruned();
                 if keep {
                     run.keep(memory);

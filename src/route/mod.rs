@@ -36,7 +36,7 @@ use crate::pheromone::Blocks;
 pub mod links;
 pub mod search;
 
-pub use search::{Bound, Searched};
+pub use search::{Bound, Searched, Searching};
 
 /// Most blocks of the route: a map with more cells than this is cut into blocks of `2^k x 2^k`
 /// cells (the smallest `k` that gives at most this many), a smaller one routes on cells.
@@ -177,15 +177,8 @@ pub fn build(
     heap: &mut [u32],
     bound: Bound,
 ) -> Result<Searched, Short> {
-    let n = blocks.count();
-    if n > usize::from(u16::MAX) {
-        return Err(Short);
-    }
-    let (Some(words), Some(heap)) = (words.get_mut(..n), heap.get_mut(..n)) else {
-        return Err(Short);
-    };
-    words.fill(unsearched(0));
-    Ok(search::search(
+    let mut at = begin_build(blocks, (start, goal), words, heap)?;
+    finish(
         moves,
         blocks,
         (start, goal),
@@ -193,7 +186,79 @@ pub fn build(
         words,
         heap,
         bound,
+        &mut at,
+    )
+}
+
+/// The route's words and heap of `blocks`: `words` and `heap` cut to one word a block, or
+/// [`Short`].
+fn cut<'w>(
+    blocks: Blocks,
+    words: &'w mut [u32],
+    heap: &'w mut [u32],
+) -> Result<(&'w mut [u32], &'w mut [u32]), Short> {
+    let n = blocks.count();
+    if n > usize::from(u16::MAX) {
+        return Err(Short);
+    }
+    match (words.get_mut(..n), heap.get_mut(..n)) {
+        (Some(words), Some(heap)) => Ok((words, heap)),
+        _ => Err(Short),
+    }
+}
+
+/// [`build`] a piece at a time: prepare the words and start the search (a pass over the
+/// words); then [`resume`] until it is done.
+pub fn begin_build(
+    blocks: Blocks,
+    ends: (Point, Point),
+    words: &mut [u32],
+    heap: &mut [u32],
+) -> Result<Searching, Short> {
+    let (words, heap) = cut(blocks, words, heap)?;
+    words.fill(unsearched(0));
+    Ok(search::begin(blocks, ends, words, heap))
+}
+
+/// Go on with a route search started by [`begin_build`] or [`begin_repair`], closing at most
+/// `limit` blocks (each reads its border cells' links once: a few thousand instructions):
+/// `Ok(Some(_))` once the route is done, `Ok(None)` when it paused. Resume with the same
+/// arguments; the pieces give the words of one [`build`] or [`repair`] bit for bit.
+#[allow(clippy::too_many_arguments)]
+pub fn resume(
+    moves: &Moves<'_>,
+    blocks: Blocks,
+    ends: (Point, Point),
+    dead: &[u32],
+    words: &mut [u32],
+    heap: &mut [u32],
+    bound: Bound,
+    at: &mut Searching,
+    limit: u32,
+) -> Result<Option<Searched>, Short> {
+    let (words, heap) = cut(blocks, words, heap)?;
+    Ok(search::resume(
+        moves, blocks, ends, dead, words, heap, bound, at, limit,
     ))
+}
+
+/// [`resume`] to the end.
+#[allow(clippy::too_many_arguments)]
+fn finish(
+    moves: &Moves<'_>,
+    blocks: Blocks,
+    ends: (Point, Point),
+    dead: &[u32],
+    words: &mut [u32],
+    heap: &mut [u32],
+    bound: Bound,
+    at: &mut Searching,
+) -> Result<Searched, Short> {
+    loop {
+        if let Some(done) = resume(moves, blocks, ends, dead, words, heap, bound, at, u32::MAX)? {
+            return Ok(done);
+        }
+    }
 }
 
 /// A word before the search: the links and their flag `known`, no next block, not reached.
@@ -220,13 +285,21 @@ pub fn repair(
     area: Option<(Point, Point)>,
     bound: Bound,
 ) -> Result<Searched, Short> {
-    let n = blocks.count();
-    if n > usize::from(u16::MAX) {
-        return Err(Short);
-    }
-    let (Some(words), Some(heap)) = (words.get_mut(..n), heap.get_mut(..n)) else {
-        return Err(Short);
-    };
+    let mut at = begin_repair(moves, blocks, ends, words, heap, area)?;
+    finish(moves, blocks, ends, dead, words, heap, bound, &mut at)
+}
+
+/// [`repair`] a piece at a time: forget the links around `area` and start the search (a pass
+/// over the words); then [`resume`] until it is done.
+pub fn begin_repair(
+    moves: &Moves<'_>,
+    blocks: Blocks,
+    ends: (Point, Point),
+    words: &mut [u32],
+    heap: &mut [u32],
+    area: Option<(Point, Point)>,
+) -> Result<Searching, Short> {
+    let (words, heap) = cut(blocks, words, heap)?;
     for w in words.iter_mut() {
         *w = unsearched(*w);
     }
@@ -254,9 +327,7 @@ pub fn repair(
             }
         }
     }
-    Ok(search::search(
-        moves, blocks, ends, dead, words, heap, bound,
-    ))
+    Ok(search::begin(blocks, ends, words, heap))
 }
 
 /// Words [`pack`] needs for a route of `count` blocks: four bits a block.

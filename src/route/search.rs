@@ -103,7 +103,95 @@ pub(super) fn octile(ax: usize, ay: usize, bx: usize, by: usize) -> u32 {
 /// key `g + h` (the distance to the goal's block plus the estimate to the start's block), and
 /// each closed block its links. `heap` is scratch of one word a block; both are `blocks.count()`
 /// long.
+#[cfg(test)]
 pub(super) fn search(
+    moves: &Moves<'_>,
+    blocks: Blocks,
+    ends: (Point, Point),
+    dead: &[u32],
+    words: &mut [u32],
+    heap: &mut [u32],
+    bound: Bound,
+) -> Searched {
+    let mut at = begin(blocks, ends, words, heap);
+    loop {
+        if let Some(done) = resume(
+            moves,
+            blocks,
+            ends,
+            dead,
+            words,
+            heap,
+            bound,
+            &mut at,
+            u32::MAX,
+        ) {
+            return done;
+        }
+    }
+}
+
+/// Where a search stands between two pieces ([`super::begin_build`], [`super::resume`]): the heap's length,
+/// the widening's bounds and the counts so far; the words and the heap hold the rest.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Searching {
+    len: usize,
+    /// Once the start's block is closed at `F`: the last key and the last count of blocks the
+    /// search still closes (the widening, `Bound::Plan`).
+    last_key: u32,
+    last_count: u32,
+    done: Searched,
+}
+
+/// The heap over `heap` for a search between `start` and `goal` with `len` blocks queued.
+fn heap_of<'h>(
+    blocks: Blocks,
+    (start, goal): (Point, Point),
+    heap: &'h mut [u32],
+    len: usize,
+) -> Heap<'h> {
+    let s = blocks.shift();
+    Heap {
+        w: heap,
+        len,
+        across: blocks.across().max(1),
+        start: (usize::from(start.x >> s), usize::from(start.y >> s)),
+        goal: (usize::from(goal.x >> s), usize::from(goal.y >> s)),
+    }
+}
+
+/// Start a search (the A* above) to be done a piece at a time ([`resume`]): the heap cleared (a pass over
+/// its words), the goal's block queued.
+pub(super) fn begin(
+    blocks: Blocks,
+    ends: (Point, Point),
+    words: &mut [u32],
+    heap: &mut [u32],
+) -> Searching {
+    heap.fill(0);
+    let mut heap = heap_of(blocks, ends, heap, 0);
+    let (sx, sy) = heap.start;
+    let (gx, gy) = heap.goal;
+    let goal_block = blocks.block(ends.1);
+    if let Some(w) = words.get_mut(goal_block) {
+        *w = (*w & (LINKS | KNOWN))
+            | (super::NONE << NEXT_SHIFT)
+            | (octile(gx, gy, sx, sy) << DIST_SHIFT);
+        heap.push(words, goal_block);
+    }
+    Searching {
+        len: heap.len,
+        last_key: u32::MAX,
+        last_count: u32::MAX,
+        done: Searched::default(),
+    }
+}
+
+/// Go on with the search at `at` ([`begin`]), closing at most `limit` blocks: `Some` once it is
+/// done, `None` when it paused (resume with the same buffers). The pieces together close the
+/// blocks of one search run to the end in its order, with the same words.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn resume(
     moves: &Moves<'_>,
     blocks: Blocks,
     (start, goal): (Point, Point),
@@ -111,38 +199,37 @@ pub(super) fn search(
     words: &mut [u32],
     heap: &mut [u32],
     bound: Bound,
-) -> Searched {
-    heap.fill(0);
+    at: &mut Searching,
+    limit: u32,
+) -> Option<Searched> {
     let across = blocks.across().max(1);
     let n = words.len();
     let down = n.div_ceil(across);
-    let s = blocks.shift();
-    let (sx, sy) = (usize::from(start.x >> s), usize::from(start.y >> s));
-    let (gx, gy) = (usize::from(goal.x >> s), usize::from(goal.y >> s));
-    let (start_block, goal_block) = (blocks.block(start), blocks.block(goal));
-    let mut heap = Heap {
-        w: heap,
-        len: 0,
-        across,
-        start: (sx, sy),
-        goal: (gx, gy),
-    };
-    let mut done = Searched::default();
-    let Some(w) = words.get_mut(goal_block) else {
-        return done;
-    };
-    *w = (*w & (LINKS | KNOWN))
-        | (super::NONE << NEXT_SHIFT)
-        | (octile(gx, gy, sx, sy) << DIST_SHIFT);
-    heap.push(words, goal_block);
-    // Once the start's block is closed at `F`: the last key and the last count of blocks the
-    // search still closes (the widening, `Bound::Plan`).
-    let (mut last_key, mut last_count) = (u32::MAX, u32::MAX);
+    let start_block = blocks.block(start);
+    let mut heap = heap_of(blocks, (start, goal), heap, at.len);
+    let (sx, sy) = heap.start;
+    let Searching {
+        mut last_key,
+        mut last_count,
+        mut done,
+        ..
+    } = *at;
+    let mut left = limit;
     while heap.len > 0 {
         let top = heap.block_at(0);
         if words.get(top).map_or(u32::MAX, |&w| dist(w)) > last_key || done.closed >= last_count {
             break;
         }
+        if left == 0 {
+            *at = Searching {
+                len: heap.len,
+                last_key,
+                last_count,
+                done,
+            };
+            return None;
+        }
+        left = left.wrapping_sub(1);
         let b = heap.pop(words);
         done.closed = done.closed.wrapping_add(1);
         let Some(&wb) = words.get(b) else { break };
@@ -203,7 +290,7 @@ pub(super) fn search(
             }
         }
     }
-    done
+    Some(done)
 }
 
 /// Whether block `(nx, ny)`, reached as short through its next block (in `wn`) as through the

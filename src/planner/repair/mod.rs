@@ -619,8 +619,7 @@ mod tests {
             let c = carve(&mut arena, cells, crate::board::F411.max_steps).unwrap();
             assert!(c.compact);
             let mut run = Run::warm(&grid, s, g, &p, c.workspace, &mut memory).unwrap();
-            while run.step() {}
-            while run.polish_step() {}
+            while let crate::planner::Poll::Working(_) = run.poll() {}
             run.keep(&mut memory);
             run.finish().unwrap().raw().collect()
         };

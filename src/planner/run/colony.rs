@@ -3,18 +3,18 @@
 //! pheromone evaporates and takes the increments, and the run records its best path, the
 //! convergence curve and whether to stop early.
 
-use crate::ant::{Ant, DeadEnd, Lost, Walk};
+use crate::ant::{Ant, DeadEnd, Lost, Trail, Walk};
 use crate::geometry::steps_length;
-use crate::grid::{Dir, Moves, Point, Reach};
+use crate::grid::{Dir, Filling, Moves, Point, Reach};
 use crate::pheromone::Table;
 use crate::rng::Xoshiro128pp;
 use crate::tighten::tighten;
-use crate::update::{deposit, wolves, WolfPaths};
+use crate::update::{deposit, wolves_amounts};
 
 use crate::planner::lend::Colony;
 use crate::planner::plan::CurvePoint;
 
-use super::Run;
+use super::{Phase, Run};
 
 /// From its second iteration on, an ant of a run with the local search may make at most this many
 /// times the moves (forward and back) of the cheapest walk that arrived so far in the run; one
@@ -115,87 +115,163 @@ pub(super) struct Iteration {
     worst_replay: Option<Replay>,
     sum: f32,
     arrived: u32,
+    /// An ant of this iteration proved the goal unreachable (the run ends with `NoPath`).
+    no_path: bool,
 }
 
-/// The iteration's best and worst paths for [`wolves`], each from where it is: `iter_best` and
-/// `iter_worst` on a workspace that keeps them, else walked again from their ants' [`Replay`]s
-/// (`again`: the replay, the path's steps, the buffer), the best into `best` when it is a new
-/// run best (`record` wants it there: `placed`), else into `tour`, the worst into `tour` once the
-/// best's deposit is done.
-struct Paths<'p, F> {
-    again: &'p mut F,
-    it: &'p Iteration,
-    /// Steps of the best and the worst path.
-    steps: (usize, usize),
-    /// `iter_best`, `iter_worst` where the workspace keeps them.
-    kept: (Option<&'p [Dir]>, Option<&'p [Dir]>),
-    best: &'p mut [Dir],
-    tour: &'p mut [Dir],
-    /// The iteration's best path is a new run best.
-    new_best: bool,
-    /// The best path was walked into `best`.
+/// Moves of the ants' walks (forward or back) one piece of the colony makes at most
+/// ([`Run::poll`]); starting a walk (a pass over the tabu set's words), tightening and depositing
+/// a path, and the flood fill of an ant that outgrew its tour are charged on the same budget
+/// (`start_cost`, [`PATH_COST`], [`FILL_CELLS`]). Measured under `-icount`
+/// (`scripts/bench_pieces.py`, `BENCHMARKS.md` 4d): the largest walk piece is 0.64-0.92 M
+/// instructions on NewYork, the depot and Sydney (2,048 moves gave 0.96 M on NewYork); a piece
+/// that ends a long walk also tightens it, about 1.5 M on maze512's 4,000-step path.
+pub(super) const MOVES_A_PIECE: u32 = 1536;
+/// Moves a walk's start is charged for: its copy of the pruning marks into the tabu set, one word
+/// for 32 cells (a 512 x 512 map: 8,192 words, as much as about 512 moves).
+const fn start_cost(cells: usize) -> u32 {
+    let words = cells / 32 / 16;
+    if words > u32::MAX as usize {
+        u32::MAX
+    } else {
+        words as u32
+    }
+}
+/// Cells of the flood fill a move of the budget pays for (a cell costs about 15 instructions, a
+/// move a few hundred).
+const FILL_CELLS: usize = 32;
+/// Path steps a move of the budget pays for in tightening and depositing a path (each step is
+/// read a few times: tightening's index, the deposit).
+const PATH_COST: usize = 2;
+
+/// Where the colony's iteration stands between two pieces ([`Run::poll`]).
+#[derive(Clone, Debug, Default)]
+pub(super) struct Walking {
+    /// What the ants that walked found.
+    it: Iteration,
+    /// Ants whose walk ended.
+    ant: u16,
+    /// The walk in progress: where it stands, the generator's state before it (for a
+    /// [`Replay`]) and its move budget.
+    now: Option<(Trail, Option<Replay>, u32)>,
+    /// After the ants: what is left of the iteration.
+    close: Close,
+    /// A walk again in progress (a [`Replay`]): where it stands and its generator.
+    again: Option<(Trail, Xoshiro128pp)>,
+    /// The best path was walked again into `best` for the wolves rule.
     placed: bool,
+    /// The flood fill an ant that outgrew its tour started (see `Lost::Overflow` below), where it
+    /// paused; it ends before the next ant walks (it uses the tabu set and the links).
+    filling: Option<Filling>,
 }
 
-impl<F: FnMut(&Option<Replay>, usize, &mut [Dir]) -> bool> WolfPaths for Paths<'_, F> {
-    fn best(&mut self) -> Option<&[Dir]> {
-        let n = self.steps.0;
-        if let Some(kept) = self.kept.0 {
-            return kept.get(..n);
-        }
-        // A new run best is walked straight into `best`, where `record` wants it.
-        let buf: &mut [Dir] = if self.new_best { self.best } else { self.tour };
-        if (self.again)(&self.it.best_replay, n, buf) {
-            self.placed = self.new_best;
-            buf.get(..n)
-        } else {
-            None
-        }
+impl Walking {
+    /// Whether this iteration has begun (an ant walked or walks).
+    pub(super) fn started(&self) -> bool {
+        self.ant > 0 || self.now.is_some() || self.close != Close::Ants || self.filling.is_some()
     }
 
-    fn worst(&mut self) -> Option<&[Dir]> {
-        let n = self.steps.1;
-        if let Some(kept) = self.kept.1 {
-            return kept.get(..n);
-        }
-        if (self.again)(&self.it.worst_replay, n, self.tour) {
-            self.tour.get(..n)
-        } else {
-            None
+    /// The name of the next piece ([`Run::piece`]).
+    pub(super) fn piece(&self) -> &'static str {
+        match self.close {
+            Close::Ants => "walk",
+            Close::Best | Close::Worst => "wolves",
+            Close::Place => "place",
+            Close::Update => "update",
         }
     }
 }
 
-/// One ant's walk, tightened ([`tighten`]) when `tight` and the walk may have a shortcut: the path
-/// the ant deposits on, in `tour`.
-#[allow(clippy::too_many_arguments)]
-fn walk_tightened(
+/// The steps of an iteration after its ants, in order.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+enum Close {
+    /// The ants walk.
+    #[default]
+    Ants,
+    /// The wolves rule's reward on the iteration's best path (walked again if not kept).
+    Best,
+    /// The wolves rule's punishment on its worst path (walked again if not kept).
+    Worst,
+    /// A new run best into `best` (walked again if not kept and not walked for the wolves).
+    Place,
+    /// The pheromone update and the record.
+    Update,
+}
+
+/// Tighten `walk` ([`tighten`]) when `tight` and the walk may have a shortcut: the path the ant
+/// deposits on, in `tour`.
+fn tightened(
     ant: &Ant<'_, '_, '_>,
     tight: bool,
-    rng: &mut Xoshiro128pp,
-    tabu: &mut [u32],
+    walk: Walk,
     tour: &mut [Dir],
-    points: &mut [Point],
-    links: &mut [u32],
-) -> Result<Walk, Lost> {
-    let walk = ant.walk(rng, tabu, tour)?;
-    Ok(if tight && walk.may_tighten {
+    (points, links, tabu): (&mut [Point], &mut [u32], &[u32]),
+) -> Walk {
+    if tight && walk.may_tighten {
         tighten(ant.moves, ant.start, walk, tour, points, links, tabu)
     } else {
         walk
-    })
+    }
+}
+
+/// Charge `steps` path steps on the piece's budget `left`.
+fn charge(left: &mut u32, steps: usize) {
+    let cost = u32::try_from(steps / PATH_COST).unwrap_or(u32::MAX);
+    *left = left.saturating_sub(cost);
+}
+
+/// Walk the ant of `r` again into `buf` (the path it deposited on, tightened), a piece at a time:
+/// `None` while it pauses (its state in `slot`), then whether it gave the path of `steps` steps
+/// again (always, unless there is no replay).
+#[allow(clippy::too_many_arguments)]
+fn again(
+    ant: &mut Ant<'_, '_, '_>,
+    tight: bool,
+    r: &Option<Replay>,
+    steps: usize,
+    slot: &mut Option<(Trail, Xoshiro128pp)>,
+    tabu: &mut [u32],
+    buf: &mut [Dir],
+    index: (&mut [Point], &mut [u32]),
+    left: &mut u32,
+) -> Option<bool> {
+    let Some(r) = r else { return Some(false) };
+    let (mut trail, mut rng) = match slot.take() {
+        Some(s) => s,
+        None => {
+            *left = left.saturating_sub(start_cost(ant.moves.grid().cells()));
+            (ant.begin(tabu, buf), r.rng.clone())
+        }
+    };
+    ant.budget = r.budget;
+    match ant.resume(&mut trail, &mut rng, tabu, buf, left) {
+        Ok(None) => {
+            *slot = Some((trail, rng));
+            None
+        }
+        Ok(Some(walk)) => {
+            charge(left, walk.steps);
+            let (points, links) = index;
+            let w = tightened(ant, tight, walk, buf, (points, links, tabu));
+            Some(w.steps == steps)
+        }
+        Err(_) => Some(false),
+    }
 }
 
 impl Run<'_, '_> {
-    /// Every ant walks start -> goal on `tau(t)` and deposits `Q / L` into the increment table;
-    /// then the wolves rule rewards the iteration's best path and punishes its worst (also into
-    /// the increments), and a best path shorter than the run's becomes the run's (`best`).
+    /// One piece of the colony's iteration: the ants walk start -> goal on `tau(t)` (at most
+    /// [`MOVES_A_PIECE`] moves a piece, an ant's walk split over pieces as needed) and each
+    /// deposits `Q / L` into the increment table; then the wolves rule rewards the iteration's
+    /// best path and punishes its worst (also into the increments), a best path shorter than the
+    /// run's becomes the run's (`best`), and the update and the record end the iteration.
     ///
     /// The best and worst paths are copied into `iter_best` and `iter_worst` as the ants find
     /// them, or, on a workspace without those buffers (empty), walked again from their ants'
     /// [`Replay`] once every ant has walked: two more walks an iteration for two tours fewer,
     /// the same increments and the same best path bit for bit (`docs/ALGORITHM.md`, "Memory").
-    pub(super) fn walk_ants(&mut self, mut on_tour: impl FnMut(&[Dir])) -> Iteration {
+    /// The ants walk in the same order with the same draws however the pieces cut them.
+    pub(super) fn colony_piece(&mut self, mut w: Walking, on_tour: &mut dyn FnMut(&[Dir])) {
         let p = self.params;
         // Every buffer an ant reads or writes (`lend::Colony`).
         let Colony {
@@ -226,131 +302,240 @@ impl Run<'_, '_> {
             budget: u32::MAX,
         };
         let (keep_best, keep_worst) = (!iter_best.is_empty(), !iter_worst.is_empty());
-        let mut it = Iteration::default();
         // The move budget (see `MOVE_BUDGET`): from the cheapest walk that arrived in this run.
         let bounded = self.iteration > 0 && self.refines && p.dead_end == DeadEnd::Backtrack;
-        for _ in 0..p.ants {
-            if let (true, Some(c)) = (bounded, self.cheapest) {
-                ant.budget = c.saturating_mul(MOVE_BUDGET);
-            }
-            let before = (!keep_best || !keep_worst).then(|| Replay {
-                rng: self.rng.clone(),
-                budget: ant.budget,
-            });
-            let walk =
-                match walk_tightened(&ant, p.tighten, &mut self.rng, tabu, tour, points, links) {
-                    Ok(w) => w,
-                    Err(Lost::Exhausted) => {
-                        // The goal is not reachable, proved by this ant: backtracking ants run
-                        // without the setup's flood fill (`setup.rs`).
-                        self.no_path = true;
-                        break;
-                    }
-                    Err(Lost::Died) => continue,
-                    Err(Lost::Budget) => {
-                        self.moves = self.moves.saturating_add(u64::from(ant.budget));
-                        self.abandoned = self.abandoned.saturating_add(1);
-                        continue;
-                    }
-                    Err(Lost::Overflow) => {
-                        self.dropped = self.dropped.saturating_add(1);
-                        // An ant that outgrew its tour proves nothing about reachability. Before
-                        // any ant has arrived, the flood fill the setup skipped decides it now,
-                        // once: an unreachable goal ends the run with `NoPath` instead of
-                        // iterations of dropped ants ending in `PathTooLong`. The tabu set and
-                        // the links are scratch between walks.
-                        if self.best.is_none() && it.arrived == 0 && !self.reach_checked {
-                            self.reach_checked = true;
-                            let grid = self.grid;
-                            if grid.reachable(self.start, self.goal, tabu, links) == Reach::No {
-                                self.no_path = true;
-                                break;
+        let cells = self.grid.cells();
+        let mut left = MOVES_A_PIECE;
+        // The iteration's best path becomes the run's when it is shorter (see `record`); the
+        // run's best changes only in `record`.
+        let new_best = |it: &Iteration, run_best: Option<Best>| {
+            it.best
+                .map(|(b, _)| b)
+                .filter(|b| run_best.is_none_or(|g| b.length() < g.length()))
+        };
+        let tight = p.tighten;
+        while left > 0 {
+            match w.close {
+                Close::Ants => {
+                    if let Some(mut fill) = w.filling.take() {
+                        let cells = (left as usize).saturating_mul(FILL_CELLS);
+                        let grid = self.grid;
+                        match grid.reach_resume(self.goal, tabu, links, &mut fill, cells) {
+                            None => {
+                                w.filling = Some(fill);
+                                left = 0;
+                            }
+                            Some(reach) => {
+                                left = left.saturating_sub(1);
+                                w.it.no_path |= reach == Reach::No;
                             }
                         }
                         continue;
                     }
-                };
-            // Tightening keeps the walk's moves.
-            self.moves = self.moves.saturating_add(u64::from(walk.moves));
-            self.cheapest = Some(self.cheapest.map_or(walk.moves, |c| c.min(walk.moves)));
-            let Some(path) = tour.get(..walk.steps) else {
-                continue;
-            };
-            on_tour(path);
-            let b = Best::of(&walk);
-            let len = b.length();
-            it.sum += len;
-            it.arrived = it.arrived.saturating_add(1);
-            deposit(&mut delta, self.grid, self.start, path, p.q / len);
-            match &mut it.best {
-                Some((cur, n)) if cur.same_length(&b) => *n = n.saturating_add(1),
-                Some((cur, _)) if len >= cur.length() => {}
-                _ => {
-                    if keep_best {
-                        copy_tour(iter_best, path);
-                    } else {
-                        it.best_replay.clone_from(&before);
+                    let (mut trail, before, budget) = match w.now.take() {
+                        Some(now) => now,
+                        None if w.ant < p.ants && !w.it.no_path => {
+                            let budget = match (bounded, self.cheapest) {
+                                (true, Some(c)) => c.saturating_mul(MOVE_BUDGET),
+                                _ => u32::MAX,
+                            };
+                            let before = (!keep_best || !keep_worst).then(|| Replay {
+                                rng: self.rng.clone(),
+                                budget,
+                            });
+                            left = left.saturating_sub(start_cost(cells));
+                            (ant.begin(tabu, tour), before, budget)
+                        }
+                        None => {
+                            w.close = Close::Best;
+                            continue;
+                        }
+                    };
+                    ant.budget = budget;
+                    let walk = match ant.resume(&mut trail, &mut self.rng, tabu, tour, &mut left) {
+                        Ok(None) => {
+                            w.now = Some((trail, before, budget));
+                            continue;
+                        }
+                        Ok(Some(walk)) => {
+                            charge(&mut left, walk.steps);
+                            tightened(&ant, tight, walk, tour, (points, links, tabu))
+                        }
+                        Err(lost) => {
+                            w.ant = w.ant.saturating_add(1);
+                            match lost {
+                                Lost::Exhausted => {
+                                    // The goal is not reachable, proved by this ant: backtracking
+                                    // ants run without the setup's flood fill (`setup.rs`).
+                                    w.it.no_path = true;
+                                }
+                                Lost::Died => {}
+                                Lost::Budget => {
+                                    self.moves = self.moves.saturating_add(u64::from(budget));
+                                    self.abandoned = self.abandoned.saturating_add(1);
+                                }
+                                Lost::Overflow => {
+                                    self.dropped = self.dropped.saturating_add(1);
+                                    // An ant that outgrew its tour proves nothing about
+                                    // reachability. Before any ant has arrived, the flood fill
+                                    // the setup skipped decides it now, once: an unreachable goal
+                                    // ends the run with `NoPath` instead of iterations of dropped
+                                    // ants ending in `PathTooLong`. The tabu set and the links
+                                    // are scratch between walks.
+                                    if self.best.is_none()
+                                        && w.it.arrived == 0
+                                        && !self.reach_checked
+                                    {
+                                        self.reach_checked = true;
+                                        // A piece at a time, before the next ant.
+                                        let grid = self.grid;
+                                        match grid.reach_begin(self.start, self.goal, tabu, links) {
+                                            Ok(fill) => w.filling = Some(fill),
+                                            Err(reach) => w.it.no_path |= reach == Reach::No,
+                                        }
+                                    }
+                                }
+                            }
+                            continue;
+                        }
+                    };
+                    w.ant = w.ant.saturating_add(1);
+                    let it = &mut w.it;
+                    // Tightening keeps the walk's moves.
+                    self.moves = self.moves.saturating_add(u64::from(walk.moves));
+                    self.cheapest = Some(self.cheapest.map_or(walk.moves, |c| c.min(walk.moves)));
+                    let Some(path) = tour.get(..walk.steps) else {
+                        continue;
+                    };
+                    on_tour(path);
+                    let b = Best::of(&walk);
+                    let len = b.length();
+                    it.sum += len;
+                    it.arrived = it.arrived.saturating_add(1);
+                    deposit(&mut delta, self.grid, self.start, path, p.q / len);
+                    match &mut it.best {
+                        Some((cur, n)) if cur.same_length(&b) => *n = n.saturating_add(1),
+                        Some((cur, _)) if len >= cur.length() => {}
+                        _ => {
+                            if keep_best {
+                                copy_tour(iter_best, path);
+                            } else {
+                                it.best_replay.clone_from(&before);
+                            }
+                            it.best = Some((b, 1));
+                        }
                     }
-                    it.best = Some((b, 1));
-                }
-            }
-            match &mut it.worst {
-                Some((cur, n)) if cur.same_length(&b) => *n = n.saturating_add(1),
-                Some((cur, _)) if len <= cur.length() => {}
-                _ => {
-                    if keep_worst {
-                        copy_tour(iter_worst, path);
-                    } else {
-                        it.worst_replay.clone_from(&before);
+                    match &mut it.worst {
+                        Some((cur, n)) if cur.same_length(&b) => *n = n.saturating_add(1),
+                        Some((cur, _)) if len <= cur.length() => {}
+                        _ => {
+                            if keep_worst {
+                                copy_tour(iter_worst, path);
+                            } else {
+                                it.worst_replay.clone_from(&before);
+                            }
+                            it.worst = Some((b, 1));
+                        }
                     }
-                    it.worst = Some((b, 1));
                 }
+                Close::Best | Close::Worst => {
+                    let amounts = match (p.algorithm.wolves(), w.it.best, w.it.worst) {
+                        (true, Some((b, nb)), Some((x, nx))) => {
+                            wolves_amounts(p.q, (b.length(), nb), (x.length(), nx))
+                                .map(|a| (a, b.steps, x.steps))
+                        }
+                        _ => None,
+                    };
+                    let Some(((reward, punish), best_steps, worst_steps)) = amounts else {
+                        w.close = Close::Place;
+                        continue;
+                    };
+                    let is_best = w.close == Close::Best;
+                    let (n, amount) = if is_best {
+                        (best_steps, reward)
+                    } else {
+                        (worst_steps, punish)
+                    };
+                    let kept = if is_best {
+                        keep_best.then_some(&*iter_best)
+                    } else {
+                        keep_worst.then_some(&*iter_worst)
+                    };
+                    let path: Option<&[Dir]> = match kept {
+                        Some(k) => k.get(..n),
+                        None => {
+                            // A new run best is walked straight into `best`, where `record`
+                            // wants it; everything else into `tour`.
+                            let into_best = is_best && new_best(&w.it, self.best).is_some();
+                            let buf: &mut [Dir] = if into_best { best } else { tour };
+                            let r = if is_best {
+                                &w.it.best_replay
+                            } else {
+                                &w.it.worst_replay
+                            };
+                            let idx = (&mut *points, &mut *links);
+                            match again(
+                                &mut ant,
+                                tight,
+                                r,
+                                n,
+                                &mut w.again,
+                                tabu,
+                                buf,
+                                idx,
+                                &mut left,
+                            ) {
+                                None => continue,
+                                Some(true) => {
+                                    w.placed |= into_best;
+                                    let buf: &[Dir] = if into_best { best } else { tour };
+                                    buf.get(..n)
+                                }
+                                Some(false) => None,
+                            }
+                        }
+                    };
+                    if let Some(t) = path {
+                        charge(&mut left, t.len());
+                        deposit(&mut delta, self.grid, self.start, t, amount);
+                    }
+                    w.close = if is_best { Close::Worst } else { Close::Place };
+                }
+                Close::Place => {
+                    if let (Some(b), false) = (new_best(&w.it, self.best), w.placed) {
+                        if keep_best {
+                            if let Some(src) = iter_best.get(..b.steps) {
+                                copy_tour(best, src);
+                            }
+                        } else {
+                            let idx = (&mut *points, &mut *links);
+                            let done = again(
+                                &mut ant,
+                                tight,
+                                &w.it.best_replay,
+                                b.steps,
+                                &mut w.again,
+                                tabu,
+                                best,
+                                idx,
+                                &mut left,
+                            );
+                            if done.is_none() {
+                                continue;
+                            }
+                        }
+                    }
+                    w.close = Close::Update;
+                }
+                Close::Update => break,
             }
         }
-        // The iteration's best path becomes the run's when it is shorter (see `record`).
-        let new_best = it
-            .best
-            .map(|(b, _)| b)
-            .filter(|b| self.best.is_none_or(|g| b.length() < g.length()));
-        // Walk the ant of `r` again into `buf`: the path it deposited on, `steps` long.
-        let mut again = |r: &Option<Replay>, steps: usize, buf: &mut [Dir]| -> bool {
-            let Some(r) = r else { return false };
-            ant.budget = r.budget;
-            let mut rng = r.rng.clone();
-            matches!(
-                walk_tightened(&ant, p.tighten, &mut rng, tabu, buf, points, links),
-                Ok(w) if w.steps == steps
-            )
-        };
-        let mut placed = false;
-        if let (true, Some((b, nb)), Some((w, nw))) = (p.algorithm.wolves(), it.best, it.worst) {
-            let mut paths = Paths {
-                again: &mut again,
-                it: &it,
-                steps: (b.steps, w.steps),
-                kept: (
-                    keep_best.then_some(&*iter_best),
-                    keep_worst.then_some(&*iter_worst),
-                ),
-                best,
-                tour,
-                new_best: new_best.is_some(),
-                placed: false,
-            };
-            let lengths = ((b.length(), nb), (w.length(), nw));
-            wolves(&mut delta, self.grid, self.start, p.q, lengths, &mut paths);
-            placed = paths.placed;
+        if w.close != Close::Update {
+            self.phase = Phase::Colony(w);
+            return;
         }
-        if let (Some(b), false) = (new_best, placed) {
-            if keep_best {
-                if let Some(src) = iter_best.get(..b.steps) {
-                    copy_tour(best, src);
-                }
-            } else {
-                again(&it.best_replay, b.steps, best);
-            }
-        }
-        it
+        self.update();
+        self.record(&w.it);
     }
 
     /// `tau = clamp((1 - rho) tau + delta)` (the wolves terms are in `delta` already).
@@ -412,7 +597,11 @@ impl Run<'_, '_> {
         // works in windows along the path (on a small map it is one exact search of the whole
         // map, and the colony's corridor does not matter at all).
         let agreed = self.refines && self.blocks.shift() > 0 && settled(&point, p.ants);
-        self.done = self.no_path || self.iteration >= p.iterations || early || agreed;
+        self.phase = if it.no_path || self.iteration >= p.iterations || early || agreed {
+            self.after_colony(it.no_path)
+        } else {
+            Phase::Colony(Walking::default())
+        };
     }
 }
 

@@ -1,15 +1,31 @@
-//! A planning run as a state machine: [`Run::new`] validates and prepares, [`Run::setup_step`]
-//! does the setup a piece at a time, [`Run::step`] runs one iteration (walk every ant, update the
-//! pheromone, record the iteration), [`Run::polish_step`] refines and smooths the best path a
-//! piece at a time, and [`Run::finish`] turns it into a [`Plan`].
+//! A planning run as a state machine. [`Run::new`] (or [`Run::warm`], [`Run::cold`]) validates
+//! and prepares; [`Run::poll`] then does one bounded piece of work and says what it did; once it
+//! answers [`Poll::Done`], [`Run::finish`] turns the run into a [`Plan`]. Every driver is the
+//! same loop, the firmware's with a yield and a cancel check in its body:
 //!
-//! The firmware yields to its executor between pieces, so it can answer other requests and cancel
-//! a plan by dropping (or finishing) the run. How the work is cut never changes the result:
-//! `step` and `finish` alone do every piece that is left.
+//! ```ignore
+//! while let Poll::Working(_) = run.poll() {
+//!     yield_now().await;            // the firmware; a host loop has an empty body
+//!     if cancelled() { return Err(Cancelled); }
+//! }
+//! let plan = run.finish()?;
+//! ```
+//!
+//! The run's [`Phase`] is one value: the setup (flood fill, pruning, coarse route), the colony
+//! (iterations of walking ants, the pheromone update, the record), the polish (the local search,
+//! the smoothing, the corridor search) and the end (the waypoints, or why there are none). A poll
+//! does one piece of the current phase and moves to the next phase when its last piece is done,
+//! like smoltcp's `Interface::poll` or embassy-net's `Runner`: the caller owns the loop, the run
+//! owns the state. A poll that does the last piece still answers [`Poll::Working`]; the next one
+//! answers [`Poll::Done`] and does nothing.
+//!
+//! How the work is cut never changes the result: the same pieces in the same order, whoever
+//! drives them; [`Run::finish`] polls whatever is left itself, and [`Run::step`] (tests and
+//! callers that observe iterations) polls to the end of the next iteration.
 //!
 //! | file | owns |
 //! | --- | --- |
-//! | `mod.rs` | [`Run`]'s state, its constructors (cold, warm), the accessors, `step` and `finish` |
+//! | `mod.rs` | [`Run`]'s state and [`Phase`], its constructors (cold, warm), the accessors, [`Run::poll`] and `finish` |
 //! | `setup.rs` | the setup before the first iteration: flood fill, pruning, the coarse route |
 //! | `colony.rs` | one iteration: every ant's walk, the pheromone update, the record and early stop |
 //! | `polish.rs` | the work after the last iteration: the local search and the smoothing |
@@ -36,7 +52,7 @@ use super::plan::Origin;
 use super::plan::{CurvePoint, Plan};
 use super::warm::{self, Answer, Area, Kept, Memory};
 use super::workspace::Workspace;
-use colony::Best;
+use colony::{Best, Walking};
 use polish::{Polish, SMALL_REFINE_WORDS};
 
 /// A warm start whose changed cells' bounding box holds more than `1 / REBUILD_SHARE` of the
@@ -79,12 +95,11 @@ pub struct Run<'g, 'a> {
     marks: bool,
     /// This run's coarse route's links are stashed in `delta` ([`route::stash`]).
     stashed: bool,
-    setup: Setup,
+    /// Where the run is: see [`Phase`].
+    phase: Phase,
     refines: bool,
-    polish: Polish,
     /// The colony's best path length, kept when the local search replaces the best path.
     colony: Option<Best>,
-    no_path: bool,
     /// The flood fill has decided reachability in this run (or could not): it runs in the setup
     /// for dying ants only, and for backtracking ones once an ant outgrew its tour before any
     /// arrived (`colony.rs`), the one case where the ants cannot prove an unreachable goal.
@@ -95,11 +110,67 @@ pub struct Run<'g, 'a> {
     abandoned: u32,
     /// The fewest moves any ant of this run made to arrive.
     cheapest: Option<u32>,
-    done: bool,
 }
 
-/// The setup still to do before the first iteration, in order: the firmware yields between the
-/// pieces ([`Run::setup_step`]).
+/// What a [`Run::poll`] did.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Poll {
+    /// It did one piece of this stage; more may be left: poll again.
+    Working(Stage),
+    /// Nothing is left (and this poll did nothing): [`Run::finish`] gives the result.
+    Done,
+}
+
+/// The stage of a run a [`Poll::Working`] piece belonged to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Stage {
+    /// The setup before the first ant: flood fill, pruning, the coarse route.
+    Setup,
+    /// The colony: the ants' walks, the pheromone update, the record of an iteration.
+    Colony,
+    /// The work after the last iteration: the local search, the smoothing, the corridor.
+    Polish,
+}
+
+impl Stage {
+    /// The stage's name, for logs.
+    pub fn name(self) -> &'static str {
+        match self {
+            Stage::Setup => "setup",
+            Stage::Colony => "colony",
+            Stage::Polish => "polish",
+        }
+    }
+}
+
+/// Where a run is: the one value that says which piece [`Run::poll`] does next.
+// The colony's variant is the largest (its iteration's replays: about 260 bytes); the core has no
+// heap to box it in, and a run holds one phase.
+#[allow(clippy::large_enum_variant)]
+#[derive(Clone, Debug)]
+enum Phase {
+    /// The setup, at this piece.
+    Setup(Setup),
+    /// The colony's iterations, the current one where it stands.
+    Colony(Walking),
+    /// The work after the last iteration, at this piece.
+    Polish(Polish),
+    /// Nothing left: how the run ended.
+    Ended(End),
+}
+
+/// How a run ended ([`Phase::Ended`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum End {
+    /// The polished path: `points[..waypoints]` are its waypoints.
+    Path { waypoints: usize },
+    /// The goal is not reachable (the flood fill or a backtracking ant proved it).
+    NoPath,
+    /// The colony stopped and no ant had arrived ([`Run::no_arrival`] says why).
+    NoArrival,
+}
+
+/// The setup still to do before the first iteration, in order: one piece a [`Run::poll`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Setup {
     /// The flood fill (is the goal reachable at all?), for dying ants only: backtracking ants
@@ -107,10 +178,8 @@ enum Setup {
     Reach,
     /// Dead-end pruning ([`Params::prune`]).
     Prune,
-    /// The coarse route on large maps.
-    Route,
-    /// Nothing: the ants can walk.
-    Done,
+    /// The coarse route on large maps: its search where it paused (`None`: not started).
+    Route(Option<route::Searching>),
 }
 
 impl<'g, 'a> Run<'g, 'a> {
@@ -118,9 +187,9 @@ impl<'g, 'a> Run<'g, 'a> {
     /// the workspace, or a start or goal off the map or on an obstacle; sets every pheromone entry
     /// to `tau0`. The rest of the setup (with [`crate::DeadEnd::Die`], a flood fill: is the goal
     /// reachable at all?; pruning the cells no shortest path needs, [`Params::prune`]; the coarse
-    /// route of a large map) runs in the first [`Run::step`], or piecewise through
-    /// [`Run::setup_step`]; an unreachable goal ends the run there (or, with backtracking ants,
-    /// in the first ant's walk), and [`Run::finish`] fails with [`Error::NoPath`].
+    /// route of a large map) runs in the first polls ([`Run::poll`]); an unreachable goal ends
+    /// the run there (or, with backtracking ants, in the first ant's walk), and [`Run::finish`]
+    /// fails with [`Error::NoPath`].
     pub fn new(
         grid: &'g Grid<'g>,
         start: Point,
@@ -133,7 +202,7 @@ impl<'g, 'a> Run<'g, 'a> {
 
     /// Record in `memory` what this run leaves in the workspace for the next [`Run::warm`] to
     /// repair locally instead of rebuilding: its pruning marks (once the setup made them) and
-    /// its coarse route's links (once [`Run::polish_step`] started: they are stashed then, before
+    /// its coarse route's links (once the polish started: they are stashed then, before
     /// the local search takes the route's words as scratch), and its answer once the polish is
     /// done (for [`super::reuse`]). Call it with the `memory` this run
     /// was started with ([`Run::warm`], [`Run::cold`]), after the run (before [`Run::finish`]),
@@ -151,9 +220,7 @@ impl<'g, 'a> Run<'g, 'a> {
         }
         // The answer, once the polish laid out its waypoints, for a replan to reuse
         // ([`super::reuse`]).
-        if let (Some(best), Polish::Done { waypoints }, false) =
-            (self.best, self.polish, self.no_path)
-        {
+        if let (Some(best), &Phase::Ended(End::Path { waypoints })) = (self.best, &self.phase) {
             memory.answer = Some(Answer {
                 start: self.start,
                 from: 0,
@@ -333,16 +400,13 @@ impl<'g, 'a> Run<'g, 'a> {
             touched: None,
             marks: false,
             stashed: false,
-            setup: Setup::Reach,
+            phase: Phase::Setup(Setup::Reach),
             refines,
-            polish: Polish::Start,
             colony: None,
-            no_path: false,
             reach_checked: false,
             dropped: 0,
             abandoned: 0,
             cheapest: None,
-            done: false,
         })
     }
 
@@ -382,13 +446,69 @@ impl<'g, 'a> Run<'g, 'a> {
         self.iteration
     }
 
-    /// True once the run has stopped (iteration limit or early stop).
+    /// True once the colony has stopped (iteration limit, early stop, an unreachable goal, or
+    /// [`Run::finish`]): the polish or the end is next.
     pub fn is_done(&self) -> bool {
-        self.done
+        matches!(self.phase, Phase::Polish(_) | Phase::Ended(_))
     }
 
-    /// Run one iteration (all ants, then the pheromone update). Returns `true` while there is more
-    /// to do.
+    /// The name of the piece the next [`Run::poll`] does, for logs: `"reach"`, `"prune"`,
+    /// `"route"`, `"walk"` (the ants), `"wolves"` (the wolves rule's paths), `"place"` (the new
+    /// best's path), `"update"`, `"lay"` (the path laid out), `"refine"`, `"smooth"` (the DP), `"tail"` (the
+    /// smoothing's trace and taut pull, the corridor), `"end"`.
+    pub fn piece(&self) -> &'static str {
+        match &self.phase {
+            Phase::Setup(Setup::Reach) => "reach",
+            Phase::Setup(Setup::Prune) => "prune",
+            Phase::Setup(Setup::Route(_)) => "route",
+            Phase::Colony(w) => w.piece(),
+            Phase::Polish(Polish::Start) => "lay",
+            Phase::Polish(Polish::Refine(_)) => "refine",
+            Phase::Polish(Polish::Smooth(_)) => "smooth",
+            Phase::Polish(Polish::Tail(_)) => "tail",
+            Phase::Ended(_) => "end",
+        }
+    }
+
+    /// Do one bounded piece of the run's work and say what it was: [`Poll::Working`] with the
+    /// piece's stage while work is left, [`Poll::Done`] (without doing anything) once nothing
+    /// is. The pieces, in order: each piece of the setup (the flood fill, the pruning, the coarse
+    /// route), each iteration of the colony, each piece of the polish (laying the path out, the
+    /// local search a budget of expanded cells at a time, the smoothing a stretch of cells at a
+    /// time, the corridor search). Drive it with
+    /// `while let Poll::Working(_) = run.poll() { /* yield, check for a cancel */ }`, then call
+    /// [`Run::finish`]; see the module docs.
+    pub fn poll(&mut self) -> Poll {
+        self.poll_observed(&mut |_| {})
+    }
+
+    /// [`Run::poll`], calling `on_tour` for every ant of a colony piece that arrived (see
+    /// [`Run::step_observed`]).
+    fn poll_observed(&mut self, on_tour: &mut dyn FnMut(&[Dir])) -> Poll {
+        // The phase is taken out for the piece, which sets the next one.
+        match core::mem::replace(&mut self.phase, Phase::Ended(End::NoArrival)) {
+            Phase::Setup(s) => {
+                self.setup_piece(s);
+                Poll::Working(Stage::Setup)
+            }
+            Phase::Colony(w) => {
+                self.colony_piece(w, on_tour);
+                Poll::Working(Stage::Colony)
+            }
+            Phase::Polish(p) => {
+                self.polish_piece(p);
+                Poll::Working(Stage::Polish)
+            }
+            Phase::Ended(end) => {
+                self.phase = Phase::Ended(end);
+                Poll::Done
+            }
+        }
+    }
+
+    /// The colony an iteration at a time, for tests and callers that observe iterations (a
+    /// driver polls, [`Run::poll`]): polls until the next iteration has been recorded (the setup
+    /// first, if any is left), never into the polish. Returns `true` while the colony goes on.
     pub fn step(&mut self) -> bool {
         self.step_observed(|_| {})
     }
@@ -397,15 +517,24 @@ impl<'g, 'a> Run<'g, 'a> {
     /// as directions from the start: exactly the path the ant deposits on (after tightening).
     /// With these, the iteration's pheromone update (eq. 11-13) can be recomputed by hand; the
     /// tests do.
-    pub fn step_observed(&mut self, on_tour: impl FnMut(&[Dir])) -> bool {
-        while self.setup_step() {}
-        if self.done {
-            return false;
+    pub fn step_observed(&mut self, mut on_tour: impl FnMut(&[Dir])) -> bool {
+        let iteration = self.iteration;
+        while matches!(self.phase, Phase::Setup(_) | Phase::Colony(_))
+            && self.iteration == iteration
+        {
+            self.poll_observed(&mut on_tour);
         }
-        let it = self.walk_ants(on_tour);
-        self.update();
-        self.record(&it);
-        !self.done
+        matches!(self.phase, Phase::Colony(_))
+    }
+
+    /// The phase after the colony stopped: the polish of the best path, or the end when no ant
+    /// arrived or the goal was proved unreachable.
+    fn after_colony(&self, no_path: bool) -> Phase {
+        match (no_path, self.best) {
+            (true, _) => Phase::Ended(End::NoPath),
+            (false, None) => Phase::Ended(End::NoArrival),
+            (false, Some(_)) => Phase::Polish(Polish::Start),
+        }
     }
 
     /// The error of a run no ant finished: [`Error::PathTooLong`] when ants were dropped for
@@ -422,20 +551,29 @@ impl<'g, 'a> Run<'g, 'a> {
     }
 
     /// Stop now and turn the best path found so far into the result: refined (large maps) and
-    /// smoothed for OHACA, doing whatever [`Run::polish_step`] left. Fails with
+    /// smoothed for OHACA, polling whatever is left ([`Run::poll`]). Fails with
     /// [`Error::NoAntArrived`] if no ant has reached the goal (only possible with
     /// [`crate::DeadEnd::Die`], or before the first iteration), with [`Error::PathTooLong`] instead
     /// if ants were dropped for paths longer than the workspace keeps, and with [`Error::NoPath`]
     /// if an unreachable goal ended the run.
     pub fn finish(mut self) -> Result<Plan<'a>, Error> {
-        if self.no_path {
-            return Err(Error::NoPath);
+        // Stopped early (before the colony ended by itself): the iteration under way is ended
+        // first (its best path may be half placed), then the polish of the best so far.
+        while let Phase::Colony(w) = &self.phase {
+            if !w.started() {
+                break;
+            }
+            self.poll();
         }
-        if self.best.is_none() {
-            return Err(self.no_arrival());
+        if let Phase::Setup(_) | Phase::Colony(_) = self.phase {
+            self.phase = self.after_colony(false);
         }
-        self.done = true;
-        while self.polish_step() {}
+        while let Poll::Working(_) = self.poll() {}
+        match self.phase {
+            Phase::Ended(End::NoPath) => return Err(Error::NoPath),
+            Phase::Ended(End::NoArrival) => return Err(self.no_arrival()),
+            _ => {}
+        }
         let Run {
             start,
             params,
@@ -446,12 +584,12 @@ impl<'g, 'a> Run<'g, 'a> {
             moves,
             pruned,
             warm,
-            polish,
+            phase,
             colony,
             ..
         } = self;
         let best = best.ok_or(Error::NoAntArrived)?;
-        let Polish::Done { waypoints: k } = polish else {
+        let Phase::Ended(End::Path { waypoints: k }) = phase else {
             return Err(Error::NoPath);
         };
         let Workspace {

@@ -1,6 +1,7 @@
 //! The work after the last iteration, a piece at a time: the best tour laid out as cells, the
 //! local search on large maps ([`Params::refine`]) a budget of expanded cells at a time, then the
-//! smoothing a stretch of raw cells at a time. The firmware yields between pieces.
+//! smoothing a stretch of raw cells at a time, then the corridor search: each a piece of
+//! [`Run::poll`].
 
 use crate::grid::{direction, is_diagonal};
 use crate::refine::{self, Budget, Memo, Refiner, Scratch};
@@ -13,7 +14,7 @@ use crate::planner::params::Params;
 use crate::planner::plan::RawPath;
 
 use super::colony::Best;
-use super::Run;
+use super::{End, Phase, Run};
 use crate::planner::lend::{self, Guide};
 
 /// Window side of the local search ([`Params::refine`]). Its scratch is the links and the coarse
@@ -38,12 +39,15 @@ const _: () = assert!(REFINE_WORDS <= GUIDE_BLOCKS);
 /// [`GUIDE_BLOCKS`] have them; a smaller one keeps the colony's path, as before).
 pub const SMALL_REFINE_SIDE: usize = 32;
 pub(super) const SMALL_REFINE_WORDS: usize = Scratch::words(SMALL_REFINE_SIDE);
-/// Cells the local search expands between two yields of [`Run::polish_step`] (a window expands
-/// at most `REFINE_SIDE^2` = 2,704).
-const REFINE_SLICE: u64 = 8192;
-/// Raw cells of the smoothing DP between two yields of [`Run::polish_step`] (each tests at most
-/// [`crate::smoothing::LOOKBACK`] segments).
-const SMOOTH_SLICE: usize = 48;
+/// The local search's budget of expanded cells in one piece of [`Run::poll`]. It is checked
+/// before each window, so 1 is one window a piece (at most `REFINE_SIDE^2` = 2,704 expanded
+/// cells; the largest measured under `-icount`, `BENCHMARKS.md` 4d: 0.8 M instructions on
+/// Sydney, 0.5 M on NewYork; 8,192 cells a piece were 2.6 M).
+const REFINE_SLICE: u64 = 1;
+/// Raw cells of the smoothing DP in one piece of [`Run::poll`] (each tests at most
+/// [`crate::smoothing::LOOKBACK`] segments, or the bounded scan's fewer; 48 were up to 2.8 M
+/// instructions on maze512's 4,000-cell path, 4 keep the DP's pieces under 0.4 M).
+const SMOOTH_SLICE: usize = 4;
 
 /// Words at the end of the pheromone increments that the route's stash holds (the local
 /// search's memo stays before them).
@@ -55,7 +59,8 @@ fn stash_tail(stashed: bool, blocks: crate::pheromone::Blocks) -> usize {
     }
 }
 
-/// The work after the last iteration, in order ([`Run::polish_step`]).
+/// The work after the last iteration, in order: one piece a [`Run::poll`]; the end is
+/// [`End::Path`].
 #[derive(Clone, Copy, Debug)]
 pub(super) enum Polish {
     /// Not started: the best path is only the best tour's directions.
@@ -64,24 +69,20 @@ pub(super) enum Polish {
     Refine(Refiner),
     /// The smoothing of the raw path in `points`, a stretch at a time.
     Smooth(Smoother),
-    /// Done: `points[..waypoints]` are the waypoints.
-    Done { waypoints: usize },
+    /// The smoothing's steps after its DP ([`Smoother::finish_piece`]), then the corridor.
+    Tail(Smoother),
 }
 
 impl Run<'_, '_> {
-    /// Do the next piece of the work after the last iteration, if any is left: lay the best path
-    /// out as cells, the local search ([`Params::refine`], large maps) on at most 8,192 expanded
-    /// cells, the smoothing DP on at most 48 raw cells. Returns `true` while work remains; does
-    /// nothing before the run is done ([`Run::is_done`]) or when it found no path. On a
-    /// 256 x 256 map each piece costs a fraction of an iteration, so the firmware yields between
-    /// them; [`Run::finish`] does whatever is left itself.
-    pub fn polish_step(&mut self) -> bool {
+    /// Do the piece `piece` of the work after the last iteration and move to the next: lay the
+    /// best path out as cells, the local search ([`Params::refine`], large maps) on at most 8,192
+    /// expanded cells, the smoothing DP on at most 48 raw cells (its last piece also the corridor
+    /// search), then the end ([`End::Path`]).
+    pub(super) fn polish_piece(&mut self, piece: Polish) {
         let Some(best) = self.best else {
-            return false;
+            self.phase = Phase::Ended(End::NoArrival);
+            return;
         };
-        if !self.done || self.no_path {
-            return false;
-        }
         let grid = self.grid;
         // The answer, the increments, the route and the buffers idle after the last ant
         // (`lend::Polishing`).
@@ -94,7 +95,7 @@ impl Run<'_, '_> {
         // The exact corridor search of small maps ([`crate::corridor`]): OHACA's default smoothing
         // on maps whose pheromone increments lend one entry a cell.
         let corridor = kind == SmoothingKind::Shortest && self.blocks.shift() == 0;
-        self.polish = match self.polish {
+        self.phase = match piece {
             Polish::Start => {
                 // Expand the tour into cells.
                 let n = best.steps.saturating_add(1);
@@ -126,7 +127,7 @@ impl Run<'_, '_> {
                         stash_tail(self.stashed, self.guide_blocks),
                     ));
                 }
-                match refiner {
+                Phase::Polish(match refiner {
                     Some(r) => Polish::Refine(r),
                     None => Polish::Smooth(Smoother::new(
                         kind,
@@ -134,7 +135,7 @@ impl Run<'_, '_> {
                         ws.delta.as_flattened_mut(),
                         ws.idle.smoothing(n),
                     )),
-                }
+                })
             }
             Polish::Refine(mut r) => {
                 // Large maps: the links and the coarse route's words; small maps: two halves of
@@ -174,38 +175,45 @@ impl Run<'_, '_> {
                         diagonal,
                     });
                     // The refined path is locally shortest: the smoothing's bounded scan.
-                    Polish::Smooth(
+                    Phase::Polish(Polish::Smooth(
                         Smoother::new(kind, n, ws.delta.as_flattened_mut(), ws.idle.smoothing(n))
                             .bounded(),
-                    )
+                    ))
                 } else {
-                    Polish::Refine(r)
+                    Phase::Polish(Polish::Refine(r))
                 }
             }
             Polish::Smooth(mut sm) => {
                 let dist = ws.delta.as_flattened_mut();
                 let links = ws.idle.smoothing(sm.cells());
                 if sm.resume(grid, ws.points, dist, links, SMOOTH_SLICE) {
-                    Polish::Smooth(sm)
+                    Phase::Polish(Polish::Smooth(sm))
                 } else {
-                    let k = sm.finish(grid, ws.points, dist, links);
-                    let waypoints = if corridor {
-                        crate::corridor::shortest(
-                            grid,
-                            ws.points,
-                            k,
-                            crate::corridor::RADIUS,
-                            ws.delta,
-                            ws.idle.links(),
-                        )
-                    } else {
-                        k
-                    };
-                    Polish::Done { waypoints }
+                    Phase::Polish(Polish::Tail(sm))
                 }
             }
-            done @ Polish::Done { .. } => done,
+            Polish::Tail(mut sm) => {
+                let dist = ws.delta.as_flattened_mut();
+                let links = ws.idle.smoothing(sm.cells());
+                match sm.finish_piece(grid, ws.points, dist, links) {
+                    None => Phase::Polish(Polish::Tail(sm)),
+                    Some(k) => {
+                        let waypoints = if corridor {
+                            crate::corridor::shortest(
+                                grid,
+                                ws.points,
+                                k,
+                                crate::corridor::RADIUS,
+                                ws.delta,
+                                ws.idle.links(),
+                            )
+                        } else {
+                            k
+                        };
+                        Phase::Ended(End::Path { waypoints })
+                    }
+                }
+            }
         };
-        !matches!(self.polish, Polish::Done { .. })
     }
 }

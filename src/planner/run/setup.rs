@@ -1,29 +1,56 @@
 //! The setup of a run before its first iteration, one piece at a time: the flood fill (is the
 //! goal reachable at all?), dead-end pruning, the coarse route of a large map. The fill and the
 //! pruning read the map (the default preset skips the fill; only the full layout prunes), the
-//! route only the blocks its search closes ([`crate::route::search`]); the firmware yields
-//! between the pieces.
+//! route only the blocks its search closes ([`crate::route::search`]); each is a piece of
+//! [`Run::poll`].
 
 use crate::ant::DeadEnd;
 use crate::grid::{Moves, Reach};
 use crate::prune::{self, prune};
 use crate::route;
 
-use super::{Area, Run, Setup};
+use super::{Area, End, Phase, Run, Setup};
+
+/// Blocks the coarse route's search closes in one piece of [`Run::poll`] (each reads its border
+/// cells' links: a few thousand instructions a block). Measured under `-icount`
+/// (`scripts/bench_pieces.py`): a piece stays below 1 M instructions.
+const ROUTE_BLOCKS: u32 = 160;
 
 impl Run<'_, '_> {
-    /// Do the next piece of the setup, if any is left: the flood fill (a goal found unreachable
-    /// ends the run: [`Run::finish`] gives [`crate::Error::NoPath`]), the dead-end pruning, the coarse
-    /// route. Returns `true` while setup remains. The flood fill and the pruning read the whole
-    /// map once, the route only the blocks its bounded search closes; the firmware yields between
-    /// the pieces;
-    /// [`Run::step`] does whatever setup is left itself, so other callers never need this.
-    pub fn setup_step(&mut self) -> bool {
+    /// The coarse route's search ended (`Ok(Some(_))`), was not wanted (`Ok(None)`) or found no
+    /// room: the colony is next.
+    fn routed(&mut self, routed: Result<Option<route::Searched>, route::Short>) {
+        self.routed = match routed {
+            Ok(Some(_searched)) => {
+                crate::fmt::debug!(
+                    "plan: route closed {} blocks, read {} blocks' links",
+                    _searched.closed,
+                    _searched.linked
+                );
+                true
+            }
+            Ok(None) => false,
+            // A workspace laid out without room for the route (none the arena lays out): said,
+            // not silent; the ants are pulled at the goal.
+            Err(route::Short) => {
+                crate::fmt::warning!("plan: no room for the coarse route");
+                false
+            }
+        };
+        crate::fmt::debug!("plan: {} cells pruned", self.pruned);
+        self.phase = Phase::Colony(Default::default());
+    }
+
+    /// Do the piece `piece` of the setup and move to the next: the flood fill (a goal found
+    /// unreachable ends the run: [`Run::finish`] gives [`crate::Error::NoPath`]), the dead-end
+    /// pruning, the coarse route (then the colony). The flood fill and the pruning read the whole
+    /// map once, the route only the blocks its bounded search closes.
+    pub(super) fn setup_piece(&mut self, piece: Setup) {
         let grid = self.grid;
         let p = &self.params;
         // What the setup owns and the buffers it borrows until the first ant (`lend::Setting`).
         let mut ws = self.ws.setting();
-        match self.setup {
+        match piece {
             Setup::Reach => {
                 // Backtracking ants skip the flood fill, cold or warm: if the goal is cut off,
                 // the first ant backs out of every branch of the start's component and proves it
@@ -38,12 +65,10 @@ impl Run<'_, '_> {
                 if !proved_by_ants
                     && grid.reachable(self.start, self.goal, visited, ring) == Reach::No
                 {
-                    self.no_path = true;
-                    self.done = true;
-                    self.setup = Setup::Done;
-                    return false;
+                    self.phase = Phase::Ended(End::NoPath);
+                    return;
                 }
-                self.setup = Setup::Prune;
+                self.phase = Phase::Setup(Setup::Prune);
             }
             Setup::Prune => {
                 // A workspace without pruning marks (`dead` empty) plans without pruning.
@@ -82,73 +107,84 @@ impl Run<'_, '_> {
                     crate::bitmap::clear(ws.dead, grid.cells());
                     0
                 };
-                self.setup = Setup::Route;
+                self.phase = Phase::Setup(Setup::Route(None));
             }
-            Setup::Route => {
+            Setup::Route(at) => {
                 // Large maps: the potential field pulls along a coarse route (not for ACA, which
                 // has no attraction), searched over the blocks the plan needs only
                 // (`route::search`: from the goal's block until the start's block and every
-                // block within the slack are closed; each block's links read as it closes).
+                // block within the slack are closed; each block's links read as it closes), at
+                // most `ROUTE_BLOCKS` blocks a piece.
                 let wanted = self.blocks.shift() > 0 && p.algorithm.attracts();
+                if !wanted {
+                    self.routed(Ok(None));
+                    return;
+                }
                 let (ends, blocks) = ((self.start, self.goal), self.guide_blocks);
                 let moves = Moves::new(*grid, ws.moves);
                 let count = blocks.count();
                 let (relink, area) = (self.relinked && self.marks, self.touched.map(Area::corners));
-                let bound = route::Bound::Plan;
-                let routed = if !wanted {
-                    Ok(None)
-                } else if ws.guide.is_packed() {
-                    // Built in words the tabu set, the path cells or the links lend (idle
-                    // until the first ant), then packed: built again each run, never
-                    // repaired (a packed route is kept only by workspaces without pruning
-                    // marks).
-                    match ws.idle.packed_route(&mut ws.guide, count) {
-                        Some(((words, heap), out)) => {
-                            route::build(&moves, blocks, ends, ws.dead, words, heap, bound)
-                                .and_then(|r| {
-                                    route::pack(blocks, words, out)
-                                        .then_some(Some(r))
-                                        .ok_or(route::Short)
-                                })
-                        }
-                        None => Err(route::Short),
-                    }
+                let packed = ws.guide.is_packed();
+                // A packed route is built in words the tabu set, the path cells or the links lend
+                // (idle until the first ant), then packed: built again each run, never repaired
+                // (a packed route is kept only by workspaces without pruning marks).
+                let bufs = if packed {
+                    ws.idle
+                        .packed_route(&mut ws.guide, count)
+                        .map(|(pair, out)| (pair, Some(out)))
                 } else {
-                    match ws.idle.route_words(&mut ws.guide, count) {
-                        // The last run's links, forgotten where the map or the marks changed.
-                        Some((words, heap)) if relink => {
-                            route::repair(&moves, blocks, ends, ws.dead, words, heap, area, bound)
-                                .map(Some)
-                        }
-                        Some((words, heap)) => {
-                            route::build(&moves, blocks, ends, ws.dead, words, heap, bound)
-                                .map(Some)
-                        }
-                        None => Err(route::Short),
-                    }
+                    ws.idle
+                        .route_words(&mut ws.guide, count)
+                        .map(|pair| (pair, None))
                 };
-                self.routed = match routed {
-                    Ok(Some(_searched)) => {
-                        crate::fmt::debug!(
-                            "plan: route closed {} blocks, read {} blocks' links",
-                            _searched.closed,
-                            _searched.linked
-                        );
-                        true
-                    }
-                    Ok(None) => false,
-                    // A workspace laid out without room for the route (none the arena lays
-                    // out): said, not silent; the ants are pulled at the goal.
-                    Err(route::Short) => {
-                        crate::fmt::warning!("plan: no room for the coarse route");
-                        false
-                    }
+                let Some(((words, heap), out)) = bufs else {
+                    self.routed(Err(route::Short));
+                    return;
                 };
-                crate::fmt::debug!("plan: {} cells pruned", self.pruned);
-                self.setup = Setup::Done;
+                let mut at = match at {
+                    Some(at) => at,
+                    // The last run's links, forgotten where the map or the marks changed.
+                    None if relink && !packed => {
+                        match route::begin_repair(&moves, blocks, ends, words, heap, area) {
+                            Ok(at) => at,
+                            Err(e) => return self.routed(Err(e)),
+                        }
+                    }
+                    None => match route::begin_build(blocks, ends, words, heap) {
+                        Ok(at) => at,
+                        Err(e) => return self.routed(Err(e)),
+                    },
+                };
+                let bound = route::Bound::Plan;
+                let dead = &*ws.dead;
+                let done = route::resume(
+                    &moves,
+                    blocks,
+                    ends,
+                    dead,
+                    words,
+                    heap,
+                    bound,
+                    &mut at,
+                    ROUTE_BLOCKS,
+                );
+                let routed = match (done, out) {
+                    (Ok(None), _) => {
+                        self.phase = Phase::Setup(Setup::Route(Some(at)));
+                        return;
+                    }
+                    (Ok(Some(r)), Some(out)) => {
+                        if route::pack(blocks, words, out) {
+                            Ok(Some(r))
+                        } else {
+                            Err(route::Short)
+                        }
+                    }
+                    (Ok(Some(r)), None) => Ok(Some(r)),
+                    (Err(e), _) => Err(e),
+                };
+                self.routed(routed);
             }
-            Setup::Done => {}
         }
-        self.setup != Setup::Done
     }
 }

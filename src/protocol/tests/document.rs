@@ -159,8 +159,7 @@ fn protocol_doc_example_is_what_the_planner_returns() {
     let defaults = hello().defaults;
     let (start, goal) = (Point::new(0, 0), Point::new(3, 2));
     let mut run = Run::cold(&g, start, goal, &defaults, s.workspace(), &mut memory).unwrap();
-    while run.step() {}
-    while run.polish_step() {}
+    while let crate::planner::Poll::Working(_) = run.poll() {}
     run.keep(&mut memory);
     let p = run.finish().unwrap();
     let want = example_path();
