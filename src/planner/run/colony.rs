@@ -66,8 +66,11 @@ pub const REFINE_GAIN: f32 = 0.99;
 /// (`docs/bench/colony-issue36.md`, `docs/ALGORITHM.md`): ant moves a plan halve on the mazes
 /// and drop by a third on the cities and the depot, and the mean raw length over the 20 large
 /// maps is 1.0009 against 1.0008 (1.0009 both with seeds 1-4).
+///
+/// An iteration the quorum ended after its first ants ([`crate::quorum::ended`]) settled too.
 pub fn settled(point: &CurvePoint, ants: u16) -> bool {
-    point.arrived == ants && point.mean * REFINE_GAIN <= point.best
+    point.walked == ants && point.arrived == ants && point.mean * REFINE_GAIN <= point.best
+        || crate::quorum::ended(point, ants)
 }
 
 /// The best path of an iteration or of the run, as step counts (exact length comparison).
@@ -115,6 +118,8 @@ pub(super) struct Iteration {
     worst_replay: Option<Replay>,
     sum: f32,
     arrived: u32,
+    /// Ants walked (all of them unless the quorum ended the iteration, [`crate::quorum`]).
+    walked: u16,
 }
 
 /// The iteration's best and worst paths for [`wolves`], each from where it is: `iter_best` and
@@ -229,7 +234,10 @@ impl Run<'_, '_> {
         let mut it = Iteration::default();
         // The move budget (see `MOVE_BUDGET`): from the cheapest walk that arrived in this run.
         let bounded = self.iteration > 0 && self.refines && p.dead_end == DeadEnd::Backtrack;
-        for _ in 0..p.ants {
+        // The quorum where `settled` applies (see `record`).
+        let quorum = self.refines && self.blocks.shift() > 0;
+        for k in 1..=p.ants {
+            it.walked = k;
             if let (true, Some(c)) = (bounded, self.cheapest) {
                 ant.budget = c.saturating_mul(MOVE_BUDGET);
             }
@@ -304,6 +312,12 @@ impl Run<'_, '_> {
                         it.worst_replay.clone_from(&before);
                     }
                     it.worst = Some((b, 1));
+                }
+            }
+            if quorum {
+                let best = it.best.map_or(f32::INFINITY, |(b, _)| b.length());
+                if crate::quorum::reached(k, p.ants, it.arrived, it.sum, best) {
+                    break;
                 }
             }
         }
@@ -394,6 +408,7 @@ impl Run<'_, '_> {
             },
             best_so_far: self.best.map_or(inf, |b| b.length()),
             arrived: u16::try_from(it.arrived).unwrap_or(u16::MAX),
+            walked: it.walked,
         };
         if let Some(slot) = self.ws.curve.get_mut(usize::from(self.iteration)) {
             *slot = point;
