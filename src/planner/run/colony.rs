@@ -231,6 +231,10 @@ impl Run<'_, '_> {
             budget: u32::MAX,
         };
         let (keep_best, keep_worst) = (!iter_best.is_empty(), !iter_worst.is_empty());
+        // Before the run has a best path, `best` is free, and the iteration's best (if any ant
+        // arrives) becomes the run's: a workspace without `iter_best` keeps it there as the ants
+        // find it instead of walking its ant again (the same path bit for bit, see `Replay`).
+        let best_free = !keep_best && self.best.is_none() && !best.is_empty();
         let mut it = Iteration::default();
         // The move budget (see `MOVE_BUDGET`): from the cheapest walk that arrived in this run.
         let bounded = self.iteration > 0 && self.refines && p.dead_end == DeadEnd::Backtrack;
@@ -296,6 +300,8 @@ impl Run<'_, '_> {
                 _ => {
                     if keep_best {
                         copy_tour(iter_best, path);
+                    } else if best_free {
+                        copy_tour(best, path);
                     } else {
                         it.best_replay.clone_from(&before);
                     }
@@ -336,24 +342,30 @@ impl Run<'_, '_> {
                 Ok(w) if w.steps == steps
             )
         };
-        let mut placed = false;
+        let mut placed = best_free;
         if let (true, Some((b, nb)), Some((w, nw))) = (p.algorithm.wolves(), it.best, it.worst) {
+            // The best path where it is: `iter_best`, or `best` when it was free (then nothing
+            // to walk again into it).
+            let (kept_best, best_buf): (Option<&[Dir]>, &mut [Dir]) = if keep_best {
+                (Some(&*iter_best), &mut *best)
+            } else if best_free {
+                (Some(&*best), &mut [])
+            } else {
+                (None, &mut *best)
+            };
             let mut paths = Paths {
                 again: &mut again,
                 it: &it,
                 steps: (b.steps, w.steps),
-                kept: (
-                    keep_best.then_some(&*iter_best),
-                    keep_worst.then_some(&*iter_worst),
-                ),
-                best,
+                kept: (kept_best, keep_worst.then_some(&*iter_worst)),
+                best: best_buf,
                 tour,
                 new_best: new_best.is_some(),
                 placed: false,
             };
             let lengths = ((b.length(), nb), (w.length(), nw));
             wolves(&mut delta, self.grid, self.start, p.q, lengths, &mut paths);
-            placed = paths.placed;
+            placed |= paths.placed;
         }
         if let (Some(b), false) = (new_best, placed) {
             if keep_best {
