@@ -117,6 +117,7 @@ pub mod planner;
 #[cfg(feature = "protocol")]
 pub mod protocol;
 pub mod prune;
+pub mod quorum;
 pub mod refine;
 pub mod rng;
 pub mod route;

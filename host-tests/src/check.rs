@@ -317,11 +317,26 @@ pub fn check_plan(
     // length within `REFINE_GAIN` of the iteration's best (`ohaca::planner::settled`), replayed
     // here from the curve when it holds every iteration: such an iteration ends the run, and no
     // earlier one may.
-    let agreed = |c: &ohaca::planner::CurvePoint| {
-        c.arrived == p.ants && c.mean * ohaca::planner::REFINE_GAIN <= c.best
-    };
     // Large maps only (the pheromone in blocks; the compact layout's are larger still).
     let windowed = refines && map.cells() > ohaca::pheromone::BLOCKS;
+    // An iteration the quorum ended after its first ants (`ohaca::quorum`) settled too: it
+    // walked `QUORUM` ants, all arrived, and they agree.
+    let agreed = |c: &ohaca::planner::CurvePoint| {
+        let all = c.walked == p.ants && c.arrived == p.ants;
+        let quorum = c.walked == ohaca::quorum::QUORUM
+            && ohaca::quorum::QUORUM < p.ants
+            && c.arrived == c.walked;
+        (all || quorum) && c.mean * ohaca::planner::REFINE_GAIN <= c.best
+    };
+    // Every iteration walks every ant, except one the quorum ended (the run's last).
+    if let Some(i) = curve.iter().position(|c| c.walked != p.ants) {
+        if !(windowed && i + 1 == curve.len() && agreed(&curve[i])) {
+            return Err(format!(
+                "iteration {i} walked {} of {} ants without a quorum",
+                curve[i].walked, p.ants
+            ));
+        }
+    }
     let settled = windowed && curve.len() == usize::from(its) && curve.last().is_some_and(agreed);
     if windowed && curve.len() == usize::from(its) {
         if let Some(i) = curve.iter().take(usize::from(its) - 1).position(agreed) {

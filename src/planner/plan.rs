@@ -17,6 +17,9 @@ pub struct CurvePoint {
     pub best_so_far: f32,
     /// Ants that reached the goal in this iteration (all of them unless they die at dead ends).
     pub arrived: u16,
+    /// Ants that walked in this iteration: all of them, unless the quorum ended it early
+    /// ([`crate::quorum`]).
+    pub walked: u16,
 }
 
 /// Where a [`Plan`] comes from. On the wire it is [`crate::protocol::PathReply::origin`], one

@@ -600,6 +600,16 @@ fn small_maps_keep_the_colonys_path() {
     }
 }
 
+/// Whether a recorded iteration settled its corridor, replayed from its numbers independently
+/// of `settled`: all `ants` walked and arrived, or the quorum's first ants did
+/// (`crate::quorum`), with a mean within `REFINE_GAIN` of the iteration's best.
+fn agrees(c: &CurvePoint, ants: u16) -> bool {
+    let all = c.walked == ants && c.arrived == ants;
+    let quorum =
+        c.walked == crate::quorum::QUORUM && crate::quorum::QUORUM < ants && c.arrived == c.walked;
+    (all || quorum) && c.mean * REFINE_GAIN <= c.best
+}
+
 #[test]
 fn refining_runs_stop_after_the_refine_patience() {
     // Unless an iteration settles the corridor first (`settled`; below, its own test): the run
@@ -618,7 +628,7 @@ fn refining_runs_stop_after_the_refine_patience() {
         let settled_stop = plan
             .curve()
             .iter()
-            .position(|c| refine && c.arrived == p.ants && c.mean * REFINE_GAIN <= c.best)
+            .position(|c| refine && agrees(c, p.ants))
             .map_or(u16::MAX, |i| i as u16 + 1);
         assert_eq!(
             plan.iterations,
@@ -657,7 +667,7 @@ fn a_refining_run_on_a_large_map_ends_at_the_first_iteration_that_settles_its_co
             };
             let curve = plan.curve();
             assert_eq!(curve.len(), usize::from(plan.iterations));
-            let agreed = |c: &CurvePoint| c.arrived == p.ants && c.mean * REFINE_GAIN <= c.best;
+            let agreed = |c: &CurvePoint| agrees(c, p.ants);
             match curve.iter().position(agreed) {
                 Some(i) => {
                     assert_eq!(
@@ -882,7 +892,7 @@ fn a_refining_run_counts_gains_of_one_percent_or_less_as_stale() {
                 small_gains += 1;
             }
             prev = l;
-            let settles = c.arrived == q.ants && c.mean * REFINE_GAIN <= c.best;
+            let settles = agrees(c, q.ants);
             if settles || i >= last_gain + usize::from(p.refine_patience) {
                 stop = i + 1;
                 break;
@@ -916,7 +926,13 @@ fn fingerprint(
         plan.moves,
         plan.curve()
             .iter()
-            .map(|c| [c.best.to_bits(), c.mean.to_bits(), u32::from(c.arrived)])
+            .map(|c| {
+                [
+                    c.best.to_bits(),
+                    c.mean.to_bits(),
+                    u32::from(c.arrived) | u32::from(c.walked) << 16,
+                ]
+            })
             .collect(),
     ))
 }

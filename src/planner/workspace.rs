@@ -403,6 +403,7 @@ impl<
                     mean: 0.0,
                     best_so_far: 0.0,
                     arrived: 0,
+                    walked: 0,
                 }; CURVE],
                 guide: [0; GUIDE_BLOCKS],
             },

@@ -42,6 +42,17 @@ pub use search::{Bound, Searched, Searching};
 /// cells (the smallest `k` that gives at most this many), a smaller one routes on cells.
 pub const GUIDE_BLOCKS: usize = 4096;
 
+/// Blocks of `2^k x 2^k` cells with `k` below this (single cells, 2 x 2 and 4 x 4: maps of up to
+/// 65,536 cells) have their links read for the whole map in one pass before the search
+/// ([`links::links`], 32 cells a word), instead of one block at a time as the search closes
+/// them ([`links::block`]). The route is the same bit for bit (the links are the same, and the
+/// search reads nothing else: `small_blocks_route_as_the_lazy_search_does`); only the cost
+/// moves. Why: on small blocks the bounded search closes most of the map anyway (a maze), and
+/// a block's own read costs about as much as its share of the whole pass several times over
+/// (measured on the device: Boston's setup 8.7 M before the bounded search, 13.0 M with it;
+/// `docs/bench/lattice-issue36.md` has the figures with this rule).
+pub const WHOLE_LINKS_BELOW: u8 = 3;
+
 /// How many blocks ahead on the route an ant's sub-goal lies.
 pub const LOOKAHEAD: u32 = 2;
 
@@ -177,7 +188,7 @@ pub fn build(
     heap: &mut [u32],
     bound: Bound,
 ) -> Result<Searched, Short> {
-    let mut at = begin_build(blocks, (start, goal), words, heap)?;
+    let mut at = begin_build(moves, blocks, (start, goal), dead, words, heap)?;
     finish(
         moves,
         blocks,
@@ -210,14 +221,19 @@ fn cut<'w>(
 /// [`build`] a piece at a time: prepare the words and start the search (a pass over the
 /// words); then [`resume`] until it is done.
 pub fn begin_build(
+    moves: &Moves<'_>,
     blocks: Blocks,
     ends: (Point, Point),
+    dead: &[u32],
     words: &mut [u32],
     heap: &mut [u32],
 ) -> Result<Searching, Short> {
     let (words, heap) = cut(blocks, words, heap)?;
     words.fill(unsearched(0));
-    Ok(search::begin(blocks, ends, words, heap))
+    let read = whole_links(moves, blocks, dead, words, None);
+    let mut at = search::begin(blocks, ends, words, heap);
+    at.linked(read);
+    Ok(at)
 }
 
 /// Go on with a route search started by [`begin_build`] or [`begin_repair`], closing at most
@@ -261,6 +277,45 @@ fn finish(
     }
 }
 
+/// On blocks smaller than [`WHOLE_LINKS_BELOW`]: read the links of the blocks in `region` (block
+/// coordinates; `None`: every block) in one pass, and mark every block's links known (the
+/// caller's words outside `region` must know theirs: a repair checks). Returns the blocks read
+/// (0 on larger blocks, where the search reads each block as it closes it).
+fn whole_links(
+    moves: &Moves<'_>,
+    blocks: Blocks,
+    dead: &[u32],
+    words: &mut [u32],
+    region: Option<links::Region>,
+) -> u32 {
+    if blocks.shift() >= WHOLE_LINKS_BELOW {
+        return 0;
+    }
+    // Only known words outside the region: otherwise the whole map.
+    let region = region.filter(|r| {
+        words.iter().enumerate().all(|(b, w)| {
+            let (bx, by) = (
+                b.checked_rem(blocks.across()).unwrap_or(0),
+                b.checked_div(blocks.across()).unwrap_or(0),
+            );
+            w & KNOWN != 0 || r.holds(bx, by)
+        })
+    });
+    let read = region.map_or(words.len(), |r| {
+        if r.x0 > r.x1 || r.y0 > r.y1 {
+            return 0;
+        }
+        r.x1.wrapping_sub(r.x0)
+            .wrapping_add(1)
+            .saturating_mul(r.y1.wrapping_sub(r.y0).wrapping_add(1))
+    });
+    links::links(moves, blocks, dead, words, region);
+    for w in words.iter_mut() {
+        *w = unsearched(*w | KNOWN);
+    }
+    u32::try_from(read).unwrap_or(u32::MAX)
+}
+
 /// A word before the search: the links and their flag `known`, no next block, not reached.
 #[inline]
 fn unsearched(known: u32) -> u32 {
@@ -285,7 +340,7 @@ pub fn repair(
     area: Option<(Point, Point)>,
     bound: Bound,
 ) -> Result<Searched, Short> {
-    let mut at = begin_repair(moves, blocks, ends, words, heap, area)?;
+    let mut at = begin_repair(moves, blocks, ends, dead, words, heap, area)?;
     finish(moves, blocks, ends, dead, words, heap, bound, &mut at)
 }
 
@@ -295,6 +350,7 @@ pub fn begin_repair(
     moves: &Moves<'_>,
     blocks: Blocks,
     ends: (Point, Point),
+    dead: &[u32],
     words: &mut [u32],
     heap: &mut [u32],
     area: Option<(Point, Point)>,
@@ -305,6 +361,7 @@ pub fn begin_repair(
     }
     let grid = *moves.grid();
     let (w, h) = (grid.width(), grid.height());
+    let mut region = None;
     if let (Some((lo, hi)), true) = (area, w > 0 && h > 0) {
         // A block's links read its border cells and the cells one move beyond them: the blocks
         // within one cell of `area`.
@@ -326,8 +383,20 @@ pub fn begin_repair(
                 }
             }
         }
+        region = Some(links::Region { x0, y0, x1, y1 });
     }
-    Ok(search::begin(blocks, ends, words, heap))
+    // Small blocks: the forgotten blocks read again in one pass (a repair without an area, or
+    // whose last run did not know every block, reads them all).
+    let region = region.or(Some(links::Region {
+        x0: 1,
+        y0: 1,
+        x1: 0,
+        y1: 0,
+    }));
+    let read = whole_links(moves, blocks, dead, words, region);
+    let mut at = search::begin(blocks, ends, words, heap);
+    at.linked(read);
+    Ok(at)
 }
 
 /// Words [`pack`] needs for a route of `count` blocks: four bits a block.
@@ -688,6 +757,78 @@ mod tests {
         assert!(unstash(blocks, &kept, &mut back));
         for (a, b) in words.iter().zip(&back) {
             assert_eq!(a & (LINKS | KNOWN), *b);
+        }
+    }
+
+    #[test]
+    fn small_blocks_route_as_the_lazy_search_does() {
+        // Maps of 2 x 2 and 4 x 4 blocks read the whole map's links first (`WHOLE_LINKS_BELOW`);
+        // the route (every block's next block and key, the search's closed count and length)
+        // is the lazy search's bit for bit, and every block's links are the per-cell rule's.
+        // Fails when the whole pass reads other links (other marks, a region off by a block).
+        let mut rng = crate::rng::Xoshiro128pp::from_u64(36);
+        for (round, (w, h)) in [(100u16, 90u16), (200, 150), (130, 70), (256, 256)]
+            .into_iter()
+            .cycle()
+            .take(12)
+            .enumerate()
+        {
+            let density = [0.1f32, 0.25, 0.35][round % 3];
+            let b = crate::testutil::random_bits(&mut rng, w, h, density);
+            let g = Grid::new(w, h, &b).unwrap();
+            let cells = usize::from(w) * usize::from(h);
+            let dead: Vec<u32> = (0..cells.div_ceil(32))
+                .map(|_| rng.next_word() & rng.next_word() & rng.next_word())
+                .collect();
+            let moves = Moves::new(g, &[]);
+            let blocks = blocks(w, h);
+            assert!(blocks.shift() > 0 && blocks.shift() < WHOLE_LINKS_BELOW);
+            let n = blocks.count();
+            let free = |p: Point| g.is_free(p);
+            let pick = |rng: &mut crate::rng::Xoshiro128pp| loop {
+                let p = Point::new(
+                    (rng.next_word() % u32::from(w)) as u16,
+                    (rng.next_word() % u32::from(h)) as u16,
+                );
+                if free(p) {
+                    return p;
+                }
+            };
+            let ends = (pick(&mut rng), pick(&mut rng));
+            let (mut words, mut heap) = (vec![0u32; n], vec![0u32; n]);
+            let r = build(
+                &moves,
+                blocks,
+                ends,
+                &dead,
+                &mut words,
+                &mut heap,
+                Bound::Plan,
+            )
+            .unwrap();
+            let mut lazy = vec![unsearched(0); n];
+            let l = search::search(
+                &moves,
+                blocks,
+                ends,
+                &dead,
+                &mut lazy,
+                &mut heap,
+                Bound::Plan,
+            );
+            let why = format!("round {round}: {w} x {h}, {ends:?}");
+            assert_eq!((r.closed, r.length), (l.closed, l.length), "{why}");
+            assert_eq!(r.linked as usize, n, "{why}");
+            for (i, (&a, &z)) in words.iter().zip(&lazy).enumerate() {
+                assert_eq!(a >> NEXT_SHIFT, z >> NEXT_SHIFT, "{why}: block {i}");
+                let (bx, by) = (i % blocks.across(), i / blocks.across());
+                let want = links::block_links(&moves, blocks, &dead, bx as u16, by as u16);
+                assert_eq!(
+                    a & (LINKS | KNOWN),
+                    u32::from(want) | KNOWN,
+                    "{why}: block {i}"
+                );
+            }
         }
     }
 }

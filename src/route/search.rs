@@ -143,6 +143,13 @@ pub struct Searching {
     done: Searched,
 }
 
+impl Searching {
+    /// Count `n` more blocks whose links were read before the search ([`Searched::linked`]).
+    pub(super) fn linked(&mut self, n: u32) {
+        self.done.linked = self.done.linked.wrapping_add(n);
+    }
+}
+
 /// The heap over `heap` for a search between `start` and `goal` with `len` blocks queued.
 fn heap_of<'h>(
     blocks: Blocks,

@@ -67,7 +67,8 @@ pub const REFINE_GAIN: f32 = 0.99;
 /// and drop by a third on the cities and the depot, and the mean raw length over the 20 large
 /// maps is 1.0009 against 1.0008 (1.0009 both with seeds 1-4).
 pub fn settled(point: &CurvePoint, ants: u16) -> bool {
-    point.arrived == ants && point.mean * REFINE_GAIN <= point.best
+    point.walked == ants && point.arrived == ants && point.mean * REFINE_GAIN <= point.best
+        || crate::quorum::ended(point, ants)
 }
 
 /// The best path of an iteration or of the run, as step counts (exact length comparison).
@@ -117,6 +118,8 @@ pub(super) struct Iteration {
     arrived: u32,
     /// An ant of this iteration proved the goal unreachable (the run ends with `NoPath`).
     no_path: bool,
+    /// Ants walked (all of them unless the quorum ended the iteration, [`crate::quorum`]).
+    walked: u16,
 }
 
 /// Moves of the ants' walks (forward or back) one piece of the colony makes at most
@@ -314,6 +317,12 @@ impl Run<'_, '_> {
                 .filter(|b| run_best.is_none_or(|g| b.length() < g.length()))
         };
         let tight = p.tighten;
+        // Before the run has a best path, `best` is free, and the iteration's best (if any ant
+        // arrives) becomes the run's: a workspace without `iter_best` keeps it there as the ants
+        // find it instead of walking its ant again (the same path bit for bit, see `Replay`).
+        let best_free = !keep_best && self.best.is_none() && !best.is_empty();
+        // The quorum where `settled` applies (see `record`).
+        let quorum = self.refines && self.blocks.shift() > 0;
         while left > 0 {
             match w.close {
                 Close::Ants => {
@@ -344,6 +353,7 @@ impl Run<'_, '_> {
                                 budget,
                             });
                             left = left.saturating_sub(start_cost(cells));
+                            w.it.walked = w.ant.saturating_add(1);
                             (ant.begin(tabu, tour), before, budget)
                         }
                         None => {
@@ -419,6 +429,8 @@ impl Run<'_, '_> {
                         _ => {
                             if keep_best {
                                 copy_tour(iter_best, path);
+                            } else if best_free {
+                                copy_tour(best, path);
                             } else {
                                 it.best_replay.clone_from(&before);
                             }
@@ -435,6 +447,12 @@ impl Run<'_, '_> {
                                 it.worst_replay.clone_from(&before);
                             }
                             it.worst = Some((b, 1));
+                        }
+                    }
+                    if quorum {
+                        let b = it.best.map_or(f32::INFINITY, |(b, _)| b.length());
+                        if crate::quorum::reached(w.ant, p.ants, it.arrived, it.sum, b) {
+                            w.close = Close::Best;
                         }
                     }
                 }
@@ -457,7 +475,14 @@ impl Run<'_, '_> {
                         (worst_steps, punish)
                     };
                     let kept = if is_best {
-                        keep_best.then_some(&*iter_best)
+                        // `best` when it was free: the ants left the path there.
+                        if keep_best {
+                            Some(&*iter_best)
+                        } else if best_free {
+                            Some(&*best)
+                        } else {
+                            None
+                        }
                     } else {
                         keep_worst.then_some(&*iter_worst)
                     };
@@ -502,7 +527,7 @@ impl Run<'_, '_> {
                     w.close = if is_best { Close::Worst } else { Close::Place };
                 }
                 Close::Place => {
-                    if let (Some(b), false) = (new_best(&w.it, self.best), w.placed) {
+                    if let (Some(b), false) = (new_best(&w.it, self.best), w.placed || best_free) {
                         if keep_best {
                             if let Some(src) = iter_best.get(..b.steps) {
                                 copy_tour(best, src);
@@ -579,6 +604,7 @@ impl Run<'_, '_> {
             },
             best_so_far: self.best.map_or(inf, |b| b.length()),
             arrived: u16::try_from(it.arrived).unwrap_or(u16::MAX),
+            walked: it.walked,
         };
         if let Some(slot) = self.ws.curve.get_mut(usize::from(self.iteration)) {
             *slot = point;

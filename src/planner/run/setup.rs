@@ -145,12 +145,12 @@ impl Run<'_, '_> {
                     Some(at) => at,
                     // The last run's links, forgotten where the map or the marks changed.
                     None if relink && !packed => {
-                        match route::begin_repair(&moves, blocks, ends, words, heap, area) {
+                        match route::begin_repair(&moves, blocks, ends, &ws.dead, words, heap, area) {
                             Ok(at) => at,
                             Err(e) => return self.routed(Err(e)),
                         }
                     }
-                    None => match route::begin_build(blocks, ends, words, heap) {
+                    None => match route::begin_build(&moves, blocks, ends, &ws.dead, words, heap) {
                         Ok(at) => at,
                         Err(e) => return self.routed(Err(e)),
                     },
