@@ -3,13 +3,13 @@
 //! pheromone evaporates and takes the increments, and the run records its best path, the
 //! convergence curve and whether to stop early.
 
-use crate::ant::{Ant, DeadEnd, Lost, Walk};
+use crate::colony::ant::{Ant, DeadEnd, Lost, Walk};
+use crate::colony::pheromone::Table;
+use crate::colony::tighten::tighten;
+use crate::colony::update::{deposit, wolves, WolfPaths};
 use crate::geometry::steps_length;
-use crate::grid::{Dir, Moves, Point, Reach};
-use crate::pheromone::Table;
+use crate::map::grid::{Dir, Moves, Point, Reach};
 use crate::rng::Xoshiro128pp;
-use crate::tighten::tighten;
-use crate::update::{deposit, wolves, WolfPaths};
 
 use crate::planner::lend::Colony;
 use crate::planner::plan::CurvePoint;
@@ -52,7 +52,7 @@ pub const REFINE_GAIN: f32 = 0.99;
 /// Whether an iteration of a run that refines settled its corridor: every ant of it arrived and
 /// their mean length is within [`REFINE_GAIN`] of the iteration's best (`mean * REFINE_GAIN <=
 /// best`, on the iteration's [`CurvePoint`], so the plan's curve replays it). Such a run stops
-/// there, whatever its patience, on a map of more than [`crate::pheromone::BLOCKS`] cells (the
+/// there, whatever its patience, on a map of more than [`crate::colony::pheromone::BLOCKS`] cells (the
 /// pheromone in blocks, the local search in windows). Not in the paper, and off without the local
 /// search (the paper preset).
 ///

@@ -1,13 +1,13 @@
 //! The setup of a run before its first iteration, one piece at a time: the flood fill (is the
 //! goal reachable at all?), dead-end pruning, the coarse route of a large map. The fill and the
 //! pruning read the map (the default preset skips the fill; only the full layout prunes), the
-//! route only the blocks its search closes ([`crate::route::search`]); the firmware yields
+//! route only the blocks its search closes ([`crate::colony::route::search`]); the firmware yields
 //! between the pieces.
 
-use crate::ant::DeadEnd;
-use crate::grid::{Moves, Reach};
-use crate::prune::{self, prune};
-use crate::route;
+use crate::colony::ant::DeadEnd;
+use crate::colony::route;
+use crate::map::grid::{Moves, Reach};
+use crate::map::prune::{self, prune};
 
 use super::{Area, Run, Setup};
 
@@ -79,7 +79,7 @@ impl Run<'_, '_> {
                         ),
                     }
                 } else {
-                    crate::bitmap::clear(ws.dead, grid.cells());
+                    crate::map::bitmap::clear(ws.dead, grid.cells());
                     0
                 };
                 self.setup = Setup::Route;
