@@ -14,9 +14,9 @@
 //! [`MAX_STEPS`](crate::protocol) is the wire's bound (the longest path one reply carries), the
 //! H743's `max_steps` today; every board's `max_steps` must be at most that.
 
+use crate::colony::route::GUIDE_BLOCKS;
+use crate::colony::tighten::hash_words;
 use crate::planner::arena;
-use crate::route::GUIDE_BLOCKS;
-use crate::tighten::hash_words;
 
 /// How a board lays out the map and the planner's buffers.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

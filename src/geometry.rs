@@ -7,12 +7,12 @@
 //! valid iff it touches no blocked cell's closed square. Touching counts: a segment that passes
 //! exactly through the corner shared by two diagonally adjacent obstacles is invalid, and so is a
 //! segment that grazes an obstacle's edge. For a single step this is exactly the
-//! no-corner-cutting rule of [`crate::grid`], so every raw path is also valid segment by segment.
+//! no-corner-cutting rule of [`crate::map::grid`], so every raw path is also valid segment by segment.
 //!
 //! [`segment_clear`] decides the rule exactly in integer arithmetic (doubled coordinates, so
 //! centres are odd integers), with no floating point and no tolerance.
 
-use crate::grid::{Grid, Point};
+use crate::map::grid::{Grid, Point};
 
 /// `sqrt(2)` as f32; the length of a diagonal step.
 pub const SQRT_2: f32 = core::f32::consts::SQRT_2;

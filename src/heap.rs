@@ -14,11 +14,11 @@ use alloc::collections::TryReserveError;
 use alloc::vec::Vec;
 use core::fmt;
 
-use crate::bitmap::words;
-use crate::grid::{Dir, Point};
-use crate::pheromone::BLOCKS;
+use crate::colony::pheromone::BLOCKS;
+use crate::colony::route::GUIDE_BLOCKS;
+use crate::map::bitmap::words;
+use crate::map::grid::{Dir, Point};
 use crate::planner::{CurvePoint, OwnedBuffers, Params, Workspace};
-use crate::route::GUIDE_BLOCKS;
 
 /// The buffers, each a `Vec`.
 type Vecs = OwnedBuffers<
@@ -128,7 +128,7 @@ impl HeapStorage {
 
     /// The same storage with at most `links` links: for a device that has fewer than
     /// [`HeapStorage::with_steps`] gives (the STM32H743 keeps paths of 16,384 steps with
-    /// tightening's smallest table, `crate::tighten::hash_words`). [`HeapStorage::ensure`]
+    /// tightening's smallest table, `crate::colony::tighten::hash_words`). [`HeapStorage::ensure`]
     /// grows them again.
     pub fn with_links(mut self, links: usize) -> Self {
         self.buffers.links.truncate(links);

@@ -7,7 +7,11 @@
 //! both: every float function comes from [`libm`], and the random numbers from a local
 //! [`rng::Xoshiro128pp`].
 //!
-//! Modules, one concept each:
+//! The files are grouped by phase: [`map`] (the map and what is known of it before any ant
+//! walks), [`colony`] (the ants and their memory), [`polish`] (what turns the raw path into the
+//! answer), [`search`] (the exact A* beside the planner), then [`planner`] which drives them all;
+//! [`board`], `protocol` and the firmware stand apart. Each module below is also at the crate
+//! root. Modules, one concept each:
 //!
 //! | module | owns |
 //! | --- | --- |
@@ -100,31 +104,27 @@ extern crate alloc;
 pub(crate) mod fmt;
 mod named;
 
-pub mod ant;
-pub mod astar;
-pub mod bitmap;
 pub mod board;
-pub mod corridor;
-pub mod dir;
+pub mod colony;
 pub mod error;
 pub mod geometry;
-pub mod grid;
 #[cfg(any(feature = "alloc", test))]
 pub mod heap;
-pub mod heuristic;
-pub mod pheromone;
+pub mod map;
 pub mod planner;
+pub mod polish;
 #[cfg(feature = "protocol")]
 pub mod protocol;
-pub mod prune;
-pub mod quorum;
-pub mod refine;
 pub mod rng;
-pub mod route;
-pub mod smoothing;
-pub mod taut;
-pub mod tighten;
-pub mod update;
+pub mod search;
+
+// Every phase's modules at the crate root as well: `ohaca::grid`, `ohaca::ant`, ... are the paths
+// the host, the tests, the examples and the fuzz targets use, and the ones the code inside the
+// crate uses (`crate::map::grid`); the folders above are where the files live.
+pub use colony::{ant, heuristic, pheromone, quorum, route, tighten, update};
+pub use map::{bitmap, dir, grid, prune};
+pub use polish::{corridor, refine, smoothing, taut};
+pub use search::astar;
 
 #[cfg(test)]
 mod testutil;

@@ -37,8 +37,8 @@ pub fn heading_walk(
     density: f32,
     steps: usize,
     min: usize,
-) -> (Vec<u8>, Vec<crate::grid::Point>) {
-    use crate::grid::{Grid, Point};
+) -> (Vec<u8>, Vec<crate::map::grid::Point>) {
+    use crate::map::grid::{Grid, Point};
     loop {
         let b = random_bits(rng, w, h, density);
         let g = Grid::new(w, h, &b).unwrap();

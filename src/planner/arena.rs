@@ -11,7 +11,7 @@
 //! | layout | when | what | words at its largest map in an arena of 25,856 (the STM32F411's, [`crate::board::F411`]) |
 //! | --- | --- | --- | --- |
 //! | full | it fits with paths of up to [`FULL_STEPS`] (on the F411: maps of up to 68,256 cells) | the map, `tabu` and `dead` (1 bit a cell each), `tau` and `delta` ([`BLOCKS`] entries), the route's [`GUIDE_BLOCKS`] words, [`LINKS`] links, `steps + 1` path cells and two tours (the iteration's best and worst are walked again), the move table on maps of up to 1,024 cells | 25,856 (65,536 cells, 2,047 steps) |
-//! | compact | the full one does not fit | the map, `tabu`; **no pruning marks** (the run does not prune), pheromone on at most [`COMPACT_BLOCKS`] blocks, the same route **packed** to four bits a block (512 words, [`crate::route::pack`]), `steps + 1` path cells and two tours, and only the links no other buffer can lend (`planner::lend`; 2,048 at 512 x 512): paths of up to the caller's bound | 25,600 (262,144 cells, 4,095 steps) |
+//! | compact | the full one does not fit | the map, `tabu`; **no pruning marks** (the run does not prune), pheromone on at most [`COMPACT_BLOCKS`] blocks, the same route **packed** to four bits a block (512 words, [`crate::colony::route::pack`]), `steps + 1` path cells and two tours, and only the links no other buffer can lend (`planner::lend`; 2,048 at 512 x 512): paths of up to the caller's bound | 25,600 (262,144 cells, 4,095 steps) |
 //!
 //! The full layout gives a run exactly the buffers of a fixed `Storage<{ words(65536) }, 2048,
 //! 4096, 1024, 0, 0>` (65,536 cells, 2,047-step paths), so its plans are that storage's bit for
@@ -32,7 +32,7 @@
 //! | phase | what it uses beyond the map, pheromone and tours |
 //! | --- | --- |
 //! | setup | the coarse route's words and heap (a word a block each, 4,096 blocks): the tabu set halved, packed into the route's 512 words afterwards |
-//! | colony | the tabu set; tightening's table of packed (cell, position) keys over the links and the path cells' words: 6,144 slots for a path of 4,096 cells, a load of 2/3 ([`crate::tighten::keyed_words`]) |
+//! | colony | the tabu set; tightening's table of packed (cell, position) keys over the links and the path cells' words: 6,144 slots for a path of 4,096 cells, a load of 2/3 ([`crate::colony::tighten::keyed_words`]) |
 //! | polish | the path cells (the raw path, then the waypoints); the local search's two slices of 4,056 words from the tabu set halved (two of at least 3,456 on maps of 221,184 to 259,583 cells: windows of 48 to 51 cells a side); the smoothing's links from the tabu set |
 //! | between plans | the path cells and the best tour (the answer the firmware sends in parts, and a replan reuses) and the pheromone |
 //!
@@ -48,14 +48,14 @@
 
 use bytemuck::{try_cast_slice_mut, Pod};
 
-use crate::bitmap::words;
+use crate::colony::pheromone::BLOCKS;
+use crate::colony::route::GUIDE_BLOCKS;
 use crate::error::Error;
-use crate::grid::{Dir, Point};
-use crate::pheromone::BLOCKS;
-use crate::route::GUIDE_BLOCKS;
+use crate::map::bitmap::words;
+use crate::map::grid::{Dir, Point};
 
-use crate::route::packed_words;
-use crate::tighten::{hash_words, keyed_fits, keyed_words};
+use crate::colony::route::packed_words;
+use crate::colony::tighten::{hash_words, keyed_fits, keyed_words};
 
 use super::lend;
 use super::run::{REFINE_WORDS, SHORT_REFINE_WORDS};
@@ -83,7 +83,7 @@ const MOVES: usize = 1024;
 #[derive(Debug)]
 pub struct Carved<'a> {
     /// The map's bits (the arena's first `words(cells)` words, as bytes): what
-    /// [`crate::grid::Grid::new`] reads.
+    /// [`crate::map::grid::Grid::new`] reads.
     pub map: &'a mut [u8],
     /// Every buffer of the run.
     pub workspace: Workspace<'a>,
@@ -345,7 +345,7 @@ fn lay(mut rest: &mut [u32], cells: usize, steps: usize, compact: bool) -> Optio
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::grid::Grid;
+    use crate::map::grid::Grid;
     use crate::planner::{plan, Params, Storage};
     use alloc::vec;
     use alloc::vec::Vec;
@@ -400,7 +400,7 @@ mod tests {
 
     #[test]
     fn the_full_layout_plans_what_the_f411s_storage_planned() {
-        type F411Storage = Storage<{ crate::bitmap::words(65_536) }, 2048, 4096, 1024, 0, 0>;
+        type F411Storage = Storage<{ crate::map::bitmap::words(65_536) }, 2048, 4096, 1024, 0, 0>;
         let mut storage = alloc::boxed::Box::new(F411Storage::new());
         for (w, h, seed) in [
             (30u16, 30u16, 1u64),
@@ -431,7 +431,7 @@ mod tests {
         // The arena walks the iteration's best and worst ants again and tightens with its
         // half-word hash table (4,096 links, fewer than the map's cells); a storage that keeps the
         // two tours must plan the same, cold and warm (the pheromone kept in the arena).
-        type Keeping = Storage<{ crate::bitmap::words(65_536) }, 2048, 4096, 1024, 0, 2048>;
+        type Keeping = Storage<{ crate::map::bitmap::words(65_536) }, 2048, 4096, 1024, 0, 2048>;
         let mut storage = alloc::boxed::Box::new(Keeping::new());
         let mut arena = vec![0u32; ARENA];
         let (w, h) = (256u16, 256u16);

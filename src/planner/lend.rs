@@ -20,10 +20,10 @@
 //! | --- | --- | --- |
 //! | setup: the coarse route, full words (a [`route::Route::new`] workspace) | a heap of a word a block | the links, else the tabu bit set (free until the first ant) |
 //! | setup: the coarse route, packed ([`route::pack`], the compact arena) | the route's words and its heap, a word a block each | the tabu bit set halved, else the tabu set and the links, else the links halved |
-//! | colony: tightening ([`crate::tighten`]) | a cell -> position index | the links (a per-cell array or a hash table), else the links and the path cells' words together (packed keys) |
-//! | polish: the local search ([`crate::refine`]) | two slices of [`super::run::REFINE_WORDS`] | the links and the route's words, the links and the tabu set, the tabu set and the route's words, the tabu set halved, the links halved |
-//! | polish: the local search's memo ([`crate::refine::Memo`]) | [`MEMO_RECORDS`] records | the front of the pheromone increments (the smoothing's ring later, the route's stash at the far end) |
-//! | polish: the smoothing ([`crate::smoothing`]) | `n` links for its shortest-path rule (fewer: the greedy rule) | the links, else the tabu set (free after the last ant and the local search) |
+//! | colony: tightening ([`crate::colony::tighten`]) | a cell -> position index | the links (a per-cell array or a hash table), else the links and the path cells' words together (packed keys) |
+//! | polish: the local search ([`crate::polish::refine`]) | two slices of [`super::run::REFINE_WORDS`] | the links and the route's words, the links and the tabu set, the tabu set and the route's words, the tabu set halved, the links halved |
+//! | polish: the local search's memo ([`crate::polish::refine::Memo`]) | [`MEMO_RECORDS`] records | the front of the pheromone increments (the smoothing's ring later, the route's stash at the far end) |
+//! | polish: the smoothing ([`crate::polish::smoothing`]) | `n` links for its shortest-path rule (fewer: the greedy rule) | the links, else the tabu set (free after the last ant and the local search) |
 //! | a reused answer's repair ([`super::repair`]): the detour | two slices, as many words as it can get (its box is sized by what blocks the answer, up to what the slices hold; no memo) | the pair of the links, the route's words and the tabu set, or one of them halved, whose shorter slice is longest (the first such in that order on a tie) |
 //! | a reused answer's repair: the smoothing | `n` links, as in the polish | as in the polish |
 //!
@@ -34,9 +34,9 @@
 //! and the route's words are scratch once the colony is done ([`super::Memory`] keeps nothing of
 //! them, or stashes what it keeps in the pheromone increments first).
 
-use crate::grid::{Dir, Point};
 #[cfg(doc)]
-use crate::route;
+use crate::colony::route;
+use crate::map::grid::{Dir, Point};
 
 pub(super) use super::workspace::Guide;
 use super::workspace::Workspace;
@@ -44,7 +44,7 @@ use super::workspace::Workspace;
 /// Two slices of scratch words.
 type Pair<'g> = (&'g mut [u32], &'g mut [u32]);
 
-/// Windows the local search's memo remembers ([`crate::refine::Memo`]): more than a pass
+/// Windows the local search's memo remembers ([`crate::polish::refine::Memo`]): more than a pass
 /// searches on the large maps' longest paths (at most 23 on `maze-128-128-2`'s 1,380 cells).
 pub(super) const MEMO_RECORDS: usize = 32;
 
@@ -54,7 +54,7 @@ pub(super) const MEMO_RECORDS: usize = 32;
 pub(super) fn memo(delta: &mut [[f32; 4]], tail: usize) -> &mut [u32] {
     let words: &mut [u32] =
         bytemuck::try_cast_slice_mut(delta.as_flattened_mut()).unwrap_or_default();
-    let want = crate::refine::memo_words(MEMO_RECORDS);
+    let want = crate::polish::refine::memo_words(MEMO_RECORDS);
     if words.len() >= want.saturating_add(tail) {
         words.get_mut(..want).unwrap_or_default()
     } else {
@@ -136,7 +136,7 @@ pub(super) struct Colony<'w> {
     pub(super) moves: &'w [u8],
     /// The ant's path, the iteration's best and worst (empty: walked again), the run's best.
     pub(super) tours: [&'w mut [Dir]; 4],
-    /// Tightening's index ([`crate::tighten::tighten`]): the path cells, then the links.
+    /// Tightening's index ([`crate::colony::tighten::tighten`]): the path cells, then the links.
     pub(super) index: (&'w mut [Point], &'w mut [u32]),
     /// The coarse route the ants read.
     pub(super) guide: &'w Guide<'w>,
@@ -265,7 +265,7 @@ fn two<'x>(
 
 /// The local search's scratch after the last ant, two slices of `words` words (the table
 /// above), else the tabu set halved when each half holds at least `fewest` words (a smaller
-/// window, [`crate::refine::Scratch::side`]); `None`: not enough.
+/// window, [`crate::polish::refine::Scratch::side`]); `None`: not enough.
 pub(super) fn refine<'x>(
     links: &'x mut [u32],
     guide: &'x mut [u32],

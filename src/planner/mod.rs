@@ -55,7 +55,7 @@ pub(crate) use workspace::OwnedBuffers;
 pub use workspace::{Buffers, Storage, Workspace};
 
 use crate::error::Error;
-use crate::grid::{Grid, Point};
+use crate::map::grid::{Grid, Point};
 
 /// Plan a path: [`Run::new`], [`Run::poll`] until done, [`Run::finish`].
 pub fn plan<'a>(

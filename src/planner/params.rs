@@ -1,11 +1,11 @@
 //! The planner's parameters: which variant runs ([`Algorithm`]) and every tunable ([`Params`]),
 //! with their valid ranges ([`Params::validate`]).
 
-use crate::ant::DeadEnd;
+use crate::colony::ant::DeadEnd;
+use crate::colony::heuristic::Attraction;
 use crate::error::{Error, Param};
-use crate::heuristic::Attraction;
 use crate::named::named;
-use crate::smoothing::SmoothingKind;
+use crate::polish::smoothing::SmoothingKind;
 
 /// The four variants the paper compares.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
@@ -100,15 +100,15 @@ pub struct Params {
     pub dead_end: DeadEnd,
     /// How OHACA smooths the result (the other variants never smooth).
     pub smoothing: SmoothingKind,
-    /// Straighten each ant's path before the pheromone update ([`crate::tighten::tighten`]); not in
+    /// Straighten each ant's path before the pheromone update ([`crate::colony::tighten::tighten`]); not in
     /// the paper, off for faithful comparisons.
     pub tighten: bool,
-    /// Prune the cells no shortest path needs before the ants run ([`crate::prune`]); not in the
+    /// Prune the cells no shortest path needs before the ants run ([`crate::map::prune`]); not in the
     /// paper, off for faithful comparisons.
     pub prune: bool,
     /// OHACA replaces each piece of the best raw path by the exact shortest path inside a window
-    /// around it before smoothing ([`crate::refine`]; on maps of at most
-    /// [`crate::pheromone::BLOCKS`] cells the window is the whole map, so the raw path is the
+    /// around it before smoothing ([`crate::polish::refine`]; on maps of at most
+    /// [`crate::colony::pheromone::BLOCKS`] cells the window is the whole map, so the raw path is the
     /// optimum); not in the paper, off for faithful comparisons. A workspace that cannot lend the
     /// scratch keeps the colony's path.
     pub refine: bool,

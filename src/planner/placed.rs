@@ -9,8 +9,8 @@
 //! addresses and checked against the buffers when read (a workspace carved differently gives
 //! `None` or other bytes, never a fault; the firmware carves the same map size each time).
 
-use crate::dir::Dir;
-use crate::grid::Point;
+use crate::map::dir::Dir;
+use crate::map::grid::Point;
 
 use super::{Plan, Workspace};
 
@@ -71,7 +71,7 @@ impl Plan<'_> {
 
 #[cfg(test)]
 mod tests {
-    use crate::grid::Grid;
+    use crate::map::grid::Grid;
     use crate::planner::{plan, Params, Storage};
     use crate::Point;
 

@@ -1,7 +1,7 @@
 //! The result of a run: the path ([`Plan`], its cells as a [`RawPath`]) and the convergence curve
 //! ([`CurvePoint`]).
 
-use crate::grid::{neighbour, Dir, Point};
+use crate::map::grid::{neighbour, Dir, Point};
 
 use super::params::Params;
 
@@ -18,7 +18,7 @@ pub struct CurvePoint {
     /// Ants that reached the goal in this iteration (all of them unless they die at dead ends).
     pub arrived: u16,
     /// Ants that walked in this iteration: all of them, unless the quorum ended it early
-    /// ([`crate::quorum`]).
+    /// ([`crate::colony::quorum`]).
     pub walked: u16,
 }
 
@@ -87,7 +87,7 @@ pub struct Plan<'a> {
     pub best_iteration: u16,
     /// Ant moves made, forward and backtracking, over the whole run.
     pub moves: u64,
-    /// Cells pruned before the ants ran ([`crate::prune`]).
+    /// Cells pruned before the ants ran ([`crate::map::prune`]).
     pub pruned: u32,
     /// Where the path comes from: a cold run, a warm one ([`super::Run::warm`]), or the rest of
     /// the previous answer ([`super::reuse`]).
@@ -160,7 +160,7 @@ pub struct RawPath<'a> {
 
 impl<'a> RawPath<'a> {
     /// The cells of the path that starts at `start` and follows `dirs` (directions as in
-    /// [`crate::grid::DX`]).
+    /// [`crate::map::grid::DX`]).
     pub fn new(start: Point, dirs: &'a [Dir]) -> Self {
         RawPath {
             next: Some(start),

@@ -44,8 +44,8 @@
 use core::fmt;
 
 use crate::geometry::{bend, distance, segment_clear, steps_length};
-use crate::grid::{is_diagonal, neighbour, Dir, Grid, Point};
-use crate::smoothing::SmoothingKind;
+use crate::map::grid::{is_diagonal, neighbour, Dir, Grid, Point};
+use crate::polish::smoothing::SmoothingKind;
 
 use super::params::{Algorithm, Params};
 use super::plan::{Origin, Plan};

@@ -2,7 +2,7 @@
 
 use super::*;
 use crate::error::{Endpoint, Param};
-use crate::grid::{Dir, Point};
+use crate::map::grid::{Dir, Point};
 use alloc::boxed::Box;
 use alloc::vec::Vec;
 
@@ -216,8 +216,8 @@ fn start_equals_goal() {
 #[test]
 fn storage_size_matches_the_formula() {
     assert_eq!(core::mem::size_of::<CurvePoint>(), 16);
-    type Walking = Storage<{ crate::bitmap::words(65536) }, 1024, 4096, 1024>;
-    type Kept = Storage<{ crate::bitmap::words(65536) }, 1024, 4096, 1024, 128, 1024>;
+    type Walking = Storage<{ crate::map::bitmap::words(65536) }, 1024, 4096, 1024>;
+    type Kept = Storage<{ crate::map::bitmap::words(65536) }, 1024, 4096, 1024, 128, 1024>;
     // Pheromone and increments, two bit sets, the move table, two tours (the iteration's best
     // and worst are walked again), points, links, curve, the coarse route.
     let want =
@@ -237,7 +237,7 @@ fn storage_size_matches_the_formula() {
     // The STM32F411's and the default QEMU board's storage (`firmware::buffers`: paths of 2,047
     // steps, no curve, the iteration's best and worst walked again) is the boot log's 95,232
     // bytes; its 4,096 links are exactly what tightening needs for 2,047 steps.
-    type F411 = Storage<{ crate::bitmap::words(65536) }, 2048, 4096, 1024, 0, 0>;
+    type F411 = Storage<{ crate::map::bitmap::words(65536) }, 2048, 4096, 1024, 0, 0>;
     assert_eq!(
         F411::BYTES,
         2 * 16 * 1024 + 2 * 8192 + 1024 + 2 * 2048 + 4 * 2048 + 4 * 4096 + 4 * 4096
@@ -334,7 +334,7 @@ fn a_warm_start_keeps_the_pheromone_away_from_changes_and_resets_it_near_them() 
     let (mut bits, w, h) = grid(&rows);
     let goal = Point::new(31, 31);
     let p = Params::default();
-    let mut st: Storage<{ crate::bitmap::words(1024) }, 1024, 2048, 1024> = Storage::new();
+    let mut st: Storage<{ crate::map::bitmap::words(1024) }, 1024, 2048, 1024> = Storage::new();
     let mut memory = Memory::new();
     {
         let g = Grid::new(w, h, &bits).unwrap();
@@ -481,10 +481,10 @@ fn a_warm_start_after_a_change_that_cuts_the_goal_off_ends_with_no_path() {
 
 /// Storage for the large test map: 64 x 48 = 3,072 cells (more than `BLOCKS`: the coarse route
 /// and the local search apply), the device's 4,096 links.
-type SLarge = Storage<{ crate::bitmap::words(3072) }, 3073, 4096>;
+type SLarge = Storage<{ crate::map::bitmap::words(3072) }, 3073, 4096>;
 /// The same with 3,584 links: enough for the route (3,072 blocks of one cell), too few to lend
 /// the local search its scratch.
-type SLargeFewLinks = Storage<{ crate::bitmap::words(3072) }, 3073, 3584>;
+type SLargeFewLinks = Storage<{ crate::map::bitmap::words(3072) }, 3073, 3584>;
 
 /// A 64 x 48 map: rows of wall segments with random gaps, and random single obstacles, so the
 /// colony's raw paths wander. Start (0, 0) and goal (63, 47) are free.
@@ -602,11 +602,12 @@ fn small_maps_keep_the_colonys_path() {
 
 /// Whether a recorded iteration settled its corridor, replayed from its numbers independently
 /// of `settled`: all `ants` walked and arrived, or the quorum's first ants did
-/// (`crate::quorum`), with a mean within `REFINE_GAIN` of the iteration's best.
+/// (`crate::colony::quorum`), with a mean within `REFINE_GAIN` of the iteration's best.
 fn agrees(c: &CurvePoint, ants: u16) -> bool {
     let all = c.walked == ants && c.arrived == ants;
-    let quorum =
-        c.walked == crate::quorum::QUORUM && crate::quorum::QUORUM < ants && c.arrived == c.walked;
+    let quorum = c.walked == crate::colony::quorum::QUORUM
+        && crate::colony::quorum::QUORUM < ants
+        && c.arrived == c.walked;
     (all || quorum) && c.mean * REFINE_GAIN <= c.best
 }
 
@@ -939,7 +940,7 @@ fn fingerprint(
 
 #[test]
 fn walking_the_iterations_best_and_worst_again_plans_what_keeping_them_does() {
-    use crate::ant::DeadEnd;
+    use crate::colony::ant::DeadEnd;
     use crate::heap::HeapStorage;
     // Every algorithm (with and without the wolves rule), both dead-end rules, with and without
     // tightening, short and full runs, on maps with and without blocks and the coarse route,

@@ -10,7 +10,7 @@
 //! | pheromone, away from the changes | kept, clamped into the current `[tau_min, tau_max]` |
 //! | pheromone within [`REPAIR_RADIUS`] cells of a change | set back to `tau0`, as in a cold start |
 //! | pheromone on edges into new obstacles | kept: ants are never offered a blocked move, so it is inert |
-//! | pruned cells, the coarse route | repaired around the changes and the two starts when the last run kept them ([`super::Run::keep`]): [`crate::prune::repair`], [`crate::route::repair`], bit for bit what a rebuild gives; else rebuilt |
+//! | pruned cells, the coarse route | repaired around the changes and the two starts when the last run kept them ([`super::Run::keep`]): [`crate::map::prune::repair`], [`crate::colony::route::repair`], bit for bit what a rebuild gives; else rebuilt |
 //! | reachability | not checked up front with backtracking ants: the first ant proves a cut-off goal |
 //! | the early stop | after [`Params::warm_patience`] stale iterations instead of [`Params::patience`] |
 //!
@@ -32,10 +32,10 @@
 //! is [`Memory::cannot_shorten`], beside the rectangles it reads. Host and device use the same
 //! code, so a sequence of warm plans gives the same paths on both.
 
+use crate::colony::heuristic::octile;
+use crate::colony::pheromone::Table;
 use crate::geometry::sqrt;
-use crate::grid::Point;
-use crate::heuristic::octile;
-use crate::pheromone::Table;
+use crate::map::grid::Point;
 
 /// Pheromone within this many cells (Chebyshev distance) of a changed cell is reset to `tau0` on
 /// a warm start. Chosen by measurement (`BENCHMARKS.md`, replanning): a wall across the path needs
@@ -248,11 +248,11 @@ pub(super) struct Answer {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub(super) struct Kept {
-    /// The start the marks were pruned for ([`crate::prune::prune`], with the goal of the
+    /// The start the marks were pruned for ([`crate::map::prune::prune`], with the goal of the
     /// memory's owner, on the map as it was before [`Memory::changes`]).
     pub(super) start: Point,
     /// True if the route's links are stashed in the pheromone increments
-    /// ([`crate::route::stash`], their last [`crate::route::stash_len`] slots).
+    /// ([`crate::colony::route::stash`], their last [`crate::colony::route::stash_len`] slots).
     pub(super) route: bool,
 }
 
@@ -403,7 +403,7 @@ pub(super) fn repair(
 ) -> u32 {
     tau.clamp(tau_min, tau_max);
     let Some(area) = changes else { return 0 };
-    // An edge belongs to the entry of its west/north end ([`crate::pheromone`]), so growing the
+    // An edge belongs to the entry of its west/north end ([`crate::colony::pheromone`]), so growing the
     // area by one more cell reaches the entries of edges that enter it from the west or north.
     let area = area.grown(REPAIR_RADIUS.saturating_add(1));
     tau.fill_area(area.min, area.max, tau0)
@@ -412,7 +412,7 @@ pub(super) fn repair(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::pheromone::Blocks;
+    use crate::colony::pheromone::Blocks;
 
     #[test]
     fn box_distances_are_lower_bounds() {

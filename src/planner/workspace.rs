@@ -11,9 +11,9 @@
 //! | 2 tours | `steps` each | 1 | the ant's path, the best so far |
 //! | 2 more tours, or none | `steps` each | 1 | the iteration's best and worst paths |
 //! | `points` | `steps + 1` | 4 | the best path as cells, tightening scratch |
-//! | `links` | `cells`, or at least tightening's table ([`crate::tighten::hash_words`]`(steps + 1)`: `2 (steps + 1)` half-word slots at a load of 1/2, down to `3 (steps + 1) / 2` at 2/3; fewer leave walks untightened), `steps + 1` (the smoothing's shortest-path rule; fewer: its greedy rule) and [`GUIDE_BLOCKS`] | 4 | path positions (tightening), flood-fill ring, pruning stack, route heap, smoothing links |
+//! | `links` | `cells`, or at least tightening's table ([`crate::colony::tighten::hash_words`]`(steps + 1)`: `2 (steps + 1)` half-word slots at a load of 1/2, down to `3 (steps + 1) / 2` at 2/3; fewer leave walks untightened), `steps + 1` (the smoothing's shortest-path rule; fewer: its greedy rule) and [`GUIDE_BLOCKS`] | 4 | path positions (tightening), flood-fill ring, pruning stack, route heap, smoothing links |
 //! | `curve` | iterations recorded | 16 | the convergence curve |
-//! | `guide` | [`GUIDE_BLOCKS`] on maps of more than [`BLOCKS`] cells, else none; an eighth of that packed ([`Workspace::with_packed_route`]) | 4 | the coarse route ([`crate::route`]) |
+//! | `guide` | [`GUIDE_BLOCKS`] on maps of more than [`BLOCKS`] cells, else none; an eighth of that packed ([`Workspace::with_packed_route`]) | 4 | the coarse route ([`crate::colony::route`]) |
 //!
 //! A buffer idle in a phase lends itself to another role there (the links above, the tabu set to
 //! the route's heap and the local search, the path cells to tightening's keyed table); each phase
@@ -35,11 +35,11 @@
 //! ants) and saves two bytes a path step: on the STM32F411 that is what paths of 2,047 steps fit in
 //! (its arena's full layout; the compact one keeps 4,095, [`super::arena`]).
 
-use crate::bitmap::words;
+use crate::colony::pheromone::{Blocks, BLOCKS};
+use crate::colony::route::{Route, GUIDE_BLOCKS};
 use crate::error::Error;
-use crate::grid::{Dir, Point};
-use crate::pheromone::{Blocks, BLOCKS};
-use crate::route::{Route, GUIDE_BLOCKS};
+use crate::map::bitmap::words;
+use crate::map::grid::{Dir, Point};
 
 use super::plan::CurvePoint;
 
@@ -86,7 +86,7 @@ pub struct Buffers<'a> {
     pub links: &'a mut [u32],
     /// Convergence curve: one entry per iteration recorded.
     pub curve: &'a mut [CurvePoint],
-    /// The coarse route on large maps ([`crate::route`]): [`GUIDE_BLOCKS`] entries (none needed on
+    /// The coarse route on large maps ([`crate::colony::route`]): [`GUIDE_BLOCKS`] entries (none needed on
     /// maps of at most [`BLOCKS`] cells).
     pub guide: &'a mut [u32],
 }
@@ -143,7 +143,7 @@ impl<'a> Workspace<'a> {
     }
 
     /// The same workspace keeping its coarse route packed in `guide`, four bits a block
-    /// ([`crate::route::pack`]): [`GUIDE_BLOCKS`]` / 8` words for the finest route, its words
+    /// ([`crate::colony::route::pack`]): [`GUIDE_BLOCKS`]` / 8` words for the finest route, its words
     /// and heap built in the tabu set or the links before the first ant (`planner::lend`).
     pub fn with_packed_route(self) -> Self {
         let guide = Guide::Packed(self.guide.scratch());
@@ -260,7 +260,7 @@ impl<'a> Workspace<'a> {
     }
 
     /// The pheromone of the last run (`[E, SE, S, SW]` per entry, row-major; see
-    /// [`crate::pheromone::Blocks`] for how a map's cells map onto entries).
+    /// [`crate::colony::pheromone::Blocks`] for how a map's cells map onto entries).
     pub fn pheromone(&self) -> &[[f32; 4]] {
         self.tau
     }

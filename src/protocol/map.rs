@@ -7,7 +7,7 @@
 //! Guarantees: nothing here panics or allocates, whatever a peer sends; every check runs before
 //! the map buffer is touched, so a refused chunk header or cell update changes nothing; an upload
 //! is complete only when exactly `width * height` cells were written (a partial or broken one is
-//! never reported complete). The map buffer has [`crate::grid`]'s layout (row-major, LSB first,
+//! never reported complete). The map buffer has [`crate::map::grid`]'s layout (row-major, LSB first,
 //! `1` = blocked).
 //!
 //! Run-length code: the map's cells in row-major order as alternating runs, free first, each run
@@ -27,7 +27,7 @@
 //! ```
 
 use super::{ErrorCode, ErrorReply, Waypoints, MAX_CHUNK};
-use crate::grid::Point;
+use crate::map::grid::Point;
 
 /// Most cells in one [`super::Request::SetCells`]: 4 bytes each, so the largest such request
 /// (id `u32::MAX`) stays within [`super::MAX_REQUEST`].

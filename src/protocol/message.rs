@@ -4,7 +4,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::grid::Point;
+use crate::map::grid::Point;
 use crate::planner::{Origin, Params};
 
 use super::wire::PointDef;
@@ -21,7 +21,7 @@ pub enum Request<'a> {
     /// `0`: who are you? Answered with [`Reply::Hello`].
     Hello,
     /// `1`: one chunk of a map upload, answered with [`Reply::Ack`]. The map is `width x
-    /// height` cells, bit-packed exactly as [`crate::grid`] stores it (row-major, LSB first,
+    /// height` cells, bit-packed exactly as [`crate::map::grid`] stores it (row-major, LSB first,
     /// `1` = blocked), `total_len = ceil(width * height / 8)` bytes, sent as chunks of at most
     /// [`MAX_CHUNK`] bytes. A chunk with `offset` 0 starts an upload; every further chunk must
     /// have the same `width`, `height` and `total_len`, and `offset <=` the bytes received so far
@@ -207,7 +207,7 @@ pub struct PathReply<'a> {
     #[serde(borrow)]
     pub waypoints: Waypoints<'a>,
     /// The raw path from the start as one direction per step (`0..8` = E, SE, S, SW, W, NW, N,
-    /// NE; see [`crate::grid::DX`]). At most [`MAX_DIRECTIONS`].
+    /// NE; see [`crate::map::grid::DX`]). At most [`MAX_DIRECTIONS`].
     pub directions: &'a [u8],
 }
 

@@ -180,7 +180,7 @@ pub fn decode_path_body(body: &[u8]) -> Option<PathReply<'_>> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::grid::Point;
+    use crate::map::grid::Point;
     use crate::planner::Origin;
 
     fn path<'a>(points: &'a [Point], dirs: &'a [u8]) -> PathReply<'a> {

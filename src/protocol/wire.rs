@@ -8,7 +8,7 @@ use serde::de::{Deserializer, Error as _};
 use serde::ser::{SerializeSeq, Serializer};
 use serde::{Deserialize, Serialize};
 
-use crate::grid::Point;
+use crate::map::grid::Point;
 
 /// [`Point`]: `x`, `y` as varints.
 #[derive(Serialize, Deserialize)]

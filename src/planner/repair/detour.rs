@@ -1,8 +1,8 @@
 //! The detour's box, sized by what blocks the answer (the module docs of [`super`], step 3).
 
 use crate::geometry::steps_length;
-use crate::grid::{is_diagonal, neighbour, Dir, Grid, Point};
-use crate::refine::{self, Scratch, MAX_SIDE, MIN_SIDE};
+use crate::map::grid::{is_diagonal, neighbour, Dir, Grid, Point};
+use crate::polish::refine::{self, Scratch, MAX_SIDE, MIN_SIDE};
 
 use super::{GiveUp, BOX_MARGIN, MARGIN};
 

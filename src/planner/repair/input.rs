@@ -2,7 +2,7 @@
 //! input around the detour (the module docs of [`super`], steps 1 and 4).
 
 use crate::geometry::segment_clear;
-use crate::grid::{neighbour, Dir, Grid, Point};
+use crate::map::grid::{neighbour, Dir, Grid, Point};
 
 use super::{GiveUp, PLACE_RADIUS};
 

@@ -16,7 +16,7 @@
 //! 2. **The anchors**: [`MARGIN`] raw cells before the first blocked move and after the last,
 //!    clamped to the robot's cell and the goal. A blocked segment whose raw cells are all free
 //!    needs no anchors: the raw path stays, and only its waypoints are smoothed again.
-//! 3. **The detour**: exact A* between the anchors ([`crate::refine::detour`]) in a box sized by
+//! 3. **The detour**: exact A* between the anchors ([`crate::polish::refine::detour`]) in a box sized by
 //!    the change, not fixed: the bounding box of the raw cells between the anchors (so the
 //!    blocked stretch's extent and the anchors' margins), grown by [`BOX_MARGIN`] cells on every
 //!    side and clipped to the map. When no path lies in the box, or the one found runs along a
@@ -59,11 +59,11 @@
 use core::fmt;
 
 use crate::geometry::{distance, segment_clear, steps_length};
-use crate::grid::{direction, is_diagonal, neighbour, Dir, Grid, Point};
-use crate::refine::Scratch;
+use crate::map::grid::{direction, is_diagonal, neighbour, Dir, Grid, Point};
+use crate::polish::refine::Scratch;
 #[cfg(doc)]
-use crate::refine::{MAX_SIDE, MIN_SIDE};
-use crate::smoothing::{Smoother, SmoothingKind};
+use crate::polish::refine::{MAX_SIDE, MIN_SIDE};
+use crate::polish::smoothing::{Smoother, SmoothingKind};
 
 use super::lend::Polishing;
 use super::params::{Algorithm, Params};
@@ -87,8 +87,8 @@ pub const MARGIN: usize = 12;
 pub const BOX_MARGIN: u16 = 6;
 
 /// How far (Chebyshev, in cells) a waypoint may lie from the raw cell it is placed on: the taut
-/// pull ([`crate::taut`]) moves a waypoint off the raw path by at most a cell a pass.
-pub const PLACE_RADIUS: u16 = crate::taut::MAX_PASSES as u16;
+/// pull ([`crate::polish::taut`]) moves a waypoint off the raw path by at most a cell a pass.
+pub const PLACE_RADIUS: u16 = crate::polish::taut::MAX_PASSES as u16;
 
 /// Why a repair gave up (the replan then goes to the colony, [`super::Fallback::Repair`]). Small,
 /// `Copy`, `Display`; `defmt::Format` with the `defmt` feature.

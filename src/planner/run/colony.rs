@@ -3,13 +3,13 @@
 //! pheromone evaporates and takes the increments, and the run records its best path, the
 //! convergence curve and whether to stop early.
 
-use crate::ant::{Ant, DeadEnd, Lost, Trail, Walk};
+use crate::colony::ant::{Ant, DeadEnd, Lost, Trail, Walk};
+use crate::colony::pheromone::Table;
+use crate::colony::tighten::tighten;
+use crate::colony::update::{deposit, wolves_amounts};
 use crate::geometry::steps_length;
-use crate::grid::{Dir, Filling, Moves, Point, Reach};
-use crate::pheromone::Table;
+use crate::map::grid::{Dir, Filling, Moves, Point, Reach};
 use crate::rng::Xoshiro128pp;
-use crate::tighten::tighten;
-use crate::update::{deposit, wolves_amounts};
 
 use crate::planner::lend::Colony;
 use crate::planner::plan::CurvePoint;
@@ -52,7 +52,7 @@ pub const REFINE_GAIN: f32 = 0.99;
 /// Whether an iteration of a run that refines settled its corridor: every ant of it arrived and
 /// their mean length is within [`REFINE_GAIN`] of the iteration's best (`mean * REFINE_GAIN <=
 /// best`, on the iteration's [`CurvePoint`], so the plan's curve replays it). Such a run stops
-/// there, whatever its patience, on a map of more than [`crate::pheromone::BLOCKS`] cells (the
+/// there, whatever its patience, on a map of more than [`crate::colony::pheromone::BLOCKS`] cells (the
 /// pheromone in blocks, the local search in windows). Not in the paper, and off without the local
 /// search (the paper preset).
 ///
@@ -68,7 +68,7 @@ pub const REFINE_GAIN: f32 = 0.99;
 /// maps is 1.0009 against 1.0008 (1.0009 both with seeds 1-4).
 pub fn settled(point: &CurvePoint, ants: u16) -> bool {
     point.walked == ants && point.arrived == ants && point.mean * REFINE_GAIN <= point.best
-        || crate::quorum::ended(point, ants)
+        || crate::colony::quorum::ended(point, ants)
 }
 
 /// The best path of an iteration or of the run, as step counts (exact length comparison).
@@ -118,7 +118,7 @@ pub(super) struct Iteration {
     arrived: u32,
     /// An ant of this iteration proved the goal unreachable (the run ends with `NoPath`).
     no_path: bool,
-    /// Ants walked (all of them unless the quorum ended the iteration, [`crate::quorum`]).
+    /// Ants walked (all of them unless the quorum ended the iteration, [`crate::colony::quorum`]).
     walked: u16,
 }
 
@@ -451,7 +451,7 @@ impl Run<'_, '_> {
                     }
                     if quorum {
                         let b = it.best.map_or(f32::INFINITY, |(b, _)| b.length());
-                        if crate::quorum::reached(w.ant, p.ants, it.arrived, it.sum, b) {
+                        if crate::colony::quorum::reached(w.ant, p.ants, it.arrived, it.sum, b) {
                             w.close = Close::Best;
                         }
                     }

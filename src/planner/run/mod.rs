@@ -37,14 +37,14 @@ mod setup;
 pub use colony::{settled, REFINE_GAIN};
 pub(crate) use polish::{REFINE_WORDS, SHORT_REFINE_WORDS};
 
+use crate::colony::heuristic::Heuristic;
+use crate::colony::pheromone::{Blocks, Table};
+use crate::colony::route;
 use crate::error::{Endpoint, Error};
 use crate::geometry::{polyline_length, turns};
-use crate::grid::{Dir, Grid, Moves, Point};
-use crate::heuristic::Heuristic;
-use crate::pheromone::{Blocks, Table};
+use crate::map::grid::{Dir, Grid, Moves, Point};
+use crate::polish::smoothing::SmoothingKind;
 use crate::rng::Xoshiro128pp;
-use crate::route;
-use crate::smoothing::SmoothingKind;
 
 use super::lend::Guide;
 use super::params::{Algorithm, Params};

@@ -3,10 +3,10 @@
 //! smoothing a stretch of raw cells at a time, then the corridor search: each a piece of
 //! [`Run::poll`].
 
-use crate::grid::{direction, is_diagonal};
-use crate::refine::{self, Budget, Memo, Refiner, Scratch};
-use crate::route::{self, GUIDE_BLOCKS};
-use crate::smoothing::{Smoother, SmoothingKind, LOOKBACK};
+use crate::colony::route::{self, GUIDE_BLOCKS};
+use crate::map::grid::{direction, is_diagonal};
+use crate::polish::refine::{self, Budget, Memo, Refiner, Scratch};
+use crate::polish::smoothing::{Smoother, SmoothingKind, LOOKBACK};
 
 use crate::planner::params::Algorithm;
 #[cfg(doc)]
@@ -32,7 +32,7 @@ pub(crate) const REFINE_WORDS: usize = Scratch::words(REFINE_SIDE);
 pub const SHORT_REFINE_SIDE: usize = 48;
 pub(crate) const SHORT_REFINE_WORDS: usize = Scratch::words(SHORT_REFINE_SIDE);
 const _: () = assert!(REFINE_WORDS <= GUIDE_BLOCKS);
-/// Window side of the local search on small maps (at most [`crate::pheromone::BLOCKS`] = 1,024
+/// Window side of the local search on small maps (at most [`crate::colony::pheromone::BLOCKS`] = 1,024
 /// cells, which have no coarse route to lend): 32, a window of 1,024 cells, as large as the map.
 /// Its two slices of [`Scratch::words`]`(32)` = 1,536 words both come from the links, so a
 /// workspace needs 3,072 links for it (the device's 4,096 and `HeapStorage`'s at least
@@ -45,13 +45,13 @@ pub(super) const SMALL_REFINE_WORDS: usize = Scratch::words(SMALL_REFINE_SIDE);
 /// Sydney, 0.5 M on NewYork; 8,192 cells a piece were 2.6 M).
 const REFINE_SLICE: u64 = 1;
 /// Raw cells of the smoothing DP in one piece of [`Run::poll`] (each tests at most
-/// [`crate::smoothing::LOOKBACK`] segments, or the bounded scan's fewer; 48 were up to 2.8 M
+/// [`crate::polish::smoothing::LOOKBACK`] segments, or the bounded scan's fewer; 48 were up to 2.8 M
 /// instructions on maze512's 4,000-cell path, 4 keep the DP's pieces under 0.4 M).
 const SMOOTH_SLICE: usize = 4;
 
 /// Words at the end of the pheromone increments that the route's stash holds (the local
 /// search's memo stays before them).
-fn stash_tail(stashed: bool, blocks: crate::pheromone::Blocks) -> usize {
+fn stash_tail(stashed: bool, blocks: crate::colony::pheromone::Blocks) -> usize {
     if stashed {
         route::stash_len(blocks)
     } else {
@@ -92,7 +92,7 @@ impl Run<'_, '_> {
         } else {
             SmoothingKind::None
         };
-        // The exact corridor search of small maps ([`crate::corridor`]): OHACA's default smoothing
+        // The exact corridor search of small maps ([`crate::polish::corridor`]): OHACA's default smoothing
         // on maps whose pheromone increments lend one entry a cell.
         let corridor = kind == SmoothingKind::Shortest && self.blocks.shift() == 0;
         self.phase = match piece {
@@ -199,11 +199,11 @@ impl Run<'_, '_> {
                     None => Phase::Polish(Polish::Tail(sm)),
                     Some(k) => {
                         let waypoints = if corridor {
-                            crate::corridor::shortest(
+                            crate::polish::corridor::shortest(
                                 grid,
                                 ws.points,
                                 k,
-                                crate::corridor::RADIUS,
+                                crate::polish::corridor::RADIUS,
                                 ws.delta,
                                 ws.idle.links(),
                             )

@@ -1,13 +1,13 @@
 //! The setup of a run before its first iteration, one piece at a time: the flood fill (is the
 //! goal reachable at all?), dead-end pruning, the coarse route of a large map. The fill and the
 //! pruning read the map (the default preset skips the fill; only the full layout prunes), the
-//! route only the blocks its search closes ([`crate::route::search`]); each is a piece of
+//! route only the blocks its search closes ([`crate::colony::route::search`]); each is a piece of
 //! [`Run::poll`].
 
-use crate::ant::DeadEnd;
-use crate::grid::{Moves, Reach};
-use crate::prune::{self, prune};
-use crate::route;
+use crate::colony::ant::DeadEnd;
+use crate::colony::route;
+use crate::map::grid::{Moves, Reach};
+use crate::map::prune::{self, prune};
 
 use super::{Area, End, Phase, Run, Setup};
 
@@ -104,7 +104,7 @@ impl Run<'_, '_> {
                         ),
                     }
                 } else {
-                    crate::bitmap::clear(ws.dead, grid.cells());
+                    crate::map::bitmap::clear(ws.dead, grid.cells());
                     0
                 };
                 self.phase = Phase::Setup(Setup::Route(None));
@@ -145,12 +145,13 @@ impl Run<'_, '_> {
                     Some(at) => at,
                     // The last run's links, forgotten where the map or the marks changed.
                     None if relink && !packed => {
-                        match route::begin_repair(&moves, blocks, ends, &ws.dead, words, heap, area) {
+                        match route::begin_repair(&moves, blocks, ends, ws.dead, words, heap, area)
+                        {
                             Ok(at) => at,
                             Err(e) => return self.routed(Err(e)),
                         }
                     }
-                    None => match route::begin_build(&moves, blocks, ends, &ws.dead, words, heap) {
+                    None => match route::begin_build(&moves, blocks, ends, ws.dead, words, heap) {
                         Ok(at) => at,
                         Err(e) => return self.routed(Err(e)),
                     },

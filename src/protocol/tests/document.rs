@@ -150,7 +150,7 @@ fn protocol_doc_example_is_exact() {
 
 #[test]
 fn protocol_doc_example_is_what_the_planner_returns() {
-    use crate::grid::Grid;
+    use crate::map::grid::Grid;
     use crate::planner::{reuse, Memory, Run, Storage};
     let g = Grid::new(4, 3, &MAP).unwrap();
     // The device's links (4,096), so the local search runs as on the device.

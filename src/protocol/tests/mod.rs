@@ -7,12 +7,12 @@
 
 use super::frame::{cobs_decode_in_place, cobs_encode_in_place};
 use super::*;
-use crate::ant::DeadEnd;
+use crate::colony::ant::DeadEnd;
 use crate::error::{Error, Param};
-use crate::grid::Point;
+use crate::map::grid::Point;
 use crate::planner::Algorithm;
 use crate::planner::Params;
-use crate::smoothing::SmoothingKind;
+use crate::polish::smoothing::SmoothingKind;
 use serde::Serialize;
 
 mod document;

@@ -21,13 +21,13 @@
 //! planner's pieces, `planner::run`): its state between pieces is a [`Trail`], and the pieces
 //! make the same moves with the same draws as one [`Ant::walk`], bit for bit.
 
-use crate::bitmap;
-use crate::grid::{is_diagonal, neighbour, opposite, Dir, Moves, Point};
-use crate::heuristic::Heuristic;
+use crate::colony::heuristic::Heuristic;
+use crate::colony::pheromone::Table;
+use crate::colony::route::Route;
+use crate::map::bitmap;
+use crate::map::grid::{is_diagonal, neighbour, opposite, Dir, Moves, Point};
 use crate::named::named;
-use crate::pheromone::Table;
 use crate::rng::Xoshiro128pp;
-use crate::route::Route;
 
 /// What an ant does when every neighbour is blocked or already visited.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
@@ -59,7 +59,7 @@ pub struct Walk {
     /// Moves made, counting forward steps and backtracking steps.
     pub moves: u32,
     /// The walk passed next to a cell it had visited before (other than the one it came from),
-    /// so [`crate::tighten::tighten`] may find a shortcut; when false, tightening cannot change the path.
+    /// so [`crate::colony::tighten::tighten`] may find a shortcut; when false, tightening cannot change the path.
     pub may_tighten: bool,
 }
 
@@ -113,10 +113,10 @@ pub struct Ant<'g, 't, 'h> {
     pub alpha: f32,
     /// Dead-end behaviour.
     pub dead_end: DeadEnd,
-    /// Cells no ant enters ([`crate::prune`]); every walk's tabu list starts as this set. Empty:
+    /// Cells no ant enters ([`crate::map::prune`]); every walk's tabu list starts as this set. Empty:
     /// none (a workspace without pruning marks).
     pub dead: &'t [u32],
-    /// Sub-goals of the potential field on large maps ([`crate::route`]); `None`: the goal.
+    /// Sub-goals of the potential field on large maps ([`crate::colony::route`]); `None`: the goal.
     pub route: Option<&'t Route<'t>>,
     /// Most moves (forward and back) the walk may make; one that needs more is abandoned
     /// ([`Lost::Budget`]). `u32::MAX`: no bound, the walk goes on until it arrives or exhausts.
@@ -461,9 +461,9 @@ fn roulette(rng: &mut Xoshiro128pp, w: &[f32], total: f32) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::grid::Grid;
-    use crate::heuristic::Attraction;
-    use crate::pheromone::Blocks;
+    use crate::colony::heuristic::Attraction;
+    use crate::colony::pheromone::Blocks;
+    use crate::map::grid::Grid;
 
     fn setup(rows: &[&str]) -> (Vec<u8>, u16, u16) {
         crate::testutil::bits(rows)

@@ -15,7 +15,7 @@
 //! Values are kept in `[tau_min, tau_max]` (max-min ant system bounds): the wolves rule subtracts
 //! pheromone, and without the floor an edge could go to zero or below and never be tried again.
 
-use crate::grid::{Dir, Point, DX, DY};
+use crate::map::grid::{Dir, Point, DX, DY};
 
 /// Index of the undirected edge `(p, d)` as `(cell, slot)`, or `None` if the neighbour would be
 /// off the map's index range (the caller only asks about allowed moves, so this does not happen).
@@ -26,7 +26,7 @@ pub fn edge(width: u16, p: Point, d: Dir) -> Option<(usize, usize)> {
         return None;
     }
     let q = Point::new(x as u16, y as u16);
-    // At most 65535 * 65535 + 65535 < 2^32: fits the (at least 32-bit) usize, see `crate::grid`.
+    // At most 65535 * 65535 + 65535 < 2^32: fits the (at least 32-bit) usize, see `crate::map::grid`.
     let cell = usize::from(q.y)
         .wrapping_mul(usize::from(width))
         .wrapping_add(usize::from(q.x));
@@ -51,7 +51,7 @@ fn owner(p: Point, d: Dir) -> (i32, i32, u8) {
 
 /// For each direction, the offset from `4 * cell` to the edge's slot in a flattened table: `d`
 /// for the four directions a cell owns, `4 * offset(d) + (d - 4)` for the other four (the edge
-/// is stored with the neighbour). `offsets` are [`crate::grid::Grid::offsets`].
+/// is stored with the neighbour). `offsets` are [`crate::map::grid::Grid::offsets`].
 pub fn slot_offsets(offsets: &[isize; 8]) -> [isize; 8] {
     let mut s = [0isize; 8];
     for (d, (slot, off)) in s.iter_mut().zip(offsets).enumerate() {
@@ -299,7 +299,7 @@ impl<'a> Table<'a> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::grid::opposite;
+    use crate::map::grid::opposite;
 
     #[test]
     fn both_directions_share_one_entry() {

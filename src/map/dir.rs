@@ -1,7 +1,7 @@
 //! The eight moves: direction codes, their offsets, diagonal or straight, and their opposite.
 //!
-//! This is the one place the moves are defined. [`crate::grid`] (which re-exports them) builds the
-//! map's move rules on them, and [`crate::bitmap`] its neighbourhood masks, so neither of those
+//! This is the one place the moves are defined. [`crate::map::grid`] (which re-exports them) builds the
+//! map's move rules on them, and [`crate::map::bitmap`] its neighbourhood masks, so neither of those
 //! modules depends on the other for them. Everything here is `const` and cannot fail.
 
 /// One of the eight moves, `0..8` clockwise from east (with `y` pointing down): E, SE, S, SW, W,

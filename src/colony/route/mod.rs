@@ -30,8 +30,8 @@
 //! links, whether they are known, the next block and the search's key) plus scratch for the heap
 //! (one `u32` per block).
 
-use crate::grid::{Moves, Point, DX, DY};
-use crate::pheromone::Blocks;
+use crate::colony::pheromone::Blocks;
+use crate::map::grid::{Moves, Point, DX, DY};
 
 pub mod links;
 pub mod search;
@@ -470,7 +470,7 @@ fn dist(w: u32) -> u32 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::grid::Grid;
+    use crate::map::grid::Grid;
 
     /// A 64 x 64 map (2 x 2 blocks would be 1024: the route uses single cells up to 4096 cells, so
     /// take 128 x 64 = 8192 cells: 2 x 2 blocks) with a wall between start and goal that has one
@@ -492,7 +492,7 @@ mod tests {
         let blocks = blocks(w, h);
         assert_eq!(blocks.shift(), 1);
         let moves = Moves::new(g, &[]);
-        let dead = vec![0u32; crate::bitmap::words(g.cells())];
+        let dead = vec![0u32; crate::map::bitmap::words(g.cells())];
         let mut words = vec![0u32; GUIDE_BLOCKS];
         let mut heap = vec![0u32; GUIDE_BLOCKS];
         let goal = Point::new(100, 2);
@@ -591,7 +591,7 @@ mod tests {
         let g = Grid::new(128, 64, &[0u8; 1024]).unwrap();
         let blocks = blocks(128, 64);
         let moves = Moves::new(g, &[]);
-        let dead = vec![0u32; crate::bitmap::words(g.cells())];
+        let dead = vec![0u32; crate::map::bitmap::words(g.cells())];
         let (start, goal) = (Point::new(127, 63), Point::new(0, 0));
         let s = blocks.shift();
         let (sx, sy) = (usize::from(start.x >> s), usize::from(start.y >> s));
@@ -648,12 +648,12 @@ mod tests {
             let cells = (w * h) as usize;
             let density = [5u32, 20, 35][round % 3];
             let mut b = vec![0u8; cells.div_ceil(8)];
-            let mut dead = vec![0u32; crate::bitmap::words(cells)];
+            let mut dead = vec![0u32; crate::map::bitmap::words(cells)];
             for i in 0..cells {
                 if rnd() % 100 < density {
                     b[i / 8] |= 1 << (i % 8);
                 } else if rnd() % 100 < 15 {
-                    crate::bitmap::set(&mut dead, i);
+                    crate::map::bitmap::set(&mut dead, i);
                 }
             }
             let blocks = blocks(w as u16, h as u16);
@@ -700,8 +700,8 @@ mod tests {
                         match rnd() % 4 {
                             0 => b[i / 8] |= 1 << (i % 8),
                             1 => b[i / 8] &= !(1 << (i % 8)),
-                            2 => crate::bitmap::set(&mut dead, i),
-                            _ => crate::bitmap::unset(&mut dead, i),
+                            2 => crate::map::bitmap::set(&mut dead, i),
+                            _ => crate::map::bitmap::unset(&mut dead, i),
                         }
                     }
                 }

@@ -29,7 +29,7 @@
 
 pub use crate::geometry::drop_collinear;
 use crate::geometry::{distance, drop_middles, segment_clear};
-use crate::grid::{Grid, Point};
+use crate::map::grid::{Grid, Point};
 use crate::named::named;
 
 /// How to post-process the raw path.
@@ -127,7 +127,7 @@ pub struct Smoother {
 enum Tail {
     /// The trace of the DP's links (and the merge of a bounded scan) is next.
     Trace,
-    /// Passes of [`crate::taut::pull`] over the first `k` waypoints, `passes` done.
+    /// Passes of [`crate::polish::taut::pull`] over the first `k` waypoints, `passes` done.
     Pull { k: usize, passes: u8 },
 }
 
@@ -162,7 +162,7 @@ impl Smoother {
     /// The same smoothing with the bounded candidate scan ([`chain_cells`]) on a path longer than
     /// [`LOOKBACK`]` + 1` cells: at most `LOOKBACK / STRIDE + CHAIN + 2 NEAR` segment tests a raw
     /// cell instead of up to `LOOKBACK - 1`. For paths that are already locally shortest, as the
-    /// planner's are after its local search ([`crate::refine`]): there the result is within about
+    /// planner's are after its local search ([`crate::polish::refine`]): there the result is within about
     /// 0.1 % of the full scan's (`docs/ALGORITHM.md`, "Smoothing"); on a wandering path that
     /// loops back on itself the full scan can find a much shorter way through its cells.
     pub fn bounded(self) -> Self {
@@ -231,9 +231,9 @@ impl Smoother {
                 None
             }
             Tail::Pull { k, passes } => {
-                let (k, changed) = crate::taut::pass(grid, pts, k);
+                let (k, changed) = crate::polish::taut::pass(grid, pts, k);
                 let passes = passes.saturating_add(1);
-                if changed && passes < crate::taut::MAX_PASSES {
+                if changed && passes < crate::polish::taut::MAX_PASSES {
                     self.tail = Tail::Pull { k, passes };
                     return None;
                 }
@@ -271,7 +271,7 @@ impl Smoother {
                 // waypoints without their collinear ones, so the pull starts from the DP's path
                 // as `smooth` has always returned it).
                 let k = drop_collinear(pts, k);
-                crate::taut::pull(grid, pts, k)
+                crate::polish::taut::pull(grid, pts, k)
             }
         };
         drop_collinear(pts, k)
@@ -425,7 +425,7 @@ pub const STRIDE: usize = 8;
 /// Each is tested (a segment test) only when strictly shorter than the best clear one so far, as
 /// in [`dp_cells`]; the previous cell `j - 1` is the default. What it gives up against the full
 /// scan is a cut point between two stride cells that no chain passes through; the greedy pass
-/// after the DP ([`merge`]) and the taut pull (`crate::taut`), which moves waypoints a cell at a
+/// after the DP ([`merge`]) and the taut pull (`crate::polish::taut`), which moves waypoints a cell at a
 /// time, take that back: on the colony's paths of the depot, Boston, New York and
 /// `maze-128-128-2` the pulled result is within 0.1 % of the full scan's, shorter on some
 /// (`docs/ALGORITHM.md`, "Smoothing", has the figures).
@@ -803,7 +803,7 @@ mod tests {
             let mut want = raw.clone();
             // The old DP, then the same taut pull the new one ends with.
             let kw = old_shortest(&g, &mut want, n);
-            let kw = crate::taut::pull(&g, &mut want, kw);
+            let kw = crate::polish::taut::pull(&g, &mut want, kw);
             let (dn, pn) = scratch_for(n);
             assert_eq!(dn, n);
             let mut got = raw.clone();
@@ -901,11 +901,12 @@ mod tests {
             let g = Grid::new(240, 120, &b).unwrap();
             // Locally shortest first, as the planner's paths are when it smooths them.
             let mut raw = vec![Point::new(0, 0); walk.len() + 64];
-            let words = crate::refine::Scratch::words(52);
+            let words = crate::polish::refine::Scratch::words(52);
             let (mut sa, mut sb) = (vec![0u32; words], vec![0u32; words]);
-            let scratch = crate::refine::Scratch::new(&mut sa, &mut sb);
-            let mut budget = crate::refine::Budget::unlimited();
-            let n = crate::refine::refine(&g, &walk, &mut raw, scratch, &mut budget).unwrap();
+            let scratch = crate::polish::refine::Scratch::new(&mut sa, &mut sb);
+            let mut budget = crate::polish::refine::Budget::unlimited();
+            let n =
+                crate::polish::refine::refine(&g, &walk, &mut raw, scratch, &mut budget).unwrap();
             raw.truncate(n);
             if n <= LOOKBACK + 1 {
                 continue;
@@ -938,7 +939,7 @@ mod tests {
             let mut q = raw.clone();
             let kq = shortest_with(&g, &mut q, n, &mut d, &mut r, LOOKBACK);
             let kq = drop_collinear(&mut q, kq);
-            let kq = crate::taut::pull(&g, &mut q, kq);
+            let kq = crate::polish::taut::pull(&g, &mut q, kq);
             full_len += polyline_length(&q[..kq]);
             full_tests += 1;
         }

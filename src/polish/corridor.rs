@@ -1,8 +1,8 @@
 //! The last step of OHACA's default smoothing on small maps: the exact shortest path through the
 //! cell centres of a corridor around the smoothed path.
 //!
-//! The shortest-subsequence DP ([`crate::smoothing`]) keeps its waypoints on the raw path's cells,
-//! and the taut pull ([`crate::taut`]) moves them one cell at a time while each move shortens the
+//! The shortest-subsequence DP ([`crate::polish::smoothing`]) keeps its waypoints on the raw path's cells,
+//! and the taut pull ([`crate::polish::taut`]) moves them one cell at a time while each move shortens the
 //! path; both stop in local optima. The exact any-angle optimum through cell centres (the segment
 //! rule of [`crate::geometry::segment_clear`]) usually runs within a few cells of the smoothed
 //! path, in the same corridor between the same obstacles. [`shortest`] finds the exact optimum over
@@ -17,7 +17,7 @@
 //! around an obstacle the 8-connected optimum passes on the other side.
 //!
 //! Cost: `O(V^2)` distance computations for `V` corridor cells (at most the map's cells), plus the
-//! segment tests of improving edges. It runs on maps of at most [`crate::pheromone::BLOCKS`] cells,
+//! segment tests of improving edges. It runs on maps of at most [`crate::colony::pheromone::BLOCKS`] cells,
 //! whose per-cell pheromone increments lend the per-cell scratch (`g`, parent, flags).
 //!
 //! Guarantees: the result is never longer than the input (the input's vertices lie in the
@@ -27,7 +27,7 @@
 //! short leaves the input as it was.
 
 use crate::geometry::{distance, drop_collinear, polyline_length, segment_clear};
-use crate::grid::{Grid, Point};
+use crate::map::grid::{Grid, Point};
 
 /// Corridor half-width in cells (Chebyshev distance from the smoothed path's segments).
 pub const RADIUS: u16 = 3;

@@ -24,7 +24,7 @@
 //!
 //! Panic-free: every index is checked; a memo too short for one record remembers nothing.
 
-use crate::grid::Point;
+use crate::map::grid::Point;
 
 use super::window::Box2;
 

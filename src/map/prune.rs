@@ -22,8 +22,8 @@
 //! Cost: one pass over the map plus a few checks per pruned cell; memory: the `dead` bit set and a
 //! stack of any length (a full stack only means one more pass).
 
-use crate::bitmap;
-use crate::grid::{Moves, Point};
+use crate::map::bitmap;
+use crate::map::grid::{Moves, Point};
 
 /// For each set of neighbour directions `N` (bit `d` = direction `d`, even = straight): 0 if `N`
 /// is not a clique of the move graph, 1 if it is, `2 + d` if it is iff the diagonal neighbour `d`
@@ -414,7 +414,7 @@ fn push_neighbours(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::grid::Grid;
+    use crate::map::grid::Grid;
 
     fn grid_from(rows: &[&str]) -> (Vec<u8>, u16, u16) {
         crate::testutil::bits(rows)

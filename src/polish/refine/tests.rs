@@ -2,7 +2,7 @@
 //! resuming, determinism.
 
 use super::*;
-use crate::grid::{DX, DY};
+use crate::map::grid::{DX, DY};
 
 fn grid(rows: &[&str]) -> (Vec<u8>, u16, u16) {
     crate::testutil::bits(rows)
@@ -36,7 +36,7 @@ fn cost(g: &Grid<'_>, p: &[Point]) -> u32 {
     assert!(g.is_free(p[0]));
     p.windows(2)
         .map(|s| {
-            let d = crate::grid::direction(s[0], s[1]).expect("neighbours");
+            let d = crate::map::grid::direction(s[0], s[1]).expect("neighbours");
             assert_eq!(g.step(s[0], d), Some(s[1]), "illegal step {s:?}");
             step_cost(s[0], s[1])
         })
@@ -261,7 +261,7 @@ fn a_memo_changes_no_path() {
         // At once.
         let mut out = vec![Point::default(); path.len() + 16];
         let mut s = Heapless::new(cells, 0x5A);
-        let mut words = vec![0xDEAD_BEEFu32; crate::refine::memo_words(8)];
+        let mut words = vec![0xDEAD_BEEFu32; crate::polish::refine::memo_words(8)];
         let memo = Memo::clear(&mut words);
         let mut budget = Budget::unlimited();
         let k = refine(
@@ -290,7 +290,7 @@ fn a_memo_changes_no_path() {
             .take(held)
             .map(<[u32]>::to_vec)
             .collect();
-        let mut poisoned = vec![0u32; crate::refine::memo_words(4 * held)];
+        let mut poisoned = vec![0u32; crate::polish::refine::memo_words(4 * held)];
         let mut bad = Memo::clear(&mut poisoned);
         let cell = |v: u32| Point::new(v as u16, (v >> 16) as u16);
         for r in &records {

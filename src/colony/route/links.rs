@@ -7,10 +7,10 @@
 //! route's search ([`super::search`]) asks for one block at a time, when it closes the block, so
 //! a plan reads the border cells of the blocks its corridor needs and no others.
 
-use crate::grid::Moves;
+use crate::colony::pheromone::Blocks;
+use crate::map::grid::Moves;
 #[cfg(test)]
-use crate::grid::Point;
-use crate::pheromone::Blocks;
+use crate::map::grid::Point;
 
 /// The links of block `(bx, by)`, cell by cell: the rule [`links`] computes 32 cells at a time,
 /// kept as the tests' reference.
@@ -33,7 +33,7 @@ pub(super) fn block_links(moves: &Moves<'_>, blocks: Blocks, dead: &[u32], bx: u
             let xs = x as u16; // <= w - 1
             let p = Point::new(xs, y);
             let ci = grid.index(p);
-            if !crate::bitmap::marked(dead, ci) {
+            if !crate::map::bitmap::marked(dead, ci) {
                 let mut leaving = 0u8;
                 if xs & last == 0 {
                     leaving |= 0x38;
@@ -52,10 +52,10 @@ pub(super) fn block_links(moves: &Moves<'_>, blocks: Blocks, dead: &[u32], bx: u
                     let d = m.trailing_zeros() as usize & 7;
                     m &= m.wrapping_sub(1);
                     let ni = ci.wrapping_add_signed(offsets.get(d).copied().unwrap_or(0));
-                    if crate::bitmap::marked(dead, ni) {
+                    if crate::map::bitmap::marked(dead, ni) {
                         continue;
                     }
-                    let q = crate::grid::neighbour(p, d as crate::grid::Dir);
+                    let q = crate::map::grid::neighbour(p, d as crate::map::grid::Dir);
                     out |= 1 << block_dir(p, q, s);
                 }
             }
@@ -193,9 +193,9 @@ pub(super) fn links(
         let pruned = if dead.is_empty() {
             0
         } else if x0 == 0 {
-            crate::bitmap::window(dead, row) << 1
+            crate::map::bitmap::window(dead, row) << 1
         } else {
-            crate::bitmap::window(dead, row.wrapping_add(x0).wrapping_sub(1))
+            crate::map::bitmap::window(dead, row.wrapping_add(x0).wrapping_sub(1))
         };
         (free, free & !pruned)
     };
@@ -320,9 +320,9 @@ pub(super) fn block(
         let pruned = if dead.is_empty() {
             0
         } else if x0 == 0 {
-            crate::bitmap::window(dead, i) << 1
+            crate::map::bitmap::window(dead, i) << 1
         } else {
-            crate::bitmap::window(dead, i.wrapping_add(x0).wrapping_sub(1))
+            crate::map::bitmap::window(dead, i.wrapping_add(x0).wrapping_sub(1))
         };
         (free, free & !pruned)
     };
@@ -476,7 +476,7 @@ fn block_dir(p: Point, q: Point, s: u8) -> u32 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::grid::Grid;
+    use crate::map::grid::Grid;
 
     #[test]
     fn one_blocks_links_match_the_per_cell_rule() {
@@ -500,7 +500,7 @@ mod tests {
             let moves = Moves::new(g, &[]);
             let mut dead: Vec<u32> = match round % 4 {
                 0 => Vec::new(),
-                _ => (0..crate::bitmap::words(cells))
+                _ => (0..crate::map::bitmap::words(cells))
                     .map(|_| pick(u32::MAX) & pick(u32::MAX) & pick(u32::MAX))
                     .collect(),
             };
@@ -567,7 +567,7 @@ mod tests {
                     let g = Grid::new(w, h, &b).unwrap();
                     let moves = Moves::new(g, &[]);
                     let dead: Vec<u32> = if pruned {
-                        (0..crate::bitmap::words(cells))
+                        (0..crate::map::bitmap::words(cells))
                             .map(|_| rng.next_word() & rng.next_word() & rng.next_word())
                             .collect()
                     } else {
@@ -634,7 +634,7 @@ mod tests {
             let moves = Moves::new(g, &[]);
             let mut dead: Vec<u32> = match round % 4 {
                 0 => Vec::new(),
-                _ => (0..crate::bitmap::words(cells))
+                _ => (0..crate::map::bitmap::words(cells))
                     .map(|_| pick(u32::MAX) & pick(u32::MAX) & pick(u32::MAX))
                     .collect(),
             };

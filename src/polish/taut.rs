@@ -1,5 +1,5 @@
 //! Pulling a smoothed path taut over the cell centres around it: the last step of OHACA's
-//! default smoothing ([`crate::smoothing::SmoothingKind::Shortest`]).
+//! default smoothing ([`crate::polish::smoothing::SmoothingKind::Shortest`]).
 //!
 //! The shortest-path smoothing keeps waypoints on the raw path's cells. The exact any-angle
 //! optimum (cell centres, the segment rule of [`crate::geometry::segment_clear`]) usually bends at
@@ -20,9 +20,9 @@
 //! lengths from [`crate::geometry::distance`] (libm's correctly rounded `sqrtf`), so the host and
 //! the device pull the same path taut.
 
-use crate::dir::{DX, DY};
 use crate::geometry::{distance, drop_collinear, segment_clear};
-use crate::grid::{Grid, Point};
+use crate::map::dir::{DX, DY};
+use crate::map::grid::{Grid, Point};
 
 /// Passes over the waypoints at most (measured on the shared small maps: one to three passes
 /// change something, the rest find nothing).

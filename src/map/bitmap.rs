@@ -1,5 +1,5 @@
 //! Sets of map cells at one bit per cell, in `u32` words: the ant's tabu list and the dead cells
-//! of [`crate::prune`], the flood fill's marks.
+//! of [`crate::map::prune`], the flood fill's marks.
 //!
 //! A 256 x 256 map needs 2,048 words (8 KiB) per set, where a byte per cell would need 64 KiB:
 //! this is what lets the colony's memory stay independent of the map's size apart from these
@@ -103,7 +103,7 @@ pub fn three(bits: &[u32], i: usize) -> u32 {
 }
 
 /// The set's members among the eight neighbours of cell `i` of a map `width` cells wide, as a
-/// direction mask (bit `d`: the neighbour in direction `d` of [`crate::dir`]). `i` must not lie
+/// direction mask (bit `d`: the neighbour in direction `d` of [`crate::map::dir`]). `i` must not lie
 /// on the map's border (its neighbours' indices are taken as `i +- 1`, `i +- width`).
 #[inline]
 pub fn around(bits: &[u32], i: usize, width: usize) -> u8 {
@@ -119,7 +119,7 @@ pub fn around(bits: &[u32], i: usize, width: usize) -> u8 {
 /// a direction mask (bit `d` = the neighbour in direction `d`; the centre is left out).
 #[allow(clippy::indexing_slicing, clippy::arithmetic_side_effects)]
 static RING9: [u8; 512] = {
-    use crate::dir::{DX, DY};
+    use crate::map::dir::{DX, DY};
     let mut t = [0u8; 512];
     let mut nb = 0usize;
     while nb < 512 {
@@ -181,7 +181,7 @@ mod tests {
 
     #[test]
     fn around_reads_the_eight_neighbours() {
-        use crate::dir::{DX, DY};
+        use crate::map::dir::{DX, DY};
         let (w, h) = (37usize, 5usize);
         let mut x = 12345u32;
         let mut b = vec![0u32; words(w * h)];

@@ -26,7 +26,7 @@
 //! diagonal one. That is the paper's "blind search".
 
 use crate::geometry::SQRT_2;
-use crate::grid::{Dir, Point, DX, DY};
+use crate::map::grid::{Dir, Point, DX, DY};
 
 /// Octile decomposition of the obstacle-free distance from `p` to `g`: `(straight, diagonal)`
 /// step counts, so the distance is `straight + sqrt(2) * diagonal`.
@@ -266,7 +266,7 @@ impl Heuristic {
     }
 
     /// `eta^beta` of the 8 moves from cell `p` when the potential field pulls towards `target`
-    /// instead of the goal (a sub-goal of [`crate::route`] on large maps).
+    /// instead of the goal (a sub-goal of [`crate::colony::route`] on large maps).
     #[inline]
     pub fn row_toward(&self, p: Point, target: Point) -> Row<'_> {
         const NONE: [u8; 8] = [(WEIGHTS - 1) as u8; 8];

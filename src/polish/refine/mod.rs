@@ -60,7 +60,7 @@
 //! (`path.len() + side`) make that practically never happen.
 
 use crate::error::Error;
-use crate::grid::{direction, Grid, Point};
+use crate::map::grid::{direction, Grid, Point};
 
 mod memo;
 mod window;

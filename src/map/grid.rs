@@ -5,7 +5,7 @@
 //! This is also the layout the wire protocol sends. `x` grows to the right, `y` grows downwards
 //! (as in Moving AI maps: `(0, 0)` is the first character of the first row).
 //!
-//! Moves: the 8 neighbours ([`crate::dir`]). A diagonal move is allowed only when both orthogonally adjacent cells
+//! Moves: the 8 neighbours ([`crate::map::dir`]). A diagonal move is allowed only when both orthogonally adjacent cells
 //! are free, so a path never squeezes between two obstacles that touch at a corner.
 //!
 //! The grid borrows its bits, so it costs nothing to build over a `static` buffer on the device or
@@ -53,7 +53,7 @@ impl Point {
     }
 }
 
-pub use crate::dir::{is_diagonal, opposite, Dir, DX, DY};
+pub use crate::map::dir::{is_diagonal, opposite, Dir, DX, DY};
 
 /// A borrowed occupancy grid. See the module docs for the bit layout.
 #[derive(Clone, Copy, Debug)]
@@ -300,7 +300,7 @@ impl<'a> Grid<'a> {
 
     /// The free cells of row `y` around the run of 32 columns from `x0` as bits: bit `j` (0..=33)
     /// is column `x0 - 1 + j`; columns off the map (left of 0, right of the last) read as not
-    /// free. For passes over the map 32 cells at a time ([`crate::route`], [`crate::prune`]).
+    /// free. For passes over the map 32 cells at a time ([`crate::colony::route`], [`crate::map::prune`]).
     #[inline]
     pub(crate) fn free_window(&self, y: usize, x0: usize) -> u64 {
         let w = usize::from(self.width);
@@ -345,7 +345,7 @@ impl<'a> Grid<'a> {
 
     /// Flood fill from `start` over allowed moves: is `goal` reachable?
     ///
-    /// `mark` is a bit set of at least [`crate::bitmap::words`]`(cells)` words; `queue` is a ring
+    /// `mark` is a bit set of at least [`crate::map::bitmap::words`]`(cells)` words; `queue` is a ring
     /// of cell indices of any length. A breadth-first frontier longer than the ring cannot be
     /// held, and the answer is then [`Reach::Unknown`] (the planner's first backtracking ant
     /// decides instead).
@@ -387,7 +387,7 @@ impl<'a> Grid<'a> {
             return Err(Reach::No);
         }
         let cap = queue.len();
-        let Some(mark) = mark.get_mut(..crate::bitmap::words(cells)) else {
+        let Some(mark) = mark.get_mut(..crate::map::bitmap::words(cells)) else {
             return Err(Reach::Unknown);
         };
         if cap == 0 {
@@ -406,7 +406,7 @@ impl<'a> Grid<'a> {
             };
         }
         let si = self.index(start);
-        crate::bitmap::set(mark, si);
+        crate::map::bitmap::set(mark, si);
         if let Some(s) = queue.get_mut(0) {
             *s = si as u32; // < cells < 2^32
         }
@@ -466,7 +466,7 @@ impl<'a> Grid<'a> {
                 if i < last_row { i.wrapping_add(w) } else { i },
             ];
             for ni in next {
-                if crate::bitmap::insert(mark, ni) {
+                if crate::map::bitmap::insert(mark, ni) {
                     if len == cap {
                         return Some(Reach::Unknown);
                     }
@@ -723,7 +723,7 @@ mod tests {
                     }
                 }
                 let g = Grid::new(w, h, &b).unwrap();
-                let mut mark = vec![0u32; crate::bitmap::words(cells)];
+                let mut mark = vec![0u32; crate::map::bitmap::words(cells)];
                 let mut queue = vec![0u32; cells];
                 for s in 0..cells {
                     // Eight-move BFS from s.

@@ -46,8 +46,8 @@
 //! Memory: the route's words (one a block: links, a known flag, the next block, the key) and
 //! scratch for the heap, one word a block.
 
-use crate::grid::{Moves, Point, DX, DY};
-use crate::pheromone::Blocks;
+use crate::colony::pheromone::Blocks;
+use crate::map::grid::{Moves, Point, DX, DY};
 
 use super::{dist, DIST_SHIFT, KNOWN, LINKS, NEXT_SHIFT};
 
@@ -447,7 +447,7 @@ mod tests {
     use super::super::links::block_links;
     use super::super::{build, Route, Short, NONE, UNREACHED};
     use super::*;
-    use crate::grid::Grid;
+    use crate::map::grid::Grid;
 
     /// A random map of `w x h` cells, about `density` % blocked, and pruning marks (or none).
     fn random_map(
@@ -460,7 +460,7 @@ mod tests {
         let cells = usize::from(w) * usize::from(h);
         let mut b = vec![0u8; cells.div_ceil(8)];
         let mut dead = if marks {
-            vec![0u32; crate::bitmap::words(cells)]
+            vec![0u32; crate::map::bitmap::words(cells)]
         } else {
             Vec::new()
         };
@@ -468,7 +468,7 @@ mod tests {
             if pick(100) < density {
                 b[i / 8] |= 1 << (i % 8);
             } else if marks && pick(100) < 10 {
-                crate::bitmap::set(&mut dead, i);
+                crate::map::bitmap::set(&mut dead, i);
             }
         }
         (b, dead)

@@ -1,7 +1,7 @@
 //! One window of the local search: the box shapes a window may take, the box itself, and the
 //! exact A* inside it (integer costs, ties broken by a fixed rule, so the same on every platform).
 
-use crate::grid::{Grid, Point, DX, DY};
+use crate::map::grid::{Grid, Point, DX, DY};
 
 use super::{octile, Budget, Scratch, CLOSED, DIAGONAL, MAX_SIDE, STRAIGHT, UNREACHED};
 

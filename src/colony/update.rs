@@ -33,8 +33,8 @@
 //! ACA and PACA use only the first two terms; HACA and OHACA add the wolves terms. Ants that died
 //! deposit nothing.
 
-use crate::grid::{neighbour, Dir, Grid, Point};
-use crate::pheromone::{slot_offsets, Table};
+use crate::colony::pheromone::{slot_offsets, Table};
+use crate::map::grid::{neighbour, Dir, Grid, Point};
 
 /// Add `amount` to every edge of the path that starts at `start` and follows `tour`.
 pub fn deposit(table: &mut Table<'_>, grid: &Grid<'_>, start: Point, tour: &[Dir], amount: f32) {
@@ -123,7 +123,7 @@ pub fn wolves_amounts(q: f32, best: (f32, u32), worst: (f32, u32)) -> Option<(f3
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::pheromone::Blocks;
+    use crate::colony::pheromone::Blocks;
 
     #[test]
     fn reward_best_punish_worst() {

@@ -10,7 +10,7 @@
 //!   parent is a neighbour whose cost plus the step's is exactly the cell's).
 //!
 //! **What it owns.** One search from a start to a goal cell on a [`Grid`], with the core's own
-//! moves ([`crate::grid::Grid::step`]: the eight king moves, a diagonal only when both
+//! moves ([`crate::map::grid::Grid::step`]: the eight king moves, a diagonal only when both
 //! orthogonally adjacent cells are free, so no corner is ever cut; read from the map's bits with
 //! [`Grid::mask_at`]). The map's bits are only read: neither variant copies them.
 //!
@@ -41,7 +41,7 @@
 //!
 //! **Storage, all the caller's.** [`search`]: [`nibble_bytes`]`(cells)` bytes of nibbles (row
 //! major, low nibble first): [`FREE`] (not closed), [`START`] (closed, no parent), or `1..=8`
-//! (closed, reached from its parent by direction `nibble - 1`, [`crate::dir`]); cleared at the
+//! (closed, reached from its parent by direction `nibble - 1`, [`crate::map::dir`]); cleared at the
 //! start of each search, and afterwards the parent tree [`write_path`] and [`path_back`] read.
 //! [`search_costs`]: `cells` words of `g` (`u32::MAX` = not reached), filled at the start, and
 //! afterwards what [`write_path_costs`] and [`path_back_costs`] read. Both: the open list.
@@ -51,9 +51,9 @@
 
 use core::fmt;
 
-use crate::dir::{is_diagonal, opposite, Dir, DX, DY};
 use crate::geometry::steps_length;
-use crate::grid::{Grid, Point};
+use crate::map::dir::{is_diagonal, opposite, Dir, DX, DY};
+use crate::map::grid::{Grid, Point};
 
 /// Nibble of a cell not closed yet.
 pub const FREE: u8 = 0;

@@ -8,7 +8,7 @@
 //! arrived, and their mean length is within [`REFINE_GAIN`] of the iteration's best, computed
 //! as the run records it (`sum / arrived`, then `mean * REFINE_GAIN <= best`), so the curve
 //! replays the decision bit for bit. It applies where [`crate::planner::settled`] does (a run
-//! with the local search on a map of more than [`crate::pheromone::BLOCKS`] cells), so the
+//! with the local search on a map of more than [`crate::colony::pheromone::BLOCKS`] cells), so the
 //! paper preset and the small maps never meet it.
 //!
 //! **Why.** With the local search the colony only chooses the corridor
@@ -102,10 +102,10 @@ mod tests {
     /// (it walks all twelve) or ends an iteration without one.
     #[test]
     fn an_iteration_ends_after_its_first_ants_exactly_when_they_agree() {
-        use crate::dir::is_diagonal;
         use crate::geometry::steps_length;
-        use crate::grid::{Grid, Point};
         use crate::heap::HeapStorage;
+        use crate::map::dir::is_diagonal;
+        use crate::map::grid::{Grid, Point};
         use crate::planner::{Params, Run};
         use alloc::vec::Vec;
 

@@ -7,9 +7,9 @@
 //! the links and the path cells' words; all give the same result). Like the rest of the core it has no panic path:
 //! every index is checked, and a path it cannot index is returned unchanged.
 
-use crate::ant::Walk;
-use crate::bitmap;
-use crate::grid::{is_diagonal, neighbour, opposite, Dir, Moves, Point};
+use crate::colony::ant::Walk;
+use crate::map::bitmap;
+use crate::map::grid::{is_diagonal, neighbour, opposite, Dir, Moves, Point};
 
 /// Straighten a finished walk in place: from each cell of the path, jump to the furthest later
 /// path cell that is one allowed move away, dropping the detour in between. Returns the new walk.
@@ -492,10 +492,10 @@ impl<'a> PathIndex<'a> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::ant::{Ant, DeadEnd};
-    use crate::grid::Grid;
-    use crate::heuristic::{Attraction, Heuristic};
-    use crate::pheromone::{Blocks, Table};
+    use crate::colony::ant::{Ant, DeadEnd};
+    use crate::colony::heuristic::{Attraction, Heuristic};
+    use crate::colony::pheromone::{Blocks, Table};
+    use crate::map::grid::Grid;
     use crate::rng::Xoshiro128pp;
 
     /// A walk of [`wandering_walk`]: the map's bits, the walk, its tour and the tabu bits it left.
@@ -539,7 +539,7 @@ mod tests {
             route: None,
             budget: u32::MAX,
         };
-        let mut tabu = vec![0u32; crate::bitmap::words(cells)];
+        let mut tabu = vec![0u32; crate::map::bitmap::words(cells)];
         let mut tour = vec![0u8; cells];
         let walk = ant.walk(&mut rng, &mut tabu, &mut tour).ok()?;
         Some(Wandering {

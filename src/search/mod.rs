@@ -1,0 +1,6 @@
+//! Whole-map searches that stand beside the planner: the exact A* baseline (4 bits a cell plus a
+//! heap), which the tests and benchmarks measure the planner against; the planner does not use it.
+//!
+//! Depends on [`crate::map`] only. Also reachable at the crate root (`ohaca::astar`).
+
+pub mod astar;
