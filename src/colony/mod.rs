@@ -10,7 +10,6 @@
 pub mod ant;
 pub mod heuristic;
 pub mod pheromone;
-pub mod quorum;
 pub mod route;
 pub mod tighten;
 pub mod update;

@@ -35,6 +35,7 @@ mod lend;
 mod params;
 mod placed;
 mod plan;
+pub mod quorum;
 mod repair;
 mod reuse;
 mod run;

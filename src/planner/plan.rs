@@ -18,7 +18,7 @@ pub struct CurvePoint {
     /// Ants that reached the goal in this iteration (all of them unless they die at dead ends).
     pub arrived: u16,
     /// Ants that walked in this iteration: all of them, unless the quorum ended it early
-    /// ([`crate::colony::quorum`]).
+    /// ([`crate::planner::quorum`]).
     pub walked: u16,
 }
 

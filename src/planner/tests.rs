@@ -602,11 +602,11 @@ fn small_maps_keep_the_colonys_path() {
 
 /// Whether a recorded iteration settled its corridor, replayed from its numbers independently
 /// of `settled`: all `ants` walked and arrived, or the quorum's first ants did
-/// (`crate::colony::quorum`), with a mean within `REFINE_GAIN` of the iteration's best.
+/// (`crate::planner::quorum`), with a mean within `REFINE_GAIN` of the iteration's best.
 fn agrees(c: &CurvePoint, ants: u16) -> bool {
     let all = c.walked == ants && c.arrived == ants;
-    let quorum = c.walked == crate::colony::quorum::QUORUM
-        && crate::colony::quorum::QUORUM < ants
+    let quorum = c.walked == crate::planner::quorum::QUORUM
+        && crate::planner::quorum::QUORUM < ants
         && c.arrived == c.walked;
     (all || quorum) && c.mean * REFINE_GAIN <= c.best
 }

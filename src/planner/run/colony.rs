@@ -68,7 +68,7 @@ pub const REFINE_GAIN: f32 = 0.99;
 /// maps is 1.0009 against 1.0008 (1.0009 both with seeds 1-4).
 pub fn settled(point: &CurvePoint, ants: u16) -> bool {
     point.walked == ants && point.arrived == ants && point.mean * REFINE_GAIN <= point.best
-        || crate::colony::quorum::ended(point, ants)
+        || crate::planner::quorum::ended(point, ants)
 }
 
 /// The best path of an iteration or of the run, as step counts (exact length comparison).
@@ -118,7 +118,7 @@ pub(super) struct Iteration {
     arrived: u32,
     /// An ant of this iteration proved the goal unreachable (the run ends with `NoPath`).
     no_path: bool,
-    /// Ants walked (all of them unless the quorum ended the iteration, [`crate::colony::quorum`]).
+    /// Ants walked (all of them unless the quorum ended the iteration, [`crate::planner::quorum`]).
     walked: u16,
 }
 
@@ -451,7 +451,7 @@ impl Run<'_, '_> {
                     }
                     if quorum {
                         let b = it.best.map_or(f32::INFINITY, |(b, _)| b.length());
-                        if crate::colony::quorum::reached(w.ant, p.ants, it.arrived, it.sum, b) {
+                        if crate::planner::quorum::reached(w.ant, p.ants, it.arrived, it.sum, b) {
                             w.close = Close::Best;
                         }
                     }
