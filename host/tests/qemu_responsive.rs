@@ -246,6 +246,19 @@ fn while_planning(map: &Map, start: Point, goal: Point, params: &Params) -> (Vec
     (answers, latency(cancel, plan))
 }
 
+/// Parameters for a plan that runs long: `iterations` iterations, no early stop, and without
+/// the local search (with it, a large map's run stops once the ants settled the corridor).
+fn long_plan(iterations: u16) -> Params {
+    Params {
+        iterations,
+        patience: 0,
+        refine_patience: 0,
+        refine: false,
+        seed: 1,
+        ..Params::default()
+    }
+}
+
 fn check(what: &str, (answers, cancel): (Vec<u64>, u64)) {
     let worst = answers.iter().copied().max().unwrap_or(0);
     println!(
@@ -269,16 +282,7 @@ fn requests_are_answered_while_a_plan_runs() {
     need_qemu!();
     let map = Map::load(maps().join("complex-26.map")).expect("map");
     let (start, goal) = (Point::new(0, 0), Point::new(25, 25));
-    let params = Params {
-        iterations: 4000,
-        patience: 0,
-        refine_patience: 0,
-        // Without the local search the colony runs all its iterations (with it, a large map's
-        // run stops once the ants settled the corridor).
-        refine: false,
-        seed: 1,
-        ..Params::default()
-    };
+    let params = long_plan(4000);
     check("complex-26", while_planning(&map, start, goal, &params));
 }
 
@@ -289,16 +293,7 @@ fn requests_are_answered_while_a_plan_runs() {
 fn requests_are_answered_while_new_york_plans() {
     need_qemu!();
     let map = Map::load(maps().join("large/NewYork_0_512.map")).expect("map");
-    let params = Params {
-        iterations: 400,
-        patience: 0,
-        refine_patience: 0,
-        // Without the local search the colony runs all its iterations (with it, a large map's
-        // run stops once the ants settled the corridor).
-        refine: false,
-        seed: 1,
-        ..Params::default()
-    };
+    let params = long_plan(400);
     check(
         "NewYork_0_512",
         while_planning(&map, Point::new(509, 443), Point::new(0, 9), &params),
@@ -313,14 +308,7 @@ fn requests_are_answered_while_a_maze_plans() {
     need_qemu!();
     let map = Map::load(maps().join("large/maze-128-128-2.map")).expect("map");
     let (start, goal) = qemu::longest_scenario("large/maze-128-128-2-random-1.scen");
-    let params = Params {
-        iterations: 400,
-        patience: 0,
-        refine_patience: 0,
-        refine: false,
-        seed: 1,
-        ..Params::default()
-    };
+    let params = long_plan(400);
     check("maze-128-128-2", while_planning(&map, start, goal, &params));
 }
 
@@ -338,14 +326,7 @@ fn the_receive_side_within_and_beyond_the_window() {
     link.hello().expect("hello");
     let map = Map::load(maps().join("large/NewYork_0_512.map")).expect("map");
     link.set_map(&map).expect("upload New York");
-    let params = Params {
-        iterations: 4000,
-        patience: 0,
-        refine_patience: 0,
-        refine: false,
-        seed: 1,
-        ..Params::default()
-    };
+    let params = long_plan(4000);
     link.set_params(&params).expect("params");
     let plan = link
         .send(&Request::Plan {
