@@ -106,6 +106,10 @@ pub const H743: Board = Board {
     window: 8,
 };
 
+/// Bytes of the STM32H743's SRAM4 (RM0433), the region that holds a [`Layout::Separate`]
+/// board's links (`src/firmware/buffers.rs`): 64 KiB.
+pub const H743_SRAM4_BYTES: usize = 64 * 1024;
+
 /// Links of a [`Layout::Separate`] board with paths of up to `steps` steps: tightening's smallest
 /// hash table for `steps + 1` cells, at least the coarse route's blocks.
 const fn links_for(steps: usize) -> usize {
@@ -121,6 +125,12 @@ const fn links_for(steps: usize) -> usize {
 pub const BOARDS: [Board; 2] = [F411, H743];
 
 impl Board {
+    /// Whether the board lays the map and the planner's buffers out in one arena
+    /// ([`Layout::Arena`]) rather than as statics of their own ([`Layout::Separate`]).
+    pub const fn is_arena(&self) -> bool {
+        matches!(self.layout, Layout::Arena { .. })
+    }
+
     /// The board called `name` (`f411`, `h743`; any case).
     pub fn named(name: &str) -> Option<Board> {
         BOARDS

@@ -47,6 +47,11 @@ pub use layout::{lend, take, MapBuf, PlanStorage, BYTES, MAP_INIT};
 pub type MapLock =
     embassy_sync::mutex::Mutex<embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex, MapBuf>;
 
+/// Which layout the board's description asks for (`ohaca::board::Board::layout`), derived once:
+/// the cargo feature that picks the `layout` module below must agree with it.
+const ARENA: bool = crate::firmware::board::BOARD.is_arena();
+const _: () = assert!(ARENA == cfg!(not(any(feature = "twin-h743", feature = "board-stm32h743"))));
+
 /// The map and the planner's buffers in one arena behind the map's lock (STM32F411 and the
 /// default QEMU board).
 #[cfg(not(feature = "twin-h743"))]
@@ -181,7 +186,7 @@ mod layout {
     /// need 65,536), and at least the coarse route's blocks (its heap): 16,384 words, all of
     /// SRAM4. The host plans in the same (`ohaca plan --board h743`).
     const LINKS: usize = SEPARATE.0;
-    const _: () = assert!(LINKS >= GUIDE_BLOCKS && 4 * LINKS <= 65_536);
+    const _: () = assert!(LINKS >= GUIDE_BLOCKS && 4 * LINKS <= ohaca::board::H743_SRAM4_BYTES);
     /// The move table for maps of up to this many cells (larger maps compute moves on the fly).
     const MOVES: usize = SEPARATE.1;
 

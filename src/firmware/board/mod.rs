@@ -14,7 +14,9 @@
 //! the same values with `--board`): `ohaca::board::F411` on the STM32F411 and the default QEMU
 //! board, `ohaca::board::H743` on the STM32H743 and on its QEMU capacity twin (`board-qemu` +
 //! `twin-h743`), whose RAM regions have the H743's sizes. Where the buffers go in RAM:
-//! `super::buffers`.
+//! `super::buffers`. The two STM32 boards share their UART setup and the rest of their
+//! [`Board`] implementation (`stm32_uart`, the `stm32_board!` macro); each board file holds only its
+//! facts: name, USART, interrupt, pins, clocks.
 
 #[cfg(any(
     all(feature = "board-qemu", feature = "board-stm32f411"),
@@ -28,6 +30,10 @@ compile_error!("choose one board: `board-qemu` (default), or `--no-default-featu
     feature = "board-stm32h743"
 )))]
 compile_error!("no board selected: enable `board-qemu`, `board-stm32f411` or `board-stm32h743`");
+
+#[cfg(any(feature = "board-stm32f411", feature = "board-stm32h743"))]
+#[macro_use]
+mod stm32_uart;
 
 #[cfg(feature = "board-qemu")]
 pub mod qemu;

@@ -3,28 +3,27 @@
 //! `BufferedUart`, embassy-stm32's timer-based time driver (1 tick = 1 µs), logs over RTT
 //! (`probe-rs run` shows them). Wiring and flashing: docs/FIRMWARE.md.
 
-use defmt_rtt as _;
+use embassy_stm32::rcc;
 use embassy_stm32::time::Hertz;
-use embassy_stm32::usart::{BufferedUart, BufferedUartRx, BufferedUartTx, Config};
-use embassy_stm32::{bind_interrupts, peripherals, rcc, usart};
-use static_cell::ConstStaticCell;
-
-use super::Board;
 
 /// Maps of up to 262,144 cells, paths of up to 4,095 steps (2,047 up to 68,256 cells), in one
 /// arena of 103,424 bytes: `ohaca::board::F411`.
 pub const BOARD: ohaca::board::Board = ohaca::board::F411;
 
-bind_interrupts!(struct Irqs {
-    USART1 => usart::BufferedInterruptHandler<peripherals::USART1>;
-});
+stm32_board! {
+    board: Stm32f411,
+    name: "stm32f411-blackpill",
+    start: start,
+    uart: USART1,
+    irq: USART1,
+    rx: PA10,
+    tx: PA9,
+}
 
-/// UART ring buffers (the planner yields once per iteration; a full map chunk is ~160 bytes).
-static RX_BUF: ConstStaticCell<[u8; crate::firmware::limits::RX_RING]> =
-    ConstStaticCell::new([0; crate::firmware::limits::RX_RING]);
-static TX_BUF: ConstStaticCell<[u8; 256]> = ConstStaticCell::new([0; 256]);
-
-pub struct Stm32f411;
+/// Clocks: 96 MHz from the 25 MHz crystal.
+fn start() -> embassy_stm32::Peripherals {
+    embassy_stm32::init(clocks())
+}
 
 fn clocks() -> embassy_stm32::Config {
     let mut config = embassy_stm32::Config::default();
@@ -46,36 +45,4 @@ fn clocks() -> embassy_stm32::Config {
     r.apb1_pre = rcc::APBPrescaler::DIV2; // 48 MHz (max 50)
     r.apb2_pre = rcc::APBPrescaler::DIV1;
     config
-}
-
-impl Board for Stm32f411 {
-    const NAME: &'static str = "stm32f411-blackpill";
-    type Rx = BufferedUartRx<'static>;
-    type Tx = BufferedUartTx<'static>;
-
-    fn init() -> (Self::Rx, Self::Tx) {
-        let p = embassy_stm32::init(clocks());
-        let mut config = Config::default();
-        config.baudrate = 115_200;
-        let uart = defmt::unwrap!(BufferedUart::new(
-            p.USART1,
-            p.PA10,
-            p.PA9,
-            TX_BUF.take(),
-            RX_BUF.take(),
-            Irqs,
-            config,
-        ));
-        let (tx, rx) = uart.split();
-        (rx, tx)
-    }
-
-    fn rx_overruns() -> u32 {
-        // BufferedUart reports overruns as read errors, which the receive task counts.
-        0
-    }
-
-    fn exit(_failure: bool) -> ! {
-        cortex_m::peripheral::SCB::sys_reset()
-    }
 }

@@ -9,27 +9,21 @@
 //! over them by `crate::firmware::buffers`, which `init` prepares for by enabling the SRAM1-3
 //! clocks (D2 domain). No DMA touches any buffer, so the D-cache needs no maintenance.
 
-use defmt_rtt as _;
-use embassy_stm32::usart::{BufferedUart, BufferedUartRx, BufferedUartTx, Config};
-use embassy_stm32::{bind_interrupts, peripherals, rcc, usart};
-use static_cell::ConstStaticCell;
-
-use super::Board;
+use embassy_stm32::rcc;
 
 /// Maps of up to 2,097,152 cells, paths of up to 16,384 steps, buffers over the RAM regions:
 /// `ohaca::board::H743`.
 pub const BOARD: ohaca::board::Board = ohaca::board::H743;
 
-bind_interrupts!(struct Irqs {
-    USART3 => usart::BufferedInterruptHandler<peripherals::USART3>;
-});
-
-/// UART ring buffers (the planner yields once per iteration; a full map chunk is ~160 bytes).
-static RX_BUF: ConstStaticCell<[u8; crate::firmware::limits::RX_RING]> =
-    ConstStaticCell::new([0; crate::firmware::limits::RX_RING]);
-static TX_BUF: ConstStaticCell<[u8; 256]> = ConstStaticCell::new([0; 256]);
-
-pub struct Stm32h743;
+stm32_board! {
+    board: Stm32h743,
+    name: "stm32h743-nucleo",
+    start: start,
+    uart: USART3,
+    irq: USART3,
+    rx: PD9,
+    tx: PD8,
+}
 
 fn clocks() -> embassy_stm32::Config {
     let mut config = embassy_stm32::Config::default();
@@ -55,44 +49,18 @@ fn clocks() -> embassy_stm32::Config {
     config
 }
 
-impl Board for Stm32h743 {
-    const NAME: &'static str = "stm32h743-nucleo";
-    type Rx = BufferedUartRx<'static>;
-    type Tx = BufferedUartTx<'static>;
-
-    fn init() -> (Self::Rx, Self::Tx) {
-        let mut cp = defmt::unwrap!(cortex_m::Peripherals::take());
-        cp.SCB.enable_icache();
-        cp.SCB.enable_dcache(&mut cp.CPUID);
-        let p = embassy_stm32::init(clocks());
-        // SRAM1-3 (D2 domain) hold planner buffers (`crate::firmware::buffers`): clock them
-        // before they are first written (RM0433, RCC_AHB2ENR).
-        embassy_stm32::pac::RCC.ahb2enr().modify(|w| {
-            w.set_sram1en(true);
-            w.set_sram2en(true);
-            w.set_sram3en(true);
-        });
-        let mut config = Config::default();
-        config.baudrate = 115_200;
-        let uart = defmt::unwrap!(BufferedUart::new(
-            p.USART3,
-            p.PD9,
-            p.PD8,
-            TX_BUF.take(),
-            RX_BUF.take(),
-            Irqs,
-            config,
-        ));
-        let (tx, rx) = uart.split();
-        (rx, tx)
-    }
-
-    fn rx_overruns() -> u32 {
-        // BufferedUart reports overruns as read errors, which the receive task counts.
-        0
-    }
-
-    fn exit(_failure: bool) -> ! {
-        cortex_m::peripheral::SCB::sys_reset()
-    }
+/// Caches on, clocks at 400 MHz, and the D2-domain SRAMs clocked before the UART opens.
+fn start() -> embassy_stm32::Peripherals {
+    let mut cp = defmt::unwrap!(cortex_m::Peripherals::take());
+    cp.SCB.enable_icache();
+    cp.SCB.enable_dcache(&mut cp.CPUID);
+    let p = embassy_stm32::init(clocks());
+    // SRAM1-3 (D2 domain) hold planner buffers (`crate::firmware::buffers`): clock them
+    // before they are first written (RM0433, RCC_AHB2ENR).
+    embassy_stm32::pac::RCC.ahb2enr().modify(|w| {
+        w.set_sram1en(true);
+        w.set_sram2en(true);
+        w.set_sram3en(true);
+    });
+    p
 }
