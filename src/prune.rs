@@ -137,15 +137,19 @@ pub fn resume(
     // is 32 cells at a time (`Grid::free_window`): on a city map about one free cell in ten is
     // tried (issue 27: the full scan was 5 M instructions of a 256 x 256 plan on the Cortex-M4).
     if !at.again && w > 0 {
+        // One division on entering; the windows then step `x0` and `y`.
+        let (mut y, mut x0) = (next / w, next % w);
         loop {
-            let (y, x0) = (next / w, next % w);
+            if x0 >= w {
+                (y, x0) = (y.wrapping_add(1), 0);
+            }
             if y >= h {
                 at.again = true;
                 next = cells;
                 break;
             }
             if settle.tried >= budget {
-                at.next = next as u32; // a cell index: < 2^32
+                at.next = y.wrapping_mul(w).wrapping_add(x0) as u32; // a cell index: < 2^32
                 at.full = settle.full;
                 return None;
             }
@@ -165,23 +169,21 @@ pub fn resume(
             let run = grid.run_bits(x0);
             let mut m = free & !((free << 1) & (free >> 1)) & !(north & south) & run;
             // A window's test counts as a try: the budget bounds the scan too.
-            settle.tried = settle.tried.saturating_add(1);
+            settle.tried = settle.tried.wrapping_add(1);
             while m != 0 {
                 let j = m.trailing_zeros() as usize;
                 m &= m.wrapping_sub(1);
                 // j >= 1: column x0 - 1 + j.
                 settle.at(dead, row.wrapping_add(x0).wrapping_add(j).wrapping_sub(1));
+                settle.tried = settle.tried.wrapping_add(1);
             }
-            let x1 = x0.wrapping_add(32);
-            next = if x1 < w {
-                row.wrapping_add(x1)
-            } else {
-                row.wrapping_add(w)
-            };
+            x0 = x0.wrapping_add(32);
         }
     }
     // A full stack dropped some neighbours: a pass over every free cell finds what they would
-    // have, as many times as it takes (`next == cells`: a pass ended).
+    // have, as many times as it takes (`next == cells`: a pass ended). The budget is checked
+    // every `FULL_CHUNK` cells (each counts as a try).
+    const FULL_CHUNK: usize = 64;
     loop {
         if next >= cells {
             if !settle.full {
@@ -195,12 +197,15 @@ pub fn resume(
             at.full = settle.full;
             return None;
         }
-        // Blocked cells are never pruned: skip them before computing anything.
-        if !grid.blocked_at(next) {
-            settle.at(dead, next);
+        let stop = next.saturating_add(FULL_CHUNK).min(cells);
+        for ci in next..stop {
+            // Blocked cells are never pruned: skip them before computing anything.
+            if !grid.blocked_at(ci) {
+                settle.at(dead, ci);
+            }
         }
-        settle.tried = settle.tried.saturating_add(1);
-        next = next.wrapping_add(1);
+        settle.tried = settle.tried.wrapping_add(FULL_CHUNK as u32);
+        next = stop;
     }
     *at = Pruning {
         next: cells as u32,
@@ -385,7 +390,8 @@ struct Settle<'m, 's> {
     /// The stack was too short for some neighbours.
     full: bool,
     touched: &'s mut Bounds,
-    /// Cells tried so far (the budget of [`resume`]).
+    /// Cells tried so far by the settling of pruned cells' neighbours (the callers count the
+    /// cells they try: the budget of [`resume`]).
     tried: u32,
 }
 
@@ -393,7 +399,6 @@ impl Settle<'_, '_> {
     fn at(&mut self, dead: &mut [u32], ci: usize) {
         let grid = *self.moves.grid();
         let (m, o, si, gi) = (self.moves, self.offsets, self.si, self.gi);
-        self.tried = self.tried.saturating_add(1);
         if !try_prune(m, o, si, gi, dead, ci, grid.point(ci)) {
             return;
         }
@@ -404,7 +409,7 @@ impl Settle<'_, '_> {
             top = top.wrapping_sub(1);
             let Some(&u) = self.stack.get(top) else { break };
             let u = u as usize;
-            self.tried = self.tried.saturating_add(1);
+            self.tried = self.tried.wrapping_add(1);
             if try_prune(m, o, si, gi, dead, u, grid.point(u)) {
                 self.touched.add(grid.point(u));
                 self.full |= push_neighbours(m, o, u, self.stack, &mut top);
