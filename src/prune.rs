@@ -138,7 +138,10 @@ pub fn resume(
     // tried (issue 27: the full scan was 5 M instructions of a 256 x 256 plan on the Cortex-M4).
     if !at.again && w > 0 {
         // One division on entering; the windows then step `x0` and `y`.
-        let (mut y, mut x0) = (next / w, next % w);
+        let (mut y, mut x0) = (
+            next.checked_div(w).unwrap_or(0),
+            next.checked_rem(w).unwrap_or(0),
+        );
         loop {
             if x0 >= w {
                 (y, x0) = (y.wrapping_add(1), 0);
