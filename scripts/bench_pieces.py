@@ -29,6 +29,7 @@ MAPS = [
     ("maps/depot-r20.map", (14, 10), (590, 294)),
     ("maps/large/maze512-1-0.map", (40, 125), (502, 437)),
     ("maps/large/Sydney_0_1024.map", None, None),
+    ("maps/large/maze-128-128-2.map", (86, 122), (17, 99)),  # its longest scenario (random-1)
 ]
 LINE = re.compile(r"plan (\d+): (\d+) iterations, .* (\d+) ticks \(new \d+, steps \d+, finish \d+\), "
                   r"largest piece (\d+) ticks \((\w+); new (\d+), setup (\d+) (\w*), "

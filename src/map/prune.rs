@@ -66,11 +66,51 @@ pub fn prune(
     dead: &mut [u32],
     stack: &mut [u32],
 ) -> u32 {
+    let mut at = begin(moves, dead);
+    loop {
+        if let Some(n) = resume(moves, start, goal, dead, stack, &mut at, u32::MAX) {
+            return n;
+        }
+    }
+}
+
+/// Where a pruning in pieces ([`begin`], [`resume`]) paused: 8 bytes, kept by the run between
+/// its pieces. The stack is empty between two cells, so nothing else carries over.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Pruning {
+    /// The next cell: the first of a 32-cell window in the first pass, the next cell in a full
+    /// pass.
+    next: u32,
+    /// In the full passes (a full stack dropped some neighbours).
+    again: bool,
+    /// The stack was too short for some neighbours in the pass under way.
+    full: bool,
+}
+
+/// Start a pruning in pieces: clear `dead` (as [`prune`] does).
+pub fn begin(moves: &Moves<'_>, dead: &mut [u32]) -> Pruning {
+    bitmap::clear(dead, moves.grid().cells());
+    Pruning::default()
+}
+
+/// Go on with the pruning [`begin`] started until it ends (`Some(cells marked)`: the same marks
+/// as [`prune`], bit for bit, since the result does not depend on the order) or about `budget`
+/// cells were tried (`None`: call again with the same `at`). The budget is checked between two
+/// 32-cell windows of the first pass and between two cells of a full pass; the depth-first
+/// settling of one pruned cell runs to its end (its stack is empty between two cells).
+pub fn resume(
+    moves: &Moves<'_>,
+    start: Point,
+    goal: Point,
+    dead: &mut [u32],
+    stack: &mut [u32],
+    at: &mut Pruning,
+    budget: u32,
+) -> Option<u32> {
     let grid = *moves.grid();
     let cells = grid.cells();
-    bitmap::clear(dead, cells);
     if dead.len() < bitmap::words(cells) {
-        return 0;
+        return Some(0);
     }
     let offsets = grid.offsets();
     let (si, gi) = (grid.index(start), grid.index(goal));
@@ -84,9 +124,11 @@ pub fn prune(
         si,
         gi,
         stack,
-        full: false,
+        full: at.full,
         touched: &mut touched,
+        tried: 0,
     };
+    let mut next = at.next as usize;
     // The first pass tries only the cells that could be prunable on the map as it is, before any
     // mark: a cell with free cells on two opposite sides (west and east, or north and south) is
     // not (those two are two cells apart, so its neighbourhood is no clique). Skipping the others
@@ -94,10 +136,27 @@ pub fn prune(
     // the cell onto the stack, where it is tried with its neighbourhood as it then is. The test
     // is 32 cells at a time (`Grid::free_window`): on a city map about one free cell in ten is
     // tried (issue 27: the full scan was 5 M instructions of a 256 x 256 plan on the Cortex-M4).
-    for y in 0..h {
-        let row = y.wrapping_mul(w);
-        let mut x0 = 0usize;
-        while x0 < w {
+    if !at.again && w > 0 {
+        // One division on entering; the windows then step `x0` and `y`.
+        let (mut y, mut x0) = (
+            next.checked_div(w).unwrap_or(0),
+            next.checked_rem(w).unwrap_or(0),
+        );
+        loop {
+            if x0 >= w {
+                (y, x0) = (y.wrapping_add(1), 0);
+            }
+            if y >= h {
+                at.again = true;
+                next = cells;
+                break;
+            }
+            if settle.tried >= budget {
+                at.next = y.wrapping_mul(w).wrapping_add(x0) as u32; // a cell index: < 2^32
+                at.full = settle.full;
+                return None;
+            }
+            let row = y.wrapping_mul(w);
             let free = grid.free_window(y, x0);
             let north = if y > 0 {
                 grid.free_window(y.wrapping_sub(1), x0)
@@ -112,27 +171,51 @@ pub fn prune(
             // Bit j is column x0 - 1 + j.
             let run = grid.run_bits(x0);
             let mut m = free & !((free << 1) & (free >> 1)) & !(north & south) & run;
+            // A window's test counts as a try: the budget bounds the scan too.
+            settle.tried = settle.tried.wrapping_add(1);
             while m != 0 {
                 let j = m.trailing_zeros() as usize;
                 m &= m.wrapping_sub(1);
                 // j >= 1: column x0 - 1 + j.
                 settle.at(dead, row.wrapping_add(x0).wrapping_add(j).wrapping_sub(1));
+                settle.tried = settle.tried.wrapping_add(1);
             }
             x0 = x0.wrapping_add(32);
         }
     }
     // A full stack dropped some neighbours: a pass over every free cell finds what they would
-    // have, as many times as it takes.
-    while settle.full {
-        settle.full = false;
-        for ci in 0..cells {
+    // have, as many times as it takes (`next == cells`: a pass ended). The budget is checked
+    // every `FULL_CHUNK` cells (each counts as a try).
+    const FULL_CHUNK: usize = 64;
+    loop {
+        if next >= cells {
+            if !settle.full {
+                break;
+            }
+            settle.full = false;
+            next = 0;
+        }
+        if settle.tried >= budget {
+            at.next = next as u32; // a cell index: < 2^32
+            at.full = settle.full;
+            return None;
+        }
+        let stop = next.saturating_add(FULL_CHUNK).min(cells);
+        for ci in next..stop {
             // Blocked cells are never pruned: skip them before computing anything.
             if !grid.blocked_at(ci) {
                 settle.at(dead, ci);
             }
         }
+        settle.tried = settle.tried.wrapping_add(FULL_CHUNK as u32);
+        next = stop;
     }
-    bitmap::count(dead, cells)
+    *at = Pruning {
+        next: cells as u32,
+        again: true,
+        full: false,
+    };
+    Some(bitmap::count(dead, cells))
 }
 
 /// A rectangle of cells, corners included: `(top-left, bottom-right)`.
@@ -255,6 +338,7 @@ pub fn repair(
         stack: rest,
         full: false,
         touched: &mut touched,
+        tried: 0,
     };
     for &ci in list.iter() {
         settle.at(dead, ci as usize);
@@ -309,6 +393,9 @@ struct Settle<'m, 's> {
     /// The stack was too short for some neighbours.
     full: bool,
     touched: &'s mut Bounds,
+    /// Cells tried so far by the settling of pruned cells' neighbours (the callers count the
+    /// cells they try: the budget of [`resume`]).
+    tried: u32,
 }
 
 impl Settle<'_, '_> {
@@ -325,6 +412,7 @@ impl Settle<'_, '_> {
             top = top.wrapping_sub(1);
             let Some(&u) = self.stack.get(top) else { break };
             let u = u as usize;
+            self.tried = self.tried.wrapping_add(1);
             if try_prune(m, o, si, gi, dead, u, grid.point(u)) {
                 self.touched.add(grid.point(u));
                 self.full |= push_neighbours(m, o, u, self.stack, &mut top);
@@ -631,6 +719,55 @@ mod tests {
             }
         }
         assert!(marked > 1000, "the maps had little to prune: {marked}");
+    }
+
+    #[test]
+    fn pruning_in_pieces_marks_what_one_piece_marks() {
+        // `resume` with budgets of 1 to 50 tries (a pause after nearly every window and cell,
+        // in the first pass and in the full passes a short stack needs) marks what `prune`
+        // marks in one call, and pauses at least once a budget on maps with anything to try.
+        let mut rng = crate::rng::Xoshiro128pp::from_u64(5);
+        let mut paused = 0u32;
+        for &(w, h) in &[(7u16, 5u16), (33, 20), (64, 64), (95, 41)] {
+            for density in [2u32, 5] {
+                let cells = usize::from(w) * usize::from(h);
+                let mut b = vec![0u8; cells.div_ceil(8)];
+                for i in 0..cells {
+                    if rng.next_word() % 16 < density {
+                        b[i / 8] |= 1 << (i % 8);
+                    }
+                }
+                let (st, go) = (Point::new(0, 0), Point::new(w - 1, h - 1));
+                for p in [st, go] {
+                    let i = usize::from(p.y) * usize::from(w) + usize::from(p.x);
+                    b[i / 8] &= !(1 << (i % 8));
+                }
+                let grid = Grid::new(w, h, &b).unwrap();
+                let moves = Moves::new(grid, &[]);
+                let words = bitmap::words(cells);
+                for stack in [0usize, 3, 4 * cells] {
+                    let mut whole = vec![0u32; words];
+                    let n = prune(&moves, st, go, &mut whole, &mut vec![0u32; stack]);
+                    for budget in [1u32, 2, 7, 50] {
+                        let mut dead = vec![!0u32; words];
+                        let mut scratch = vec![0u32; stack];
+                        let mut at = begin(&moves, &mut dead);
+                        let m = loop {
+                            match resume(&moves, st, go, &mut dead, &mut scratch, &mut at, budget) {
+                                Some(m) => break m,
+                                None => paused += 1,
+                            }
+                        };
+                        assert_eq!(
+                            (m, &dead),
+                            (n, &whole),
+                            "{w} x {h} {density} {stack} {budget}"
+                        );
+                    }
+                }
+            }
+        }
+        assert!(paused > 1000, "the pruning hardly paused: {paused}");
     }
 
     /// Marks of `rows` pruned from scratch for `s`, `g`, as rows of `x` / `.` / `#`.

@@ -176,8 +176,8 @@ enum Setup {
     /// The flood fill (is the goal reachable at all?), for dying ants only: backtracking ants
     /// prove an unreachable goal themselves (`setup.rs`).
     Reach,
-    /// Dead-end pruning ([`Params::prune`]).
-    Prune,
+    /// Dead-end pruning ([`Params::prune`]): where it paused (`None`: not started).
+    Prune(Option<crate::map::prune::Pruning>),
     /// The coarse route on large maps: its search where it paused (`None`: not started).
     Route(Option<route::Searching>),
 }
@@ -459,7 +459,7 @@ impl<'g, 'a> Run<'g, 'a> {
     pub fn piece(&self) -> &'static str {
         match &self.phase {
             Phase::Setup(Setup::Reach) => "reach",
-            Phase::Setup(Setup::Prune) => "prune",
+            Phase::Setup(Setup::Prune(_)) => "prune",
             Phase::Setup(Setup::Route(_)) => "route",
             Phase::Colony(w) => w.piece(),
             Phase::Polish(Polish::Start) => "lay",

@@ -7,7 +7,7 @@
 use crate::colony::ant::DeadEnd;
 use crate::colony::route;
 use crate::map::grid::{Moves, Reach};
-use crate::map::prune::{self, prune};
+use crate::map::prune;
 
 use super::{Area, End, Phase, Run, Setup};
 
@@ -15,6 +15,12 @@ use super::{Area, End, Phase, Run, Setup};
 /// cells' links: a few thousand instructions a block). Measured under `-icount`
 /// (`scripts/bench_pieces.py`): a piece stays below 1 M instructions.
 const ROUTE_BLOCKS: u32 = 160;
+
+/// Cells the pruning from scratch tries in one piece of [`Run::poll`] (`prune::resume`: a
+/// 32-cell window of the first pass counts as one; a few hundred instructions each, the settling
+/// of a pruned cell's dead branch included). Measured under `-icount`
+/// (`scripts/bench_pieces.py`).
+const PRUNE_TRIES: u32 = 2_000;
 
 impl Run<'_, '_> {
     /// The coarse route's search ended (`Ok(Some(_))`), was not wanted (`Ok(None)`) or found no
@@ -68,9 +74,9 @@ impl Run<'_, '_> {
                     self.phase = Phase::Ended(End::NoPath);
                     return;
                 }
-                self.phase = Phase::Setup(Setup::Prune);
+                self.phase = Phase::Setup(Setup::Prune(None));
             }
-            Setup::Prune => {
+            Setup::Prune(at) => {
                 // A workspace without pruning marks (`dead` empty) plans without pruning.
                 self.pruned = if p.prune && !ws.dead.is_empty() {
                     let moves = Moves::new(*grid, ws.moves);
@@ -95,13 +101,20 @@ impl Run<'_, '_> {
                             self.relinked &= !r.rebuilt;
                             r.pruned
                         }
-                        None => prune(
-                            &moves,
-                            self.start,
-                            self.goal,
-                            ws.dead,
-                            ws.idle.prune_stack(),
-                        ),
+                        // From scratch, at most `PRUNE_TRIES` cells tried a piece.
+                        None => {
+                            let mut at = at.unwrap_or_else(|| prune::begin(&moves, ws.dead));
+                            let stack = ws.idle.prune_stack();
+                            let (s, g) = (self.start, self.goal);
+                            match prune::resume(&moves, s, g, ws.dead, stack, &mut at, PRUNE_TRIES)
+                            {
+                                Some(n) => n,
+                                None => {
+                                    self.phase = Phase::Setup(Setup::Prune(Some(at)));
+                                    return;
+                                }
+                            }
+                        }
                     }
                 } else {
                     crate::map::bitmap::clear(ws.dead, grid.cells());
