@@ -13,8 +13,9 @@ use super::{Area, End, Phase, Run, Setup};
 
 /// Blocks the coarse route's search closes in one piece of [`Run::poll`] (each reads its border
 /// cells' links: a few thousand instructions a block). Measured under `-icount`
-/// (`scripts/bench_pieces.py`): a piece stays below 1 M instructions.
-const ROUTE_BLOCKS: u32 = 160;
+/// (`scripts/bench_pieces.py`): at 160 blocks a piece Sydney's route (H743 twin) took 1.24 M
+/// instructions; at 112 the largest route piece is 0.57 M on NewYork, 0.59 M on the depot.
+const ROUTE_BLOCKS: u32 = 112;
 
 /// Cells the pruning from scratch tries in one piece of [`Run::poll`] (`prune::resume`: a
 /// 32-cell window of the first pass counts as one; a few hundred instructions each, the settling
