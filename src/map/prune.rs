@@ -696,17 +696,7 @@ mod tests {
             for density in [2u32, 4, 6] {
                 for _ in 0..4 {
                     let cells = usize::from(w) * usize::from(h);
-                    let mut b = vec![0u8; cells.div_ceil(8)];
-                    for i in 0..cells {
-                        if rng.next_word() % 16 < density {
-                            b[i / 8] |= 1 << (i % 8);
-                        }
-                    }
-                    let (st, go) = (Point::new(0, 0), Point::new(w - 1, h - 1));
-                    for p in [st, go] {
-                        let i = usize::from(p.y) * usize::from(w) + usize::from(p.x);
-                        b[i / 8] &= !(1 << (i % 8));
-                    }
+                    let (b, st, go) = corner_to_corner(&mut rng, w, h, density);
                     let grid = Grid::new(w, h, &b).unwrap();
                     let moves = Moves::new(grid, &[]);
                     let words = bitmap::words(cells);
@@ -721,6 +711,29 @@ mod tests {
         assert!(marked > 1000, "the maps had little to prune: {marked}");
     }
 
+    /// A random `w` x `h` map, a cell blocked with probability `density / 16`, and its corner
+    /// pair (0, 0) -> (w - 1, h - 1), both free.
+    fn corner_to_corner(
+        rng: &mut crate::rng::Xoshiro128pp,
+        w: u16,
+        h: u16,
+        density: u32,
+    ) -> (Vec<u8>, Point, Point) {
+        let cells = usize::from(w) * usize::from(h);
+        let mut b = vec![0u8; cells.div_ceil(8)];
+        for i in 0..cells {
+            if rng.next_word() % 16 < density {
+                b[i / 8] |= 1 << (i % 8);
+            }
+        }
+        let (st, go) = (Point::new(0, 0), Point::new(w - 1, h - 1));
+        for p in [st, go] {
+            let i = usize::from(p.y) * usize::from(w) + usize::from(p.x);
+            b[i / 8] &= !(1 << (i % 8));
+        }
+        (b, st, go)
+    }
+
     #[test]
     fn pruning_in_pieces_marks_what_one_piece_marks() {
         // `resume` with budgets of 1 to 50 tries (a pause after nearly every window and cell,
@@ -731,17 +744,7 @@ mod tests {
         for &(w, h) in &[(7u16, 5u16), (33, 20), (64, 64), (95, 41)] {
             for density in [2u32, 5] {
                 let cells = usize::from(w) * usize::from(h);
-                let mut b = vec![0u8; cells.div_ceil(8)];
-                for i in 0..cells {
-                    if rng.next_word() % 16 < density {
-                        b[i / 8] |= 1 << (i % 8);
-                    }
-                }
-                let (st, go) = (Point::new(0, 0), Point::new(w - 1, h - 1));
-                for p in [st, go] {
-                    let i = usize::from(p.y) * usize::from(w) + usize::from(p.x);
-                    b[i / 8] &= !(1 << (i % 8));
-                }
+                let (b, st, go) = corner_to_corner(&mut rng, w, h, density);
                 let grid = Grid::new(w, h, &b).unwrap();
                 let moves = Moves::new(grid, &[]);
                 let words = bitmap::words(cells);
