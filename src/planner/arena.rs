@@ -91,28 +91,79 @@ pub struct Carved<'a> {
     pub compact: bool,
 }
 
+/// Every buffer's length in a layout, in the order [`lay`] takes them: written once, summed by
+/// [`full_words`] and [`compact_words`], and taken by [`lay`], so the sizes an arena is checked
+/// against are the ones it is cut into.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Sizes {
+    /// Words of the map's bits, and of the tabu set (a bit a cell each).
+    map: usize,
+    /// Words of the pruning marks (none in the compact layout).
+    dead: usize,
+    /// Pheromone entries, of `tau` and of `delta` each (four words an entry).
+    blocks: usize,
+    /// Words of the coarse route (a word a block, or packed).
+    guide: usize,
+    /// Links.
+    links: usize,
+    /// Path cells (a word each); the two tours take as many bytes each.
+    cells: usize,
+    /// Bytes of the move table.
+    moves: usize,
+}
+
+impl Sizes {
+    /// The layout of a map of `cells` cells with paths of `steps` steps (saturating).
+    const fn of(cells: usize, steps: usize, compact: bool) -> Self {
+        let w = words(cells);
+        let n = steps.saturating_add(1);
+        if compact {
+            Self {
+                map: w,
+                dead: 0,
+                blocks: COMPACT_BLOCKS,
+                guide: packed_words(GUIDE_BLOCKS),
+                links: compact_links(cells, steps),
+                cells: n,
+                moves: 0,
+            }
+        } else {
+            Self {
+                map: w,
+                dead: w,
+                blocks: if cells < BLOCKS { cells } else { BLOCKS },
+                guide: GUIDE_BLOCKS,
+                links: LINKS,
+                cells: n,
+                moves: if cells <= MOVES { cells } else { 0 },
+            }
+        }
+    }
+
+    /// Its words in all (saturating): each buffer rounded up to whole words, as [`take_as`]
+    /// takes it.
+    const fn words(self) -> usize {
+        self.map
+            .saturating_mul(2)
+            .saturating_add(self.dead)
+            .saturating_add(self.blocks.saturating_mul(8))
+            .saturating_add(self.guide)
+            .saturating_add(self.links)
+            .saturating_add(self.cells)
+            .saturating_add(self.cells.saturating_mul(2).div_ceil(4))
+            .saturating_add(self.moves.div_ceil(4))
+    }
+}
+
 /// Words the full layout takes for a map of `cells` cells and paths of `steps` steps (saturating).
 pub const fn full_words(cells: usize, steps: usize) -> usize {
-    let w = words(cells);
-    let pheromone = if cells < BLOCKS { cells } else { BLOCKS };
-    let moves = if cells <= MOVES { cells.div_ceil(4) } else { 0 };
-    w.saturating_mul(3)
-        .saturating_add(pheromone.saturating_mul(8))
-        .saturating_add(GUIDE_BLOCKS)
-        .saturating_add(LINKS)
-        .saturating_add(path_words(steps))
-        .saturating_add(moves)
+    Sizes::of(cells, steps, false).words()
 }
 
 /// Words the compact layout takes for a map of `cells` cells and paths of `steps` steps
 /// (saturating).
 pub const fn compact_words(cells: usize, steps: usize) -> usize {
-    words(cells)
-        .saturating_mul(2)
-        .saturating_add(COMPACT_BLOCKS.saturating_mul(8))
-        .saturating_add(packed_words(GUIDE_BLOCKS))
-        .saturating_add(compact_links(cells, steps))
-        .saturating_add(path_words(steps))
+    Sizes::of(cells, steps, true).words()
 }
 
 /// Links of the compact layout: the most any phase borrows beside the tabu set
@@ -149,13 +200,6 @@ const fn max(a: usize, b: usize) -> usize {
     } else {
         b
     }
-}
-
-/// Words of the path cells and the two tours for paths of `steps` steps: `steps + 1` cells of a
-/// word, `2 (steps + 1)` bytes of tours.
-const fn path_words(steps: usize) -> usize {
-    let n = steps.saturating_add(1);
-    n.saturating_add(n.saturating_mul(2).div_ceil(4))
 }
 
 /// The most cells an arena of `arena` words plans at full resolution: every map of at most this
@@ -201,25 +245,22 @@ const fn fits_compact(arena: usize, w: usize) -> bool {
 }
 
 /// The smallest tabu-set length above `x` at which the compact layout's links change (what the
-/// tabu set lends: the local search's slices, the route's words and heap, the smoothing's links).
+/// tabu set lends: the local search's slices, the route's words and heap, the smoothing's links):
+/// the cuts of the lending rules themselves ([`lend::cuts`]).
 const fn next_cut(x: usize) -> usize {
-    let cuts = [
+    let cuts = lend::cuts(
         REFINE_WORDS,
-        REFINE_WORDS.saturating_mul(2),
-        SHORT_REFINE_WORDS.saturating_mul(2),
+        SHORT_REFINE_WORDS,
         GUIDE_BLOCKS,
-        GUIDE_BLOCKS.saturating_mul(2),
         MIN_STEPS.saturating_add(1),
-    ];
+    );
     let mut best = usize::MAX / 64;
-    // A const fn: the six candidates by hand.
-    let [a, b, c, d, e, f] = cuts;
-    best = min_above(best, a, x);
-    best = min_above(best, b, x);
-    best = min_above(best, c, x);
-    best = min_above(best, d, x);
-    best = min_above(best, e, x);
-    min_above(best, f, x)
+    let mut rest: &[usize] = &cuts;
+    while let [c, tail @ ..] = rest {
+        best = min_above(best, *c, x);
+        rest = tail;
+    }
+    best
 }
 
 /// `c` if it lies above `x` and below `best`, else `best`.
@@ -296,33 +337,18 @@ pub fn carve(arena: &mut [u32], cells: usize, max_steps: usize) -> Result<Carved
 
 /// [`carve`]'s layout, in the order of the module docs' table.
 fn lay(mut rest: &mut [u32], cells: usize, steps: usize, compact: bool) -> Option<Carved<'_>> {
-    let n = steps.checked_add(1)?;
-    let w = words(cells);
-    let map = take_as::<u8>(&mut rest, w.checked_mul(4)?)?;
-    let tabu = take(&mut rest, w)?;
-    let (dead, blocks, links, guide) = if compact {
-        let guide = packed_words(GUIDE_BLOCKS);
-        (
-            &mut [][..],
-            COMPACT_BLOCKS,
-            compact_links(cells, steps),
-            guide,
-        )
-    } else {
-        (take(&mut rest, w)?, cells.min(BLOCKS), LINKS, GUIDE_BLOCKS)
-    };
-    let tau = take_as::<[f32; 4]>(&mut rest, blocks)?;
-    let delta = take_as::<[f32; 4]>(&mut rest, blocks)?;
-    let guide = take(&mut rest, guide)?;
-    let links = take(&mut rest, links)?;
-    let points = take_as::<Point>(&mut rest, n)?;
-    let tours = take_as::<Dir>(&mut rest, n.checked_mul(2)?)?;
-    let (tour, best) = tours.split_at_mut_checked(n)?;
-    let moves = if !compact && cells <= MOVES {
-        take_as::<u8>(&mut rest, cells)?
-    } else {
-        &mut []
-    };
+    let size = Sizes::of(cells, steps, compact);
+    let map = take_as::<u8>(&mut rest, size.map.checked_mul(4)?)?;
+    let tabu = take(&mut rest, size.map)?;
+    let dead = take(&mut rest, size.dead)?;
+    let tau = take_as::<[f32; 4]>(&mut rest, size.blocks)?;
+    let delta = take_as::<[f32; 4]>(&mut rest, size.blocks)?;
+    let guide = take(&mut rest, size.guide)?;
+    let links = take(&mut rest, size.links)?;
+    let points = take_as::<Point>(&mut rest, size.cells)?;
+    let tours = take_as::<Dir>(&mut rest, size.cells.checked_mul(2)?)?;
+    let (tour, best) = tours.split_at_mut_checked(size.cells)?;
+    let moves = take_as::<u8>(&mut rest, size.moves)?;
     let ws = Workspace::new(Buffers {
         tau,
         delta,

@@ -112,7 +112,7 @@ impl Idle<'_> {
         Some((words, heap))
     }
 
-    /// A packed route of `count` blocks: the words and heap to build it in ([`route`], the table
+    /// A packed route of `count` blocks: the words and heap to build it in ([`route_take`], the table
     /// above) and the words to pack it into; `None` for a word-a-block route or without room.
     pub(super) fn packed_route<'g>(
         &'g mut self,
@@ -122,7 +122,9 @@ impl Idle<'_> {
         let Guide::Packed(out) = guide else {
             return None;
         };
-        Some((route(self.tabu, self.cells, self.links, count)?, out))
+        let lent = Lent::new(self.links, self.tabu, self.cells, &mut []);
+        let take = route_take(lent.lengths(), count)?;
+        Some((lent.take(take)?, out))
     }
 }
 
@@ -163,7 +165,7 @@ pub(super) struct Spent<'w> {
 }
 
 impl Spent<'_> {
-    /// The local search's two slices on a large map ([`refine`], the table above): the links,
+    /// The local search's two slices on a large map ([`refine_take`], the table above): the links,
     /// the route's words (`guide`, stashed first if kept) and the tabu set.
     pub(super) fn refine<'g>(
         &'g mut self,
@@ -171,13 +173,9 @@ impl Spent<'_> {
         words: usize,
         fewest: usize,
     ) -> Option<(&'g mut [u32], &'g mut [u32])> {
-        refine(
-            self.links,
-            guide.reborrow().scratch(),
-            self.tabu,
-            words,
-            fewest,
-        )
+        let lent = Lent::new(self.links, self.tabu, &mut [], guide.reborrow().scratch());
+        let take = refine_take(lent.lengths(), words, fewest)?;
+        lent.take(take)
     }
 
     /// The local search's two slices on a small map: two slices of `words` of the links
@@ -187,15 +185,19 @@ impl Spent<'_> {
         (a, rest.get_mut(..words).unwrap_or_default())
     }
 
-    /// The detour's scratch of a reused answer's repair ([`detour`], the table above): the
+    /// The detour's scratch of a reused answer's repair ([`detour_take`], the table above): the
     /// longest two slices the links, the route's words (`guide`) and the tabu set give.
     pub(super) fn detour<'g>(&'g mut self, guide: &'g mut Guide<'_>) -> Pair<'g> {
-        detour(self.links, guide.reborrow().scratch(), self.tabu)
+        let lent = Lent::new(self.links, self.tabu, &mut [], guide.reborrow().scratch());
+        let take = detour_take(lent.lengths());
+        lent.take(take).unwrap_or_default()
     }
 
-    /// The smoothing's links for a raw path of `n` cells ([`smoothing`]).
+    /// The smoothing's links for a raw path of `n` cells ([`smoothing_take`]).
     pub(super) fn smoothing(&mut self, n: usize) -> &mut [u32] {
-        smoothing(self.links, self.tabu, n)
+        let lent = Lent::new(self.links, self.tabu, &mut [], &mut []);
+        let take = smoothing_take(lent.lengths(), n);
+        lent.take(take).map_or(&mut [], |(links, _)| links)
     }
 
     /// The links (the corridor search's scratch on small maps).
@@ -248,180 +250,377 @@ impl<'a> Workspace<'a> {
     }
 }
 
-/// Two slices of `words` words from `a` and `b`: one of each, else both from `a`, else both
-/// from `b`; `None` if neither way fits.
-fn two<'x>(
-    a: &'x mut [u32],
-    b: &'x mut [u32],
-    words: usize,
-) -> Option<(&'x mut [u32], &'x mut [u32])> {
-    if a.len() >= words && b.len() >= words {
-        return Some((a.get_mut(..words)?, b.get_mut(..words)?));
+/// A buffer a phase borrows while it is idle.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+pub(super) enum Buf {
+    /// The links.
+    Links,
+    /// The tabu bit set.
+    Tabu,
+    /// The path cells' words (idle before the first ant).
+    Points,
+    /// The route's words (scratch after the colony).
+    Guide,
+}
+
+/// What a phase takes of the idle buffers: each lending rule below chooses one from the
+/// buffers' lengths alone, and [`Take::fits`] says whether those lengths hold it. The rule is
+/// written once: the slices a phase gets ([`Lent::take`]) and the links an arena must lay out
+/// for it (the `*_links` functions) are both derived from it.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+pub(super) enum Take {
+    /// The first `words` words of each of two buffers.
+    Pair(Buf, Buf, usize),
+    /// Two slices of `words` words one after the other in one buffer.
+    Halves(Buf, usize),
+    /// One buffer, whole (the second slice empty).
+    Whole(Buf),
+}
+
+/// The lengths, in words, of the idle buffers a rule chooses among.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+pub(super) struct Lengths {
+    pub(super) links: usize,
+    pub(super) tabu: usize,
+    pub(super) points: usize,
+    pub(super) guide: usize,
+}
+
+impl Lengths {
+    const fn of(self, b: Buf) -> usize {
+        match b {
+            Buf::Links => self.links,
+            Buf::Tabu => self.tabu,
+            Buf::Points => self.points,
+            Buf::Guide => self.guide,
+        }
     }
-    let from = if a.len() >= words { a } else { b };
-    let (x, y) = from.split_at_mut_checked(words)?;
-    Some((x, y.get_mut(..words)?))
+}
+
+impl Take {
+    /// Whether buffers of these lengths hold it.
+    pub(super) const fn fits(self, l: Lengths) -> bool {
+        match self {
+            Take::Pair(a, b, words) => {
+                !matches!(
+                    (a, b),
+                    (Buf::Links, Buf::Links)
+                        | (Buf::Tabu, Buf::Tabu)
+                        | (Buf::Points, Buf::Points)
+                        | (Buf::Guide, Buf::Guide)
+                ) && l.of(a) >= words
+                    && l.of(b) >= words
+            }
+            Take::Halves(a, words) => l.of(a) >= words.saturating_mul(2),
+            Take::Whole(_) => true,
+        }
+    }
+
+    /// Words of its shorter slice.
+    pub(super) const fn words(self, l: Lengths) -> usize {
+        match self {
+            Take::Pair(_, _, words) | Take::Halves(_, words) => words,
+            Take::Whole(b) => l.of(b),
+        }
+    }
+
+    /// `Some(self)` when buffers of these lengths hold it.
+    const fn within(self, l: Lengths) -> Option<Take> {
+        if self.fits(l) {
+            Some(self)
+        } else {
+            None
+        }
+    }
+}
+
+/// The idle buffers themselves, to lend what a [`Take`] says.
+pub(super) struct Lent<'x> {
+    /// Indexed by [`Buf`]: each is handed out at most once.
+    bufs: [Option<&'x mut [u32]>; 4],
+}
+
+impl<'x> Lent<'x> {
+    pub(super) fn new(
+        links: &'x mut [u32],
+        tabu: &'x mut [u32],
+        points: &'x mut [u32],
+        guide: &'x mut [u32],
+    ) -> Self {
+        Self {
+            bufs: [Some(links), Some(tabu), Some(points), Some(guide)],
+        }
+    }
+
+    /// Their lengths.
+    pub(super) fn lengths(&self) -> Lengths {
+        let len = |b: Buf| {
+            self.bufs
+                .get(b as usize)
+                .and_then(|x| x.as_ref())
+                .map_or(0, |x| x.len())
+        };
+        Lengths {
+            links: len(Buf::Links),
+            tabu: len(Buf::Tabu),
+            points: len(Buf::Points),
+            guide: len(Buf::Guide),
+        }
+    }
+
+    fn buf(&mut self, b: Buf) -> Option<&'x mut [u32]> {
+        self.bufs.get_mut(b as usize)?.take()
+    }
+
+    /// The slices `take` names; `None` when the buffers do not hold it.
+    pub(super) fn take(mut self, take: Take) -> Option<Pair<'x>> {
+        match take {
+            Take::Pair(a, b, words) => {
+                let x = self.buf(a)?.get_mut(..words)?;
+                Some((x, self.buf(b)?.get_mut(..words)?))
+            }
+            Take::Halves(a, words) => {
+                let (x, y) = self.buf(a)?.split_at_mut_checked(words)?;
+                Some((x, y.get_mut(..words)?))
+            }
+            Take::Whole(a) => Some((self.buf(a)?, &mut [])),
+        }
+    }
 }
 
 /// The local search's scratch after the last ant, two slices of `words` words (the table
-/// above), else the tabu set halved when each half holds at least `fewest` words (a smaller
-/// window, [`crate::polish::refine::Scratch::side`]); `None`: not enough.
-pub(super) fn refine<'x>(
-    links: &'x mut [u32],
-    guide: &'x mut [u32],
-    tabu: &'x mut [u32],
-    words: usize,
-    fewest: usize,
-) -> Option<(&'x mut [u32], &'x mut [u32])> {
-    let fits = |a: usize, b: usize| {
-        a >= words && b >= words || a >= words.saturating_mul(2) || b >= words.saturating_mul(2)
-    };
-    match (links.len() >= words, guide.len() >= words) {
-        (true, true) => return Some((links.get_mut(..words)?, guide.get_mut(..words)?)),
-        (false, true) if tabu.len() >= words => {
-            return Some((tabu.get_mut(..words)?, guide.get_mut(..words)?))
-        }
-        _ if fits(links.len(), tabu.len()) => return two(links, tabu, words),
-        _ => {}
+/// above): the links and the route's words, the tabu set and the route's words, the links and
+/// the tabu set (one of each, else both from one), else the tabu set halved when each half
+/// holds at least `fewest` words (a smaller window,
+/// [`crate::polish::refine::Scratch::side`]); `None`: not enough. Reads the links, the tabu set
+/// and the route's words.
+pub(super) const fn refine_take(l: Lengths, words: usize, fewest: usize) -> Option<Take> {
+    if l.links >= words && l.guide >= words {
+        return Some(Take::Pair(Buf::Links, Buf::Guide, words));
     }
-    let half = tabu.len() / 2;
+    if l.links < words && l.guide >= words && l.tabu >= words {
+        return Some(Take::Pair(Buf::Tabu, Buf::Guide, words));
+    }
+    if l.links >= words && l.tabu >= words
+        || l.links >= words.saturating_mul(2)
+        || l.tabu >= words.saturating_mul(2)
+    {
+        return if l.links >= words && l.tabu >= words {
+            Some(Take::Pair(Buf::Links, Buf::Tabu, words))
+        } else if l.links >= words {
+            Some(Take::Halves(Buf::Links, words))
+        } else {
+            Some(Take::Halves(Buf::Tabu, words))
+        };
+    }
+    let half = l.tabu / 2;
     if half < fewest {
-        return None;
+        None
+    } else {
+        Some(Take::Halves(Buf::Tabu, half))
     }
-    let (a, b) = tabu.split_at_mut_checked(half)?;
-    Some((a, b.get_mut(..half)?))
 }
 
 /// A repair's detour scratch between plans, when the links, the route's words and the tabu set are
 /// all idle: of the pairs (links, route), (links, tabu set), (tabu set, route) and of each of the
 /// three halved, the one whose shorter slice is longest (the first in that order on a tie), both
-/// slices cut to that length; two empty slices when every buffer is empty. It depends on the
-/// three lengths only, so host and device lend the same.
-pub(super) fn detour<'x>(
-    links: &'x mut [u32],
-    guide: &'x mut [u32],
-    tabu: &'x mut [u32],
-) -> Pair<'x> {
-    let (l, g, t) = (links.len(), guide.len(), tabu.len());
-    let sizes = [l.min(g), l.min(t), t.min(g), l / 2, t / 2, g / 2];
-    let mut pick = 0usize;
-    let mut words = 0usize;
-    for (k, &w) in sizes.iter().enumerate() {
-        if w > words {
-            (pick, words) = (k, w);
+/// slices cut to that length (empty when every buffer is).
+pub(super) const fn detour_take(l: Lengths) -> Take {
+    let ways = [
+        Take::Pair(Buf::Links, Buf::Guide, min(l.links, l.guide)),
+        Take::Pair(Buf::Links, Buf::Tabu, min(l.links, l.tabu)),
+        Take::Pair(Buf::Tabu, Buf::Guide, min(l.tabu, l.guide)),
+        Take::Halves(Buf::Links, l.links / 2),
+        Take::Halves(Buf::Tabu, l.tabu / 2),
+        Take::Halves(Buf::Guide, l.guide / 2),
+    ];
+    let mut best = Take::Pair(Buf::Links, Buf::Guide, 0);
+    let mut rest: &[Take] = &ways;
+    while let [way, tail @ ..] = rest {
+        if way.words(l) > best.words(l) {
+            best = *way;
         }
+        rest = tail;
     }
-    let cut = |x: &'x mut [u32]| -> &'x mut [u32] { x.get_mut(..words).unwrap_or_default() };
-    let halves = |x: &'x mut [u32]| -> Pair<'x> {
-        let (a, b) = x.split_at_mut(words.min(x.len()));
-        (a, b.get_mut(..words).unwrap_or_default())
-    };
-    match pick {
-        0 => (cut(links), cut(guide)),
-        1 => (cut(links), cut(tabu)),
-        2 => (cut(tabu), cut(guide)),
-        3 => halves(links),
-        4 => halves(tabu),
-        _ => halves(guide),
+    best
+}
+
+const fn min(a: usize, b: usize) -> usize {
+    if a < b {
+        a
+    } else {
+        b
     }
 }
 
-/// Words [`refine`] needs in the links beside a tabu set of `tabu` words (and a route of fewer
-/// than `words` words).
+/// The words and the heap of a packed route of `count` blocks, built before the first ant (the
+/// table above): the tabu set halved, else the tabu set and the path cells' words, else either
+/// of them and the links, else the links halved; `None`: not enough.
+pub(super) const fn route_take(l: Lengths, count: usize) -> Option<Take> {
+    let take = match (l.tabu >= count, l.points >= count) {
+        _ if l.tabu >= count.saturating_mul(2) => Take::Halves(Buf::Tabu, count),
+        (true, true) => Take::Pair(Buf::Tabu, Buf::Points, count),
+        (true, false) => Take::Pair(Buf::Tabu, Buf::Links, count),
+        (false, true) => Take::Pair(Buf::Points, Buf::Links, count),
+        (false, false) => Take::Halves(Buf::Links, count),
+    };
+    take.within(l)
+}
+
+/// The smoothing's links for a raw path of `n` cells: the links when they hold `n`, else the
+/// tabu set when it does, else the links (the greedy rule).
+pub(super) const fn smoothing_take(l: Lengths, n: usize) -> Take {
+    if l.links < n && l.tabu >= n {
+        Take::Whole(Buf::Tabu)
+    } else {
+        Take::Whole(Buf::Links)
+    }
+}
+
+/// Idle buffers of these lengths, with `links` links.
+const fn with_links(links: usize, tabu: usize, points: usize) -> Lengths {
+    Lengths {
+        links,
+        tabu,
+        points,
+        guide: 0,
+    }
+}
+
+/// Words [`refine_take`] needs in the links beside a tabu set of `tabu` words (and a route of
+/// fewer than `words` words): the fewest of 0, `words` and twice `words` that it lends from.
 pub(super) const fn refine_links(tabu: usize, words: usize, fewest: usize) -> usize {
-    if tabu >= words.saturating_mul(2) || tabu / 2 >= fewest {
+    if refine_take(with_links(0, tabu, 0), words, fewest).is_some() {
         0
-    } else if tabu >= words {
+    } else if refine_take(with_links(words, tabu, 0), words, fewest).is_some() {
         words
     } else {
         words.saturating_mul(2)
     }
 }
 
-/// The words and the heap of a packed route of `count` blocks, built before the first ant (the
-/// table above), from the tabu set, the path cells' words (`points`, idle before the first ant)
-/// and the links; `None`: not enough.
-pub(super) fn route<'x>(
-    tabu: &'x mut [u32],
-    points: &'x mut [u32],
-    links: &'x mut [u32],
-    count: usize,
-) -> Option<(&'x mut [u32], &'x mut [u32])> {
-    let (t, p) = (tabu.len() >= count, points.len() >= count);
-    if tabu.len() >= count.checked_mul(2)? {
-        let (a, b) = tabu.split_at_mut_checked(count)?;
-        return Some((a, b.get_mut(..count)?));
-    }
-    match (t, p) {
-        (true, true) => Some((tabu.get_mut(..count)?, points.get_mut(..count)?)),
-        (true, false) => Some((tabu.get_mut(..count)?, links.get_mut(..count)?)),
-        (false, true) => Some((points.get_mut(..count)?, links.get_mut(..count)?)),
-        (false, false) => {
-            let (a, b) = links.split_at_mut_checked(count)?;
-            Some((a, b.get_mut(..count)?))
-        }
-    }
-}
-
-/// Words [`route`] needs in the links beside a tabu set of `tabu` words and `points` words of
-/// path cells for a route of `count` blocks.
+/// Words [`route_take`] needs in the links beside a tabu set of `tabu` words and `points` words
+/// of path cells for a route of `count` blocks: the fewest of 0, `count` and twice `count` that
+/// it lends from.
 pub(super) const fn route_links(tabu: usize, points: usize, count: usize) -> usize {
-    let (t, p) = (tabu >= count, points >= count);
-    if tabu >= count.saturating_mul(2) || t && p {
+    if route_take(with_links(0, tabu, points), count).is_some() {
         0
-    } else if t || p {
+    } else if route_take(with_links(count, tabu, points), count).is_some() {
         count
     } else {
         count.saturating_mul(2)
     }
 }
 
-/// The smoothing's links for a raw path of `n` cells: the links when they hold `n`, else the
-/// tabu set when it does, else the links (the greedy rule).
-pub(super) fn smoothing<'x>(links: &'x mut [u32], tabu: &'x mut [u32], n: usize) -> &'x mut [u32] {
-    if links.len() < n && tabu.len() >= n {
-        tabu
-    } else {
-        links
-    }
-}
-
-/// Words [`smoothing`] needs in the links beside a tabu set of `tabu` words for `n` cells.
+/// Words [`smoothing_take`] needs in the links beside a tabu set of `tabu` words for `n`
+/// cells: 0 when it lends `n` words without them, else `n`.
 pub(super) const fn smoothing_links(tabu: usize, n: usize) -> usize {
-    if tabu >= n {
+    let l = with_links(0, tabu, 0);
+    if smoothing_take(l, n).words(l) >= n {
         0
     } else {
         n
     }
 }
 
+/// The tabu-set lengths at which the rules above change what they need of the links, for the
+/// local search's `words` and `fewest`, a route of `count` blocks and paths of `n` cells (when
+/// the path cells hold `count` words): between two of them every `*_links` above is the same
+/// ([`super::arena::capacity`] walks the tabu lengths piece by piece).
+pub(super) const fn cuts(words: usize, fewest: usize, count: usize, n: usize) -> [usize; 6] {
+    [
+        words,
+        words.saturating_mul(2),
+        fewest.saturating_mul(2),
+        count,
+        count.saturating_mul(2),
+        n,
+    ]
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
+    fn lengths(links: usize, tabu: usize, points: usize, guide: usize) -> Lengths {
+        Lengths {
+            links,
+            tabu,
+            points,
+            guide,
+        }
+    }
+
+    /// Lend `take` from fresh buffers of these lengths: the two slices' lengths.
+    fn lend(l: Lengths, take: Take) -> Option<(usize, usize)> {
+        let (mut a, mut b, mut c, mut d) = (
+            vec![0u32; l.links],
+            vec![0u32; l.tabu],
+            vec![0u32; l.points],
+            vec![0u32; l.guide],
+        );
+        let lent = Lent::new(&mut a, &mut b, &mut c, &mut d);
+        assert_eq!(lent.lengths(), l);
+        lent.take(take).map(|(x, y)| (x.len(), y.len()))
+    }
+
     #[test]
     fn every_lending_fits_what_its_size_says() {
-        // For lengths around the boundaries, `route` and `refine` find their slices exactly
-        // when the sizes say the links suffice, and never return overlapping or short slices.
+        // For lengths around the boundaries, the route and the local search find their slices
+        // exactly when the sizes say the links suffice, and the slices lent are as long as the
+        // rule says (two `&mut` slices never overlap, by type).
         for tabu in [0usize, 10, 99, 100, 150, 199, 200, 500] {
             for links in [0usize, 50, 99, 100, 199, 200, 300] {
-                let (mut t, mut l) = (vec![0u32; tabu], vec![0u32; links]);
-                let need = route_links(tabu, 0, 100);
-                let got = route(&mut t, &mut [], &mut l, 100);
-                assert_eq!(got.is_some(), links >= need, "tabu {tabu} links {links}");
-                if let Some((a, b)) = got {
-                    assert_eq!((a.len(), b.len()), (100, 100));
-                }
-                let mut g = vec![0u32; 7];
-                let got = refine(&mut l, &mut g, &mut t, 100, 60);
+                let l = lengths(links, tabu, 0, 7);
+                let got = route_take(l, 100);
                 assert_eq!(
                     got.is_some(),
-                    links >= refine_links(tabu, 100, 60),
+                    links >= route_links(tabu, 0, 100),
                     "{tabu} {links}"
                 );
+                if let Some(take) = got {
+                    assert_eq!(lend(l, take), Some((100, 100)));
+                }
+                let got = refine_take(l, 100, 60);
+                let need = refine_links(tabu, 100, 60);
+                assert_eq!(got.is_some(), links >= need, "{tabu} {links}");
+                if let Some(take) = got {
+                    let w = take.words(l);
+                    assert!(w == 100 || w >= 60 && w == tabu / 2, "{take:?}");
+                    assert_eq!(lend(l, take), Some((w, w)));
+                }
                 let n = 120;
-                let s = smoothing(&mut l, &mut t, n).len();
+                let take = smoothing_take(l, n);
+                let s = lend(l, take).map_or(0, |(x, _)| x);
                 assert_eq!(s >= n, links >= smoothing_links(tabu, n), "{tabu} {links}");
+            }
+        }
+        // A pair of one buffer with itself is never lent.
+        let l = lengths(10, 10, 10, 10);
+        assert!(!Take::Pair(Buf::Links, Buf::Links, 1).fits(l));
+        assert_eq!(lend(l, Take::Pair(Buf::Tabu, Buf::Tabu, 1)), None);
+        assert_eq!(lend(l, Take::Halves(Buf::Tabu, 6)), None);
+    }
+
+    #[test]
+    fn the_links_change_only_at_the_cuts() {
+        // Between two tabu lengths of `cuts`, every size the arena lays out is the same: the
+        // arena's capacity search relies on it. A rule whose threshold is not a cut fails here.
+        for (words, fewest, count, n) in
+            [(100, 60, 70, 300), (4056, 3456, 4096, 4096), (8, 3, 20, 9)]
+        {
+            let cuts = cuts(words, fewest, count, n);
+            let sizes = |tabu| {
+                (
+                    refine_links(tabu, words, fewest),
+                    route_links(tabu, n, count),
+                    smoothing_links(tabu, n),
+                )
+            };
+            for tabu in 1..3 * (words + count + n) {
+                if !cuts.contains(&tabu) {
+                    assert_eq!(sizes(tabu), sizes(tabu - 1), "{tabu}");
+                }
             }
         }
     }
@@ -429,28 +628,28 @@ mod tests {
     #[test]
     fn a_detour_gets_the_longest_pair_the_idle_buffers_give() {
         // Every pairing against a brute force over the six ways: both slices as long as the best
-        // way's shorter one, and disjoint (two `&mut` borrows of one buffer cannot overlap).
+        // way's shorter one.
         for l in [0usize, 1, 7, 100, 4056, 4096] {
             for g in [0usize, 512, 4096] {
                 for t in [0usize, 2048, 5795, 8192] {
-                    let (mut a, mut b, mut c) = (vec![0u32; l], vec![0u32; g], vec![0u32; t]);
                     let best = [l.min(g), l.min(t), t.min(g), l / 2, t / 2, g / 2]
                         .into_iter()
                         .max()
                         .unwrap();
-                    let (x, y) = detour(&mut a, &mut b, &mut c);
-                    assert_eq!((x.len(), y.len()), (best, best), "{l} {g} {t}");
+                    let len = lengths(l, t, 0, g);
+                    assert_eq!(
+                        lend(len, detour_take(len)),
+                        Some((best, best)),
+                        "{l} {g} {t}"
+                    );
                 }
             }
         }
         // The F411's layouts: the full one (links and route words, 4,096 each) and the compact
         // one at 512 x 512 (its tabu set halved) and at Nav2's depot (the links and the tabu set).
-        let sizes = |l, g, t| {
-            let (mut a, mut b, mut c) = (vec![0u32; l], vec![0u32; g], vec![0u32; t]);
-            detour(&mut a, &mut b, &mut c).0.len()
-        };
-        assert_eq!(sizes(4096, 4096, 2048), 4096);
-        assert_eq!(sizes(2048, 512, 8192), 4096);
-        assert_eq!(sizes(4056, 512, 5795), 4056);
+        let words = |l, g, t| detour_take(lengths(l, t, 0, g)).words(lengths(l, t, 0, g));
+        assert_eq!(words(4096, 4096, 2048), 4096);
+        assert_eq!(words(2048, 512, 8192), 4096);
+        assert_eq!(words(4056, 512, 5795), 4056);
     }
 }
