@@ -45,9 +45,9 @@ impl Map {
             usize::from(width) * usize::from(height),
             "cell count"
         );
-        let mut bits = vec![0u8; blocked.len().div_ceil(8)];
+        let mut bits = vec![0u8; ohaca::map::bits::bytes(blocked.len())];
         for (i, _) in blocked.iter().enumerate().filter(|(_, b)| **b) {
-            bits[i / 8] |= 1 << (i % 8);
+            ohaca::map::bits::set(&mut bits, i, true);
         }
         Map {
             width,
@@ -178,11 +178,7 @@ impl Map {
     pub fn set(&mut self, p: Point, blocked: bool) {
         let i = self.index(p);
         self.blocked[i] = blocked;
-        if blocked {
-            self.bits[i / 8] |= 1 << (i % 8);
-        } else {
-            self.bits[i / 8] &= !(1 << (i % 8));
-        }
+        ohaca::map::bits::set(&mut self.bits, i, blocked);
     }
 
     /// The cells as booleans, row-major, `true` = blocked.

@@ -655,12 +655,9 @@ impl DStarLite {
         let mut flipped = Vec::new();
         for &(p, blocked) in changed {
             let i = usize::from(p.y) * usize::from(w) + usize::from(p.x);
-            if let Some(b) = self.bits.get_mut(i / 8) {
-                let bit = 1u8 << (i % 8);
-                if (*b & bit != 0) != blocked {
-                    *b ^= bit;
-                    flipped.push(p);
-                }
+            if ohaca::map::bits::get(&self.bits, i).is_some_and(|was| was != blocked) {
+                ohaca::map::bits::set(&mut self.bits, i, blocked);
+                flipped.push(p);
             }
         }
         // Every vertex with an out-edge that changed: the flipped cells' 3 x 3 blocks.

@@ -242,7 +242,7 @@ async fn update(u: Update<'_>, blocked: bool) -> Small {
     let mut memory = state::colony();
     let was_blocked = |p: Point| {
         let i = usize::from(p.y) * usize::from(size.0) + usize::from(p.x);
-        map.get(i / 8).is_some_and(|b| b >> (i % 8) & 1 == 1)
+        ohaca::map::bits::get(&map, i).unwrap_or(false)
     };
     let done = match u {
         Update::Rect(x, y, w, h) => {

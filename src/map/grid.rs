@@ -65,7 +65,7 @@ pub struct Grid<'a> {
 
 /// Bytes needed to hold `cells` bits.
 pub const fn bytes_for(cells: usize) -> usize {
-    cells.div_ceil(8)
+    crate::map::bits::bytes(cells)
 }
 
 impl<'a> Grid<'a> {
@@ -137,10 +137,7 @@ impl<'a> Grid<'a> {
     /// True if cell index `i` is blocked; indices outside the map count as blocked.
     #[inline]
     fn blocked_index(&self, i: usize) -> bool {
-        match self.bits.get(i / 8) {
-            Some(b) => (b >> (i % 8)) & 1 == 1,
-            None => true,
-        }
+        crate::map::bits::get(self.bits, i).unwrap_or(true)
     }
 
     /// True if cell index `i` is blocked or beyond the map's bits.

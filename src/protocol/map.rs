@@ -33,44 +33,19 @@ use crate::map::grid::Point;
 /// (id `u32::MAX`) stays within [`super::MAX_REQUEST`].
 pub const MAX_UPDATE_CELLS: usize = 60;
 
-/// Bit `i` of `bits` (false past the end).
+/// Cell `i`'s bit (free past the end): the layout is [`crate::map::bits`]'s.
 fn bit(bits: &[u8], i: u32) -> bool {
-    let byte = bits.get((i / 8) as usize).copied().unwrap_or(0);
-    byte & 1u8.wrapping_shl(i % 8) != 0
+    crate::map::bits::get(bits, i as usize).unwrap_or(false)
 }
 
-/// Set bit `i` of `bits` to `value` (nothing past the end).
+/// Set cell `i`'s bit to `value` (nothing past the end).
 fn put_bit(bits: &mut [u8], i: u32, value: bool) {
-    if let Some(b) = bits.get_mut((i / 8) as usize) {
-        let m = 1u8.wrapping_shl(i % 8);
-        if value {
-            *b |= m;
-        } else {
-            *b &= !m;
-        }
-    }
+    crate::map::bits::set(bits, i as usize, value);
 }
 
-/// Set bits `from .. from + len` to `value`, whole bytes at a time where it can.
+/// Set cells `from .. from + len` to `value`.
 fn fill_bits(bits: &mut [u8], from: u32, len: u32, value: bool) {
-    let end = from.saturating_add(len);
-    let mut i = from;
-    while i < end && i % 8 != 0 {
-        put_bit(bits, i, value);
-        i = i.saturating_add(1);
-    }
-    let whole = end.saturating_sub(i) / 8;
-    if whole > 0 {
-        let (a, b) = ((i / 8) as usize, (i / 8).saturating_add(whole) as usize);
-        if let Some(s) = bits.get_mut(a..b) {
-            s.fill(if value { 0xFF } else { 0 });
-        }
-        i = i.saturating_add(whole.saturating_mul(8));
-    }
-    while i < end {
-        put_bit(bits, i, value);
-        i = i.saturating_add(1);
-    }
+    crate::map::bits::fill(bits, from as usize, len as usize, value);
 }
 
 /// The run-length code of a packed map (see the module docs), one byte at a time: no buffer.

@@ -27,14 +27,12 @@ impl Map {
     /// give a map that [`Map::grid`] rejects.
     pub fn from_fn(width: u16, height: u16, mut blocked: impl FnMut(u16, u16) -> bool) -> Map {
         let cells = usize::from(width) * usize::from(height);
-        let mut bits = vec![0u8; cells.div_ceil(8)];
+        let mut bits = vec![0u8; ohaca::map::bits::bytes(cells)];
         for y in 0..height {
             for x in 0..width {
                 if blocked(x, y) {
                     let i = usize::from(y) * usize::from(width) + usize::from(x);
-                    if let Some(b) = bits.get_mut(i / 8) {
-                        *b |= 1 << (i % 8);
-                    }
+                    ohaca::map::bits::set(&mut bits, i, true);
                 }
             }
         }
@@ -62,7 +60,7 @@ impl Map {
             return true;
         }
         let i = usize::from(p.y) * usize::from(self.width) + usize::from(p.x);
-        self.bits.get(i / 8).is_none_or(|b| (b >> (i % 8)) & 1 == 1)
+        ohaca::map::bits::get(&self.bits, i).unwrap_or(true)
     }
 
     /// Block (`blocked`) or clear cell `p`, with the device's own cell writer

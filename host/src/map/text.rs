@@ -265,14 +265,11 @@ fn build(
             },
         )
     })?;
-    let mut bits = vec![0u8; (w * rows.len()).div_ceil(8)];
+    let mut bits = vec![0u8; ohaca::map::bits::bytes(w * rows.len())];
     for (y, (ln, l)) in rows.iter().enumerate() {
         for (x, c) in l.chars().enumerate() {
             if classify(x + 1, c).map_err(|p| (*ln, p))? {
-                let i = y * w + x;
-                if let Some(b) = bits.get_mut(i / 8) {
-                    *b |= 1 << (i % 8);
-                }
+                ohaca::map::bits::set(&mut bits, y * w + x, true);
             }
         }
     }
