@@ -69,6 +69,10 @@ pub struct PlanReport {
     /// Why no path was found (absent when `found`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub error: Option<String>,
+    /// The steps that ran short of scratch (`ohaca::planner::Shortfalls`, absent when none did:
+    /// always on a board's layout, and from the device, which logs them instead).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shortfalls: Option<String>,
 }
 
 /// `v` with a negative zero made positive: a path of one cell has length `0`, not `-0` (the
@@ -113,6 +117,7 @@ impl PlanReport {
             elapsed_us: micros(elapsed),
             params: plan.params,
             error: None,
+            shortfalls: (!plan.shortfalls.is_empty()).then(|| plan.shortfalls.to_string()),
         }
     }
 
@@ -137,6 +142,7 @@ impl PlanReport {
             elapsed_us: micros(elapsed),
             params: *params,
             error: Some(error.to_string()),
+            shortfalls: None,
         }
     }
 
@@ -307,6 +313,9 @@ pub fn summary(r: &PlanReport) -> String {
     );
     s.push_str(&line);
     s.push('\n');
+    if let Some(short) = &r.shortfalls {
+        let _ = writeln!(s, "ran short of scratch (a cheaper form ran): {short}");
+    }
     s
 }
 
@@ -343,6 +352,7 @@ mod tests {
             elapsed_us: 1500,
             params: Params::default(),
             error: None,
+            shortfalls: None,
         }
     }
 

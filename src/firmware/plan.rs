@@ -193,6 +193,14 @@ async fn plan(
     let t_finish = Instant::now();
     let plan = run.finish()?;
     let t_end = Instant::now();
+    if !plan.shortfalls.is_empty() {
+        // None on the board's own layout (`ohaca::planner::Shortfalls`): said, never silent.
+        defmt::warn!(
+            "plan {}: ran short of scratch: {}",
+            job.id,
+            defmt::Display2Format(&plan.shortfalls)
+        );
+    }
     let ticks = t_end.saturating_duration_since(t0).as_ticks();
     let last = t_end.saturating_duration_since(t_finish).as_ticks();
     if last > largest.0 {

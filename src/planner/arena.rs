@@ -446,8 +446,10 @@ mod tests {
             let mut arena = vec![0u32; ARENA];
             let c = carve(&mut arena, g.cells(), 2047).unwrap();
             assert!(!c.compact);
-            let b = plan(&g, s, goal, &p, c.workspace)
-                .map(|pl| (pl.directions().to_vec(), pl.waypoints().to_vec(), pl.moves));
+            let b = plan(&g, s, goal, &p, c.workspace).map(|pl| {
+                assert!(pl.shortfalls.is_empty(), "{w} x {h}: {}", pl.shortfalls);
+                (pl.directions().to_vec(), pl.waypoints().to_vec(), pl.moves)
+            });
             assert_eq!(a, b, "{w} x {h}");
         }
     }
@@ -593,6 +595,8 @@ mod tests {
             assert_eq!(g.step(pair[0], d), Some(pair[1]));
         }
         assert_eq!(plan.directions().len(), 4000);
+        // The compact layout lends every step all it asks for.
+        assert!(plan.shortfalls.is_empty(), "{}", plan.shortfalls);
         assert!(
             (plan.raw_length - 4000.0).abs() < 1e-3,
             "{}",

@@ -21,6 +21,7 @@
 //! | `lend` | one typed view of the workspace per phase (setup, colony, polish) and what a buffer idle in a phase lends to it |
 //! | `run` | [`Run`]: the loop as a state machine ([`Run::poll`]: setup, walk + update + record, polish) |
 //! | `plan` | [`Plan`], [`RawPath`], [`CurvePoint`]: the result |
+//! | `short` | [`Shortfalls`]: the steps that ran short of scratch, in the result |
 //! | `placed` | [`Placed`], [`Bases`]: where a plan lies in its workspace, to read it again later (the firmware's path parts) |
 //! | `warm` | [`Memory`], [`Area`]: warm starts after map changes, and the pheromone repair |
 //! | `reuse` | [`reuse`]: a replan answered with the rest of the last answer, when no change can block or shorten it; else why not ([`Fallback`]) |
@@ -39,6 +40,7 @@ pub mod quorum;
 mod repair;
 mod reuse;
 mod run;
+mod short;
 mod warm;
 mod workspace;
 
@@ -50,6 +52,7 @@ pub use repair::{
 };
 pub use reuse::{reuse, Fallback};
 pub use run::{settled, Poll, Run, Stage, REFINE_GAIN};
+pub use short::Shortfalls;
 pub use warm::{Area, Memory, BLOCKED, FREED, REPAIR_RADIUS};
 #[cfg(any(feature = "alloc", test))]
 pub(crate) use workspace::OwnedBuffers;

@@ -89,6 +89,9 @@ pub struct Plan<'a> {
     pub moves: u64,
     /// Cells pruned before the ants ran ([`crate::map::prune`]).
     pub pruned: u32,
+    /// The steps that ran short of scratch (none in a workspace the arena or a board's
+    /// `Storage` lays out; [`super::Shortfalls`]).
+    pub shortfalls: super::Shortfalls,
     /// Where the path comes from: a cold run, a warm one ([`super::Run::warm`]), or the rest of
     /// the previous answer ([`super::reuse`]).
     pub origin: Origin,
@@ -118,6 +121,7 @@ impl<'a> Plan<'a> {
             best_iteration: 0,
             moves: 0,
             pruned: 0,
+            shortfalls: super::Shortfalls::NONE,
             origin,
             curve: &[],
             params,

@@ -1013,3 +1013,44 @@ fn walking_the_iterations_best_and_worst_again_plans_what_keeping_them_does() {
     }
     assert!(wolves_seen >= 20, "{wolves_seen}");
 }
+
+#[test]
+fn a_short_workspace_says_which_steps_ran_short() {
+    // A winding corridor of 120 cells on a 12 x 12 map: the smoothing's shortest-path rule needs
+    // a link a cell, which 8 links and a tabu set of 5 words do not hold, so the greedy rule
+    // smooths and the plan says so; with 128 links nothing runs short. Both paths are valid.
+    let mut rows = [[b'#'; 12]; 12];
+    for (y, row) in rows.iter_mut().enumerate() {
+        if y % 2 == 0 {
+            row.fill(b'.');
+        } else {
+            row[if y % 4 == 1 { 11 } else { 0 }] = b'.';
+        }
+    }
+    let rows: Vec<&str> = rows
+        .iter()
+        .map(|r| core::str::from_utf8(r).unwrap())
+        .collect();
+    let (b, w, h) = grid(&rows);
+    let g = Grid::new(w, h, &b).unwrap();
+    let (start, goal) = (Point::new(0, 0), Point::new(0, 10));
+    let p = Params::default();
+    let mut short: Storage<5, 160, 8, 0> = Storage::new();
+    let a = plan(&g, start, goal, &p, short.workspace()).unwrap();
+    assert!(
+        a.shortfalls.contains(Shortfalls::SMOOTHING),
+        "{}",
+        a.shortfalls
+    );
+    let mut full: Storage<5, 160, 160, 0> = Storage::new();
+    let b2 = plan(&g, start, goal, &p, full.workspace()).unwrap();
+    assert!(b2.shortfalls.is_empty(), "{}", b2.shortfalls);
+    for pl in [&a, &b2] {
+        let raw: Vec<Point> = pl.raw().collect();
+        assert_eq!((raw[0], *raw.last().unwrap()), (start, goal));
+        assert!(pl
+            .waypoints()
+            .windows(2)
+            .all(|s| crate::geometry::segment_clear(&g, s[0], s[1])));
+    }
+}

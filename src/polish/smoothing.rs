@@ -172,6 +172,12 @@ impl Smoother {
         }
     }
 
+    /// The rule it smooths with: the one asked for, or the greedy rule when its scratch was
+    /// short ([`Smoother::new`]).
+    pub fn kind(&self) -> SmoothingKind {
+        self.kind
+    }
+
     /// Cells of the raw path it smooths.
     pub fn cells(&self) -> usize {
         self.n

@@ -606,6 +606,7 @@ impl Sender {
             elapsed_us: micros(round_trip),
             params,
             error: None,
+            shortfalls: None,
         };
         Outcome::found(report, Some(path.ticks))
     }

@@ -50,6 +50,7 @@ use super::lend::Guide;
 use super::params::{Algorithm, Params};
 use super::plan::Origin;
 use super::plan::{CurvePoint, Plan};
+use super::short::Shortfalls;
 use super::warm::{self, Answer, Area, Kept, Memory};
 use super::workspace::Workspace;
 use colony::{Best, Walking};
@@ -82,6 +83,8 @@ pub struct Run<'g, 'a> {
     stale: u16,
     moves: u64,
     pruned: u32,
+    /// The steps that ran short of scratch so far ([`crate::planner::Shortfalls`]).
+    short: Shortfalls,
     routed: bool,
     warm: bool,
     /// A warm start's changes since the last run, and what that run kept (see [`Run::keep`]).
@@ -393,6 +396,7 @@ impl<'g, 'a> Run<'g, 'a> {
             stale: 0,
             moves: 0,
             pruned: 0,
+            short: Shortfalls::NONE,
             routed: false,
             warm: warm.is_some(),
             reuse,
@@ -583,6 +587,7 @@ impl<'g, 'a> Run<'g, 'a> {
             iteration,
             moves,
             pruned,
+            short,
             warm,
             phase,
             colony,
@@ -629,6 +634,7 @@ impl<'g, 'a> Run<'g, 'a> {
             best_iteration,
             moves,
             pruned,
+            shortfalls: short,
             origin: if warm { Origin::Warm } else { Origin::Cold },
             curve,
             params,

@@ -14,7 +14,7 @@ use crate::planner::params::Params;
 use crate::planner::plan::RawPath;
 
 use super::colony::Best;
-use super::{End, Phase, Run};
+use super::{End, Phase, Run, Shortfalls};
 use crate::planner::lend::{self, Guide};
 
 /// Window side of the local search ([`Params::refine`]). Its scratch is the links and the coarse
@@ -50,6 +50,15 @@ const REFINE_SLICE: u64 = 1;
 const SMOOTH_SLICE: usize = 4;
 
 /// Words at the end of the pheromone increments that the route's stash holds (the local
+/// `sm`, with [`Shortfalls::SMOOTHING`] noted in `short` when it smooths with a cheaper rule
+/// than `kind` (its links were short).
+fn noted(sm: Smoother, kind: SmoothingKind, short: &mut Shortfalls) -> Smoother {
+    if sm.kind() != kind {
+        short.insert(Shortfalls::SMOOTHING);
+    }
+    sm
+}
+
 /// search's memo stays before them).
 fn stash_tail(stashed: bool, blocks: crate::colony::pheromone::Blocks) -> usize {
     if stashed {
@@ -116,6 +125,9 @@ impl Run<'_, '_> {
                         let out = dist.get_mut(at..).unwrap_or_default();
                         route::stash(self.guide_blocks, words, out)
                     };
+                    if !self.stashed {
+                        self.short.insert(Shortfalls::STASH);
+                    }
                 }
                 let refiner = self
                     .refines
@@ -129,11 +141,10 @@ impl Run<'_, '_> {
                 }
                 Phase::Polish(match refiner {
                     Some(r) => Polish::Refine(r),
-                    None => Polish::Smooth(Smoother::new(
+                    None => Polish::Smooth(noted(
+                        Smoother::new(kind, n, ws.delta.as_flattened_mut(), ws.idle.smoothing(n)),
                         kind,
-                        n,
-                        ws.delta.as_flattened_mut(),
-                        ws.idle.smoothing(n),
+                        &mut self.short,
                     )),
                 })
             }
@@ -141,11 +152,19 @@ impl Run<'_, '_> {
                 // Large maps: the links and the coarse route's words; small maps: two halves of
                 // the links (see `SMALL_REFINE_SIDE`).
                 let (a, b) = if self.blocks.shift() > 0 {
-                    ws.idle
-                        .refine(&mut ws.guide, REFINE_WORDS, SHORT_REFINE_WORDS)
-                        .unwrap_or((&mut [], &mut []))
+                    let lent = ws
+                        .idle
+                        .refine(&mut ws.guide, REFINE_WORDS, SHORT_REFINE_WORDS);
+                    if lent.is_none() {
+                        self.short.insert(Shortfalls::REFINE);
+                    }
+                    lent.unwrap_or((&mut [], &mut []))
                 } else {
-                    ws.idle.halves_of_links(SMALL_REFINE_WORDS)
+                    let (a, b) = ws.idle.halves_of_links(SMALL_REFINE_WORDS);
+                    if b.len() < SMALL_REFINE_WORDS {
+                        self.short.insert(Shortfalls::REFINE);
+                    }
+                    (a, b)
                 };
                 let mut budget = Budget::new(REFINE_SLICE);
                 let tail = stash_tail(self.stashed, self.guide_blocks);
@@ -175,10 +194,9 @@ impl Run<'_, '_> {
                         diagonal,
                     });
                     // The refined path is locally shortest: the smoothing's bounded scan.
-                    Phase::Polish(Polish::Smooth(
-                        Smoother::new(kind, n, ws.delta.as_flattened_mut(), ws.idle.smoothing(n))
-                            .bounded(),
-                    ))
+                    let sm =
+                        Smoother::new(kind, n, ws.delta.as_flattened_mut(), ws.idle.smoothing(n));
+                    Phase::Polish(Polish::Smooth(noted(sm, kind, &mut self.short).bounded()))
                 } else {
                     Phase::Polish(Polish::Refine(r))
                 }

@@ -9,7 +9,7 @@ use crate::colony::route;
 use crate::map::grid::{Moves, Reach};
 use crate::map::prune;
 
-use super::{Area, End, Phase, Run, Setup};
+use super::{Area, End, Phase, Run, Setup, Shortfalls};
 
 /// Blocks the coarse route's search closes in one piece of [`Run::poll`] (each reads its border
 /// cells' links: a few thousand instructions a block). Measured under `-icount`
@@ -41,6 +41,7 @@ impl Run<'_, '_> {
             // not silent; the ants are pulled at the goal.
             Err(route::Short) => {
                 crate::fmt::warning!("plan: no room for the coarse route");
+                self.short.insert(Shortfalls::ROUTE);
                 false
             }
         };
