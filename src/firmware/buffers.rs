@@ -60,7 +60,7 @@ mod layout {
     use ohaca::board::Layout;
     use ohaca::grid::Grid;
     use ohaca::planner::arena;
-    use ohaca::planner::Workspace;
+    use ohaca::planner::{Memory, Workspace};
     use static_cell::ConstStaticCell;
 
     use crate::firmware::board::BOARD;
@@ -84,40 +84,62 @@ mod layout {
     pub const BYTES: usize = 4 * WORDS - MAP_BYTES;
 
     /// The arena: the map in its first [`MAP_BYTES`] bytes (what the receiver writes and
-    /// `Deref` shows), the planner's buffers after the map of each plan (`lend`).
-    pub struct MapBuf([u32; WORDS]);
+    /// `Deref` shows), the planner's buffers after the map of each plan (`lend`); and what the
+    /// pheromone in it remembers of the last plan (`ohaca::planner::Memory`), under the same
+    /// lock as the map whose changes it records.
+    pub struct MapBuf {
+        words: [u32; WORDS],
+        memory: Memory,
+    }
 
-    /// Its value at boot (zeroed, in `.bss`).
-    pub const MAP_INIT: MapBuf = MapBuf([0; WORDS]);
+    /// Its value at boot (zeroed, in `.bss`; no plan remembered).
+    pub const MAP_INIT: MapBuf = MapBuf {
+        words: [0; WORDS],
+        memory: Memory::new(),
+    };
+
+    impl MapBuf {
+        /// The map's bytes and the colony memory, both writable at once.
+        pub fn split(&mut self) -> (&mut [u8], &mut Memory) {
+            let bytes: &mut [u8] = bytemuck::cast_slice_mut(&mut self.words[..]);
+            (
+                bytes.get_mut(..MAP_BYTES).unwrap_or(&mut []),
+                &mut self.memory,
+            )
+        }
+    }
 
     impl core::ops::Deref for MapBuf {
         type Target = [u8];
         fn deref(&self) -> &[u8] {
-            let bytes: &[u8] = bytemuck::cast_slice(&self.0[..]);
+            let bytes: &[u8] = bytemuck::cast_slice(&self.words[..]);
             bytes.get(..MAP_BYTES).unwrap_or(&[])
         }
     }
 
     impl core::ops::DerefMut for MapBuf {
         fn deref_mut(&mut self) -> &mut [u8] {
-            let bytes: &mut [u8] = bytemuck::cast_slice_mut(&mut self.0[..]);
-            bytes.get_mut(..MAP_BYTES).unwrap_or(&mut [])
+            self.split().0
         }
     }
 
     /// The map of `width x height` cells and a workspace for one plan on it, both from the
     /// arena (`ohaca::planner::arena::carve`: every buffer on maps of up to 68,256 cells, the
-    /// compact layout beyond).
+    /// compact layout beyond), and the colony memory.
     pub fn lend<'a>(
         map: &'a mut MapBuf,
         _storage: &'a mut PlanStorage,
         width: u16,
         height: u16,
-    ) -> Result<(Grid<'a>, Workspace<'a>), ohaca::Error> {
+    ) -> Result<(Grid<'a>, Workspace<'a>, &'a mut Memory), ohaca::Error> {
         let cells = usize::from(width) * usize::from(height);
-        let carved = arena::carve(&mut map.0, cells, PLAN_STEPS)?;
+        let carved = arena::carve(&mut map.words, cells, PLAN_STEPS)?;
         let bits: &'a [u8] = carved.map;
-        Ok((Grid::new(width, height, bits)?, carved.workspace))
+        Ok((
+            Grid::new(width, height, bits)?,
+            carved.workspace,
+            &mut map.memory,
+        ))
     }
 
     static STORAGE: ConstStaticCell<PlanStorage> = ConstStaticCell::new(PlanStorage);
@@ -143,32 +165,48 @@ mod layout {
     use ohaca::board::Layout;
     use ohaca::grid::{Dir, Point};
     use ohaca::pheromone::BLOCKS;
-    use ohaca::planner::{Buffers, Workspace};
+    use ohaca::planner::{Buffers, Memory, Workspace};
     use ohaca::route::GUIDE_BLOCKS;
 
     use crate::firmware::board::BOARD;
     use crate::firmware::limits::{MAP_BYTES, PLAN_CELLS, PLAN_STEPS};
 
     /// The map buffer behind `state::MAP`'s lock: the [`MAP`] static, lent to it once by
-    /// [`take`]; empty before (nothing can read unset memory through it).
-    pub struct MapBuf(Option<&'static mut [u8]>);
+    /// [`take`]; empty before (nothing can read unset memory through it). With it, what the
+    /// pheromone in the planner's storage remembers of the last plan (`ohaca::planner::Memory`),
+    /// under the same lock as the map whose changes it records.
+    pub struct MapBuf {
+        bytes: Option<&'static mut [u8]>,
+        memory: Memory,
+    }
 
-    /// Its value at boot: no buffer yet.
-    pub const MAP_INIT: MapBuf = MapBuf(None);
+    /// Its value at boot: no buffer yet, no plan remembered.
+    pub const MAP_INIT: MapBuf = MapBuf {
+        bytes: None,
+        memory: Memory::new(),
+    };
+
+    impl MapBuf {
+        /// The map's bytes and the colony memory, both writable at once.
+        pub fn split(&mut self) -> (&mut [u8], &mut Memory) {
+            let bytes: &mut [u8] = match &mut self.bytes {
+                Some(b) => b,
+                None => &mut [],
+            };
+            (bytes, &mut self.memory)
+        }
+    }
 
     impl core::ops::Deref for MapBuf {
         type Target = [u8];
         fn deref(&self) -> &[u8] {
-            self.0.as_deref().unwrap_or(&[])
+            self.bytes.as_deref().unwrap_or(&[])
         }
     }
 
     impl core::ops::DerefMut for MapBuf {
         fn deref_mut(&mut self) -> &mut [u8] {
-            match &mut self.0 {
-                Some(b) => b,
-                None => &mut [],
-            }
+            self.split().0
         }
     }
 
@@ -306,11 +344,13 @@ mod layout {
         storage: &'a mut PlanStorage,
         width: u16,
         height: u16,
-    ) -> Result<(ohaca::grid::Grid<'a>, Workspace<'a>), ohaca::Error> {
-        let bits: &'a [u8] = map;
+    ) -> Result<(ohaca::grid::Grid<'a>, Workspace<'a>, &'a mut Memory), ohaca::Error> {
+        let (bits, memory) = map.split();
+        let bits: &'a [u8] = bits;
         Ok((
             ohaca::grid::Grid::new(width, height, bits)?,
             storage.workspace(),
+            memory,
         ))
     }
 
@@ -348,7 +388,7 @@ mod layout {
             guide,
         });
         let mut buf = defmt::unwrap!(map_lock.try_lock().ok(), "the map buffer is locked at boot");
-        buf.0 = Some(map);
+        buf.bytes = Some(map);
         storage
     }
 }

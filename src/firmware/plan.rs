@@ -101,21 +101,19 @@ async fn plan(
         return Err(cancelled());
     }
     let (width, height) = state::map_size().ok_or(ErrorReply::new(ErrorCode::NoMap))?;
-    let (grid, mut ws) = buffers::lend(&mut map, storage, width, height)?;
+    let (grid, mut ws, memory) = buffers::lend(&mut map, storage, width, height)?;
     // Where the plan will lie, to read its parts again once the lock is given up.
     let bases = ws.bases();
     let t0 = Instant::now();
     // A warm plan keeps the colony if it is for this map and goal; both kinds record theirs for
     // the next `PlanWarm` once the run started (a refused plan leaves the pheromone as it was).
-    // The memory is read and written under the map's lock.
-    let mut memory = state::colony();
+    // The memory lives under the map's lock (`state::MAP`).
     let (start, goal, params) = (job.start, job.goal, &job.params);
     // First, a warm plan that no change since can shorten or block is the rest of the last
     // answer: no run at all.
     if job.warm {
-        match reuse(&grid, start, goal, params, &mut ws, &mut memory) {
+        match reuse(&grid, start, goal, params, &mut ws, memory) {
             Ok(plan) => {
-                state::set_colony(memory);
                 let ticks = Instant::now().saturating_duration_since(t0).as_ticks();
                 defmt::info!(
                     "plan {}: {}, length {}, {} waypoints, {} ticks",
@@ -137,11 +135,10 @@ async fn plan(
         }
     }
     let mut run = if job.warm {
-        Run::warm(&grid, start, goal, params, ws, &mut memory)
+        Run::warm(&grid, start, goal, params, ws, memory)
     } else {
-        Run::cold(&grid, start, goal, params, ws, &mut memory)
+        Run::cold(&grid, start, goal, params, ws, memory)
     }?;
-    state::set_colony(memory);
     if job.warm {
         defmt::info!("plan {}: warm start asked, warm {}", job.id, run.is_warm());
     }
@@ -188,8 +185,7 @@ async fn plan(
     let [most_setup, most_colony, most_polish] = most;
     // What the run leaves in the storage for the next warm start to repair rather than rebuild
     // (its pruning marks and route links), recorded only now that it is complete.
-    run.keep(&mut memory);
-    state::set_colony(memory);
+    run.keep(memory);
     let t_finish = Instant::now();
     let plan = run.finish()?;
     let t_end = Instant::now();
@@ -333,7 +329,7 @@ async fn send(
                 );
                 return Err(ErrorReply::new(ErrorCode::Cancelled));
             }
-            let (_grid, ws) = buffers::lend(&mut map, storage, size.0, size.1)?;
+            let (_grid, ws, _) = buffers::lend(&mut map, storage, size.0, size.1)?;
             let (tour, waypoints) = ws
                 .placed(&placed)
                 .ok_or(ErrorReply::new(ErrorCode::Internal))?;

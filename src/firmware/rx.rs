@@ -205,7 +205,7 @@ impl Session {
         let mut map = MAP.lock().await;
         if starts {
             // The pheromone in the planner's storage is for the old map.
-            state::set_colony(ohaca::planner::Memory::new());
+            map.split().1.forget();
         }
         match self.upload.write(c, &mut map[..]) {
             Ok(Some((w, h))) => {
@@ -218,10 +218,6 @@ impl Session {
         }
     }
 }
-
-/// `SetRect`s of at most this many cells are told to the colony memory cell by cell
-/// (`Memory::cell`); larger ones as a rectangle.
-const SMALL_RECT: u32 = 64;
 
 /// Block or clear cells of the map in place; cancels the running and queued plans.
 async fn update(u: Update<'_>, blocked: bool) -> Small {
@@ -239,46 +235,25 @@ async fn update(u: Update<'_>, blocked: bool) -> Small {
     let mut map = MAP.lock().await;
     // The colony memory learns what changes, and which cells a clear frees (blocked before:
     // read from the map before it is written), for the next `PlanWarm` (`ohaca::planner::reuse`).
-    let mut memory = state::colony();
+    let (bits, memory) = map.split();
     let was_blocked = |p: Point| {
         let i = usize::from(p.y) * usize::from(size.0) + usize::from(p.x);
-        ohaca::map::bits::get(&map, i).unwrap_or(false)
+        ohaca::map::bits::get(bits, i).unwrap_or(false)
     };
     let done = match u {
         Update::Rect(x, y, w, h) => {
-            let small = u32::from(w) * u32::from(h) <= SMALL_RECT;
-            if let (true, Some(a)) = (small, Area::rect(x, y, w, h)) {
-                // Cell by cell, so a box set and cleared again is no change to the answer.
-                let (lo, hi) = a.corners();
-                for y in lo.y..=hi.y {
-                    for x in lo.x..=hi.x {
-                        let p = Point::new(x, y);
-                        memory.cell(p, was_blocked(p), blocked);
-                    }
-                }
-            } else if let Some(a) = Area::rect(x, y, w, h) {
-                let cleared = if blocked {
-                    None
-                } else {
-                    let (lo, hi) = a.corners();
-                    (lo.y..=hi.y)
-                        .flat_map(|y| (lo.x..=hi.x).map(move |x| Point::new(x, y)))
-                        .filter(|&p| was_blocked(p))
-                        .map(Area::cell)
-                        .reduce(Area::union)
-                };
-                memory.changed(a, cleared);
+            if let Some(a) = Area::rect(x, y, w, h) {
+                memory.rect(a, blocked, was_blocked);
             }
-            set_rect(size, &mut map[..], (x, y, w, h), blocked)
+            set_rect(size, bits, (x, y, w, h), blocked)
         }
         Update::Cells(c) => {
             for p in c.iter() {
                 memory.cell(p, was_blocked(p), blocked);
             }
-            set_cells(size, &mut map[..], &c, blocked)
+            set_cells(size, bits, &c, blocked)
         }
     };
-    state::set_colony(memory);
     match done {
         Ok(()) => Small::Ack,
         Err(e) => Small::Error(e),

@@ -53,7 +53,7 @@ pub use repair::{
 pub use reuse::{reuse, Fallback};
 pub use run::{settled, Poll, Run, Stage, REFINE_GAIN};
 pub use short::Shortfalls;
-pub use warm::{Area, Memory, BLOCKED, FREED, REPAIR_RADIUS};
+pub use warm::{Area, Memory, BLOCKED, CELL_BY_CELL, FREED, REPAIR_RADIUS};
 #[cfg(any(feature = "alloc", test))]
 pub(crate) use workspace::OwnedBuffers;
 pub use workspace::{Buffers, Storage, Workspace};

@@ -188,6 +188,9 @@ impl Blocked {
 /// it grows least (a larger rectangle: fewer replans proven unnecessary, never a wrong proof).
 pub const FREED: usize = 8;
 
+/// Rectangles of at most this many cells are recorded cell by cell ([`Memory::rect`]).
+pub const CELL_BY_CELL: u64 = 64;
+
 /// The cells cleared since an answer was planned ([`Memory::changed`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -308,6 +311,31 @@ impl Memory {
             }
             // Written as it was: nothing changed.
             _ => {}
+        }
+    }
+
+    /// The cells of `area` were set to `blocked`, `was_blocked` reading the map before the
+    /// write: cell by cell ([`Memory::cell`]) when `area` has at most [`CELL_BY_CELL`] cells, so
+    /// a small box set and cleared again is no change to the answer; else one rectangle whose
+    /// cleared part is the cells that were blocked ([`Memory::changed`]). What the firmware's
+    /// receiver and the host's replanning both call, with the map they are about to write.
+    pub fn rect(&mut self, area: Area, blocked: bool, was_blocked: impl Fn(Point) -> bool) {
+        let (lo, hi) = area.corners();
+        let cells = (lo.y..=hi.y).flat_map(|y| (lo.x..=hi.x).map(move |x| Point::new(x, y)));
+        if area.cells() <= CELL_BY_CELL {
+            for p in cells {
+                self.cell(p, was_blocked(p), blocked);
+            }
+        } else {
+            let cleared = if blocked {
+                None
+            } else {
+                cells
+                    .filter(|&p| was_blocked(p))
+                    .map(Area::cell)
+                    .reduce(Area::union)
+            };
+            self.changed(area, cleared);
         }
     }
 
@@ -550,4 +578,37 @@ mod tests {
         assert_eq!(repair(&mut tau, None, 1.0, 0.01, 100.0), 0);
         assert!(tau.entries().iter().all(|e| *e == [100.0; 4]));
     }
+
+    #[test]
+    fn a_rectangle_is_told_cell_by_cell_when_small() {
+        // 4 x 4 cells (at most `BLOCKED` remembered): set and cleared again, cell by cell, so
+        // nothing counts as freed.
+        let free = |_: Point| false;
+        let all_blocked = |_: Point| true;
+        let mut m = Memory::new();
+        let small = Area::rect(2, 3, 4, 4).unwrap();
+        m.rect(small, true, free);
+        m.rect(small, false, all_blocked);
+        assert_eq!(m.freed.areas().count(), 0);
+        assert_eq!(m.changes(), Some(small));
+        // 9 x 8 cells: one rectangle; clearing it frees exactly the cells that were blocked.
+        let mut m = Memory::new();
+        let large = Area::rect(2, 3, 9, 8).unwrap();
+        m.rect(large, true, free);
+        assert_eq!(m.freed.areas().count(), 0);
+        let one = Point::new(5, 6);
+        m.rect(large, false, |p| p == one);
+        assert_eq!(m.freed.areas().collect::<alloc::vec::Vec<_>>(), [Area::cell(one)]);
+        // Set and cleared again as a rectangle: every cell counts as freed (no cell is
+        // remembered).
+        let mut m = Memory::new();
+        m.rect(large, true, free);
+        m.rect(large, false, all_blocked);
+        assert_eq!(m.freed.areas().collect::<alloc::vec::Vec<_>>(), [large]);
+        // Nothing was blocked: nothing is freed.
+        let mut m = Memory::new();
+        m.rect(large, false, free);
+        assert_eq!((m.freed.areas().count(), m.changes()), (0, Some(large)));
+    }
+
 }

@@ -1,6 +1,6 @@
 //! The map the device holds: its buffer ([`MAP`], behind the one lock the planner and the
-//! receiver share), its size ([`MAP_SIZE`]) and what the planner's storage remembers of the last
-//! plan on it (the colony memory, [`COLONY`]).
+//! receiver share, with what the planner's storage remembers of the last plan on it, the colony
+//! memory `ohaca::planner::Memory`) and its size ([`MAP_SIZE`]).
 //!
 //! The map lives once (32 KiB for 512x512 cells, 1 bit a cell): the planner holds the lock
 //! while it plans, a piece at a time, and reads the map in place (no copy); the receiver takes
@@ -16,24 +16,20 @@ use core::cell::Cell;
 use embassy_sync::blocking_mutex::Mutex as BlockingMutex;
 use embassy_sync::mutex::Mutex;
 
-use ohaca::planner::Memory;
-
 use super::Raw;
 use crate::firmware::buffers::{MapLock, MAP_INIT};
 
 /// The map buffer, packed as `ohaca::grid` stores a map; [`MAP_SIZE`] says what it holds. On the
 /// small boards the first `MAP_BYTES` bytes of the arena the planner's buffers share (103,424
 /// bytes in all, `crate::firmware::buffers`); on the STM32H743 and its twin a static of the AXI
-/// SRAM that `crate::firmware::buffers::take` lends to this lock at boot.
+/// SRAM that `crate::firmware::buffers::take` lends to this lock at boot. The colony memory lives
+/// under the same lock (`MapBuf::split`): the planner reads and writes it around `Run::warm`,
+/// the receiver when it writes the map, so a change can never slip between a plan's start and
+/// its record.
 pub static MAP: MapLock = Mutex::new(MAP_INIT);
 /// Width and height of the complete map in [`MAP`]; `None`: no map (none yet, an upload in
 /// progress, or a failed one).
 static MAP_SIZE: BlockingMutex<Raw, Cell<Option<(u16, u16)>>> = BlockingMutex::new(Cell::new(None));
-/// What the pheromone in the planner's storage belongs to, and the cells changed since
-/// (`ohaca::planner::Memory`). Read and written only while holding [`MAP`]'s lock: by the
-/// planner around `Run::warm`, by the receiver when it writes the map, so a change can never slip
-/// between a plan's start and its record.
-static COLONY: BlockingMutex<Raw, Cell<Memory>> = BlockingMutex::new(Cell::new(Memory::new()));
 
 /// The size of the map in [`MAP`], if it holds a complete one.
 pub fn map_size() -> Option<(u16, u16)> {
@@ -43,14 +39,4 @@ pub fn map_size() -> Option<(u16, u16)> {
 /// Record what [`MAP`] holds.
 pub fn set_map_size(size: Option<(u16, u16)>) {
     MAP_SIZE.lock(|c| c.set(size));
-}
-
-/// The colony memory (call with [`MAP`]'s lock held).
-pub fn colony() -> Memory {
-    COLONY.lock(Cell::get)
-}
-
-/// Replace the colony memory (call with [`MAP`]'s lock held).
-pub fn set_colony(m: Memory) {
-    COLONY.lock(|c| c.set(m));
 }

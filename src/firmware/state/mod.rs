@@ -22,7 +22,7 @@ use ohaca::protocol::MapLimits;
 pub use jobs::{
     cancel_all, cancelled, stop_all, stopped, stops, Job, GENERATION, JOBS, PLANNING, PLAN_QUEUE,
 };
-pub use map::{colony, map_size, set_colony, set_map_size, MAP};
+pub use map::{map_size, set_map_size, MAP};
 pub use replies::{
     reply, small_sent, wait_for_small, Out, Small, TxPort, OUT, SENDING_SMALL, WINDOW,
 };
