@@ -31,7 +31,8 @@ use std::collections::BinaryHeap;
 use serde::Deserialize;
 
 use ohaca::board::{Board, F411};
-use ohaca::planner::{reuse, Fallback, Memory, Origin, Poll, Run};
+use ohaca::planner::session::{self, Begun};
+use ohaca::planner::{Fallback, Memory, Origin, Poll};
 use ohaca::{Grid, Params, Point};
 
 use crate::board::BoardStorage;
@@ -270,32 +271,32 @@ impl Planner for HostPlanner {
 
     fn plan(&mut self, start: Point, goal: Point, warm: bool) -> Result<Planned, String> {
         let grid = self.map.grid().map_err(|e| e.to_string())?;
-        let mut ws = self
+        let ws = self
             .storage
             .as_mut()
             .ok_or("no map yet")?
             .workspace()
             .map_err(|e| e.to_string())?;
-        // As the firmware does: a warm replan that no change since can shorten or block is the
-        // rest of the last answer (or its local repair); else the reason, kept for the table.
-        let mut fallback = None;
-        if warm {
-            match reuse(&grid, start, goal, &self.params, &mut ws, &mut self.memory) {
-                Ok(plan) => return Ok(Planned::of(&plan, None)),
-                Err(why) => fallback = Some(why),
-            }
-        }
-        let mut run = if warm {
-            Run::warm(&grid, start, goal, &self.params, ws, &mut self.memory)
-        } else {
-            Run::cold(&grid, start, goal, &self.params, ws, &mut self.memory)
-        }
+        // The firmware's dispatch (`ohaca::planner::session`): a warm replan that no change since
+        // can shorten or block is the rest of the last answer (or its local repair); else the
+        // reason, kept for the table, and a run.
+        let begun = session::begin(
+            &grid,
+            (start, goal),
+            &self.params,
+            ws,
+            &mut self.memory,
+            warm,
+        )
         .map_err(|e| e.to_string())?;
-        // The one loop (the firmware's, without its yields); then, as the firmware does, record
-        // what the run leaves for the next warm start.
+        let (mut run, fallback) = match begun {
+            Begun::Answered(plan) => return Ok(Planned::of(&plan, None)),
+            Begun::Running(run, why) => (run, why),
+        };
+        // The one loop (the firmware's, without its yields), then what the run leaves for the
+        // next warm start.
         while let Poll::Working(_) = run.poll() {}
-        run.keep(&mut self.memory);
-        let plan = run.finish().map_err(|e| e.to_string())?;
+        let plan = session::end(run, &mut self.memory).map_err(|e| e.to_string())?;
         Ok(Planned {
             fallback,
             ..Planned::of(&plan, None)

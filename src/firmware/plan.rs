@@ -20,7 +20,8 @@ use core::sync::atomic::Ordering;
 use embassy_futures::yield_now;
 use embassy_time::Instant;
 
-use ohaca::planner::{reuse, Placed, Plan, Poll, Run, Stage};
+use ohaca::planner::session::{self, Begun};
+use ohaca::planner::{Placed, Plan, Poll, Stage};
 use ohaca::protocol::{
     encode_reply, wire_len, ErrorCode, ErrorReply, PathBody, PathPart, PathReply, Reply, Waypoints,
     PART_BYTES,
@@ -101,7 +102,7 @@ async fn plan(
         return Err(cancelled());
     }
     let (width, height) = state::map_size().ok_or(ErrorReply::new(ErrorCode::NoMap))?;
-    let (grid, mut ws, memory) = buffers::lend(&mut map, storage, width, height)?;
+    let (grid, ws, memory) = buffers::lend(&mut map, storage, width, height)?;
     // Where the plan will lie, to read its parts again once the lock is given up.
     let bases = ws.bases();
     let t0 = Instant::now();
@@ -110,35 +111,33 @@ async fn plan(
     // The memory lives under the map's lock (`state::MAP`).
     let (start, goal, params) = (job.start, job.goal, &job.params);
     // First, a warm plan that no change since can shorten or block is the rest of the last
-    // answer: no run at all.
-    if job.warm {
-        match reuse(&grid, start, goal, params, &mut ws, memory) {
-            Ok(plan) => {
-                let ticks = Instant::now().saturating_duration_since(t0).as_ticks();
-                defmt::info!(
-                    "plan {}: {}, length {}, {} waypoints, {} ticks",
-                    job.id,
-                    plan.origin.name(),
-                    plan.length,
-                    plan.waypoints().len(),
-                    ticks
-                );
-                let ready = ready(job, &plan, ticks, bases, (width, height), frame)?;
-                return Ok((ticks, ready));
-            }
-            // Why the colony runs: the replan could not be answered with the last answer.
-            Err(why) => defmt::info!(
-                "plan {}: not reused: {}",
+    // answer: no run at all (`ohaca::planner::session`, as on the host).
+    let mut run = match session::begin(&grid, (start, goal), params, ws, memory, job.warm)? {
+        Begun::Answered(plan) => {
+            let ticks = Instant::now().saturating_duration_since(t0).as_ticks();
+            defmt::info!(
+                "plan {}: {}, length {}, {} waypoints, {} ticks",
                 job.id,
-                defmt::Display2Format(&why)
-            ),
+                plan.origin.name(),
+                plan.length,
+                plan.waypoints().len(),
+                ticks
+            );
+            let ready = ready(job, &plan, ticks, bases, (width, height), frame)?;
+            return Ok((ticks, ready));
         }
-    }
-    let mut run = if job.warm {
-        Run::warm(&grid, start, goal, params, ws, memory)
-    } else {
-        Run::cold(&grid, start, goal, params, ws, memory)
-    }?;
+        Begun::Running(run, why) => {
+            // Why the colony runs: the replan could not be answered with the last answer.
+            if let Some(why) = why {
+                defmt::info!(
+                    "plan {}: not reused: {}",
+                    job.id,
+                    defmt::Display2Format(&why)
+                );
+            }
+            run
+        }
+    };
     if job.warm {
         defmt::info!("plan {}: warm start asked, warm {}", job.id, run.is_warm());
     }
@@ -184,10 +183,9 @@ async fn plan(
     let [in_setup, in_steps, in_polish] = spent;
     let [most_setup, most_colony, most_polish] = most;
     // What the run leaves in the storage for the next warm start to repair rather than rebuild
-    // (its pruning marks and route links), recorded only now that it is complete.
-    run.keep(memory);
+    // (its pruning marks and route links), recorded only now that it is complete; its plan.
     let t_finish = Instant::now();
-    let plan = run.finish()?;
+    let plan = session::end(run, memory)?;
     let t_end = Instant::now();
     if !plan.shortfalls.is_empty() {
         // None on the board's own layout (`ohaca::planner::Shortfalls`): said, never silent.

@@ -97,6 +97,58 @@ pub fn reuse<'a>(
     ws: &'a mut Workspace<'_>,
     memory: &mut Memory,
 ) -> Result<Plan<'a>, Fallback> {
+    let reused = answer(grid, start, goal, params, ws, memory)?;
+    let Workspace { best, points, .. } = ws;
+    Ok(reused.plan(best, points, memory, params))
+}
+
+/// A replan answered from the last answer ([`answer`]): its lengths and origin; where it lies
+/// in the workspace is the memory's answer now. It borrows nothing, so a caller that owns the
+/// workspace can still hand it to a run when there is no such answer
+/// ([`super::session::begin`]).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Reused {
+    pub(super) raw_length: f32,
+    pub(super) length: f32,
+    pub(super) origin: Origin,
+}
+
+impl Reused {
+    /// The plan: the memory's answer's raw path in `best` and waypoints in `points` (ranges
+    /// [`answer`] checked before it recorded them).
+    pub(super) fn plan<'a>(
+        self,
+        best: &'a [Dir],
+        points: &'a [Point],
+        memory: &Memory,
+        params: &Params,
+    ) -> Plan<'a> {
+        let (start, tour, waypoints) = match memory.answer {
+            Some(a) => (
+                a.start,
+                best.get(idx(a.from)..idx(a.steps)).unwrap_or_default(),
+                points.get(idx(a.first)..idx(a.end)).unwrap_or_default(),
+            ),
+            None => (Point::new(0, 0), &[][..], &[][..]),
+        };
+        Plan::without_run(
+            (start, tour, waypoints),
+            (self.raw_length, self.length),
+            self.origin,
+            *params,
+        )
+    }
+}
+
+/// [`reuse`]'s answer without its plan: the memory's answer is the new one on success.
+pub(super) fn answer(
+    grid: &Grid<'_>,
+    start: Point,
+    goal: Point,
+    params: &Params,
+    ws: &mut Workspace<'_>,
+    memory: &mut Memory,
+) -> Result<Reused, Fallback> {
     use Fallback::{NoAnswer, OffAnswer};
     if !memory.is_warm_for(grid.width(), grid.height(), goal) || start == goal {
         return Err(NoAnswer);
@@ -170,24 +222,25 @@ pub fn reuse<'a>(
     }
     // The robot's cell goes into the slot before the entry: a waypoint it has passed.
     let k0 = first.wrapping_add(entry).checked_sub(1).ok_or(NoAnswer)?;
+    // The new answer's ranges, checked before they are recorded ([`Reused::plan`] reads them).
+    let ranges = (from.wrapping_add(at)..steps, k0..end);
+    if ws.best.get(ranges.0.clone()).is_none() || ws.points.get(ranges.1.clone()).is_none() {
+        return Err(NoAnswer);
+    }
     *ws.points.get_mut(k0).ok_or(NoAnswer)? = start;
     memory.answer = Some(Answer {
         start,
-        from: u32::try_from(from.wrapping_add(at)).map_err(|_| NoAnswer)?,
+        from: u32::try_from(ranges.0.start).map_err(|_| NoAnswer)?,
         steps: answer.steps,
         first: u32::try_from(k0).map_err(|_| NoAnswer)?,
         end: answer.end,
         params: answer.params,
     });
-    let Workspace { best, points, .. } = ws;
-    let tour: &'a [Dir] = best.get(from.wrapping_add(at)..steps).ok_or(NoAnswer)?;
-    let waypoints: &'a [Point] = points.get(k0..end).ok_or(NoAnswer)?;
-    Ok(Plan::without_run(
-        (start, tour, waypoints),
-        (raw_length, length),
-        Origin::Reused,
-        *params,
-    ))
+    Ok(Reused {
+        raw_length,
+        length,
+        origin: Origin::Reused,
+    })
 }
 
 fn idx(v: u32) -> usize {

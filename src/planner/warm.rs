@@ -598,7 +598,10 @@ mod tests {
         assert_eq!(m.freed.areas().count(), 0);
         let one = Point::new(5, 6);
         m.rect(large, false, |p| p == one);
-        assert_eq!(m.freed.areas().collect::<alloc::vec::Vec<_>>(), [Area::cell(one)]);
+        assert_eq!(
+            m.freed.areas().collect::<alloc::vec::Vec<_>>(),
+            [Area::cell(one)]
+        );
         // Set and cleared again as a rectangle: every cell counts as freed (no cell is
         // remembered).
         let mut m = Memory::new();
@@ -610,5 +613,4 @@ mod tests {
         m.rect(large, false, free);
         assert_eq!((m.freed.areas().count(), m.changes()), (0, Some(large)));
     }
-
 }

@@ -67,7 +67,8 @@ use crate::polish::smoothing::{Smoother, SmoothingKind};
 
 use super::lend::Polishing;
 use super::params::{Algorithm, Params};
-use super::plan::{Origin, Plan};
+use super::plan::Origin;
+use super::reuse::Reused;
 use super::warm::{Answer, Memory};
 use super::workspace::Workspace;
 
@@ -155,17 +156,17 @@ pub fn longest_detour(old: f32) -> f32 {
 /// `at` of it, and the waypoints after the robot's are `points[first + entry..end]`
 /// ([`super::reuse`]).
 #[allow(clippy::too_many_arguments)] // reuse's state, passed on
-pub(super) fn repair<'a>(
+pub(super) fn repair(
     grid: &Grid<'_>,
     start: Point,
     goal: Point,
     params: &Params,
-    ws: &'a mut Workspace<'_>,
+    ws: &mut Workspace<'_>,
     memory: &mut Memory,
     answer: Answer,
     at: usize,
     entry: usize,
-) -> Result<Plan<'a>, GiveUp> {
+) -> Result<Reused, GiveUp> {
     use GiveUp::{NoRoom, StillBlocked, Unplaced};
     let idx = |v: u32| usize::try_from(v).unwrap_or(usize::MAX);
     let (from, steps) = (idx(answer.from), idx(answer.steps));
@@ -413,6 +414,10 @@ pub(super) fn repair<'a>(
         return Err(GiveUp::MayShorten);
     }
     let word = |x: usize| u32::try_from(x).map_err(|_| NoRoom);
+    // The new answer's ranges, checked before they are recorded ([`Reused::plan`] reads them).
+    if best.get(base..new_steps).is_none() || points.get(k0..new_end).is_none() {
+        return Err(NoRoom);
+    }
     memory.answer = Some(Answer {
         start,
         from: word(base)?,
@@ -421,14 +426,11 @@ pub(super) fn repair<'a>(
         end: word(new_end)?,
         params: answer.params,
     });
-    let tour: &'a [Dir] = best.get(base..new_steps).ok_or(NoRoom)?;
-    let waypoints: &'a [Point] = points.get(k0..new_end).ok_or(NoRoom)?;
-    Ok(Plan::without_run(
-        (start, tour, waypoints),
-        (raw_length, length),
-        Origin::Repaired,
-        *params,
-    ))
+    Ok(Reused {
+        raw_length,
+        length,
+        origin: Origin::Repaired,
+    })
 }
 
 #[cfg(test)]
