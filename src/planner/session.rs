@@ -18,6 +18,9 @@ use super::warm::Memory;
 use super::workspace::Workspace;
 
 /// How a request begins ([`begin`]).
+// The run is the large variant and the usual one; there is no allocator to box it, and the
+// value is taken apart at once by the caller.
+#[allow(clippy::large_enum_variant)]
 pub enum Begun<'g, 'a> {
     /// Answered from the last answer, without a run ([`super::Origin::Reused`] or `Repaired`).
     Answered(Plan<'a>),
