@@ -31,7 +31,7 @@ use std::collections::BinaryHeap;
 use serde::Deserialize;
 
 use ohaca::board::{Board, F411};
-use ohaca::planner::session::{self, Begun};
+use ohaca::planner::session;
 use ohaca::planner::{Fallback, Memory, Origin, Poll};
 use ohaca::{Grid, Params, Point};
 
@@ -271,7 +271,7 @@ impl Planner for HostPlanner {
 
     fn plan(&mut self, start: Point, goal: Point, warm: bool) -> Result<Planned, String> {
         let grid = self.map.grid().map_err(|e| e.to_string())?;
-        let ws = self
+        let mut ws = self
             .storage
             .as_mut()
             .ok_or("no map yet")?
@@ -280,19 +280,16 @@ impl Planner for HostPlanner {
         // The firmware's dispatch (`ohaca::planner::session`): a warm replan that no change since
         // can shorten or block is the rest of the last answer (or its local repair); else the
         // reason, kept for the table, and a run.
-        let begun = session::begin(
-            &grid,
-            (start, goal),
-            &self.params,
-            ws,
-            &mut self.memory,
-            warm,
-        )
-        .map_err(|e| e.to_string())?;
-        let (mut run, fallback) = match begun {
-            Begun::Answered(plan) => return Ok(Planned::of(&plan, None)),
-            Begun::Running(run, why) => (run, why),
+        let (ends, memory) = ((start, goal), &mut self.memory);
+        let fallback = match session::answer(&grid, ends, &self.params, &mut ws, memory, warm) {
+            Ok(reused) => {
+                let plan = reused.into_plan(ws, memory, &self.params);
+                return Ok(Planned::of(&plan, None));
+            }
+            Err(why) => why,
         };
+        let mut run = session::start(&grid, ends, &self.params, ws, memory, warm)
+            .map_err(|e| e.to_string())?;
         // The one loop (the firmware's, without its yields), then what the run leaves for the
         // next warm start.
         while let Poll::Working(_) = run.poll() {}

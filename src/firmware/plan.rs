@@ -20,7 +20,7 @@ use core::sync::atomic::Ordering;
 use embassy_futures::yield_now;
 use embassy_time::Instant;
 
-use ohaca::planner::session::{self, Begun};
+use ohaca::planner::session;
 use ohaca::planner::{Placed, Plan, Poll, Stage};
 use ohaca::protocol::{
     encode_reply, wire_len, ErrorCode, ErrorReply, PathBody, PathPart, PathReply, Reply, Waypoints,
@@ -102,7 +102,7 @@ async fn plan(
         return Err(cancelled());
     }
     let (width, height) = state::map_size().ok_or(ErrorReply::new(ErrorCode::NoMap))?;
-    let (grid, ws, memory) = buffers::lend(&mut map, storage, width, height)?;
+    let (grid, mut ws, memory) = buffers::lend(&mut map, storage, width, height)?;
     // Where the plan will lie, to read its parts again once the lock is given up.
     let bases = ws.bases();
     let t0 = Instant::now();
@@ -112,8 +112,10 @@ async fn plan(
     let (start, goal, params) = (job.start, job.goal, &job.params);
     // First, a warm plan that no change since can shorten or block is the rest of the last
     // answer: no run at all (`ohaca::planner::session`, as on the host).
-    let mut run = match session::begin(&grid, (start, goal), params, ws, memory, job.warm)? {
-        Begun::Answered(plan) => {
+    let ends = (start, goal);
+    match session::answer(&grid, ends, params, &mut ws, memory, job.warm) {
+        Ok(reused) => {
+            let plan = reused.into_plan(ws, memory, params);
             let ticks = Instant::now().saturating_duration_since(t0).as_ticks();
             defmt::info!(
                 "plan {}: {}, length {}, {} waypoints, {} ticks",
@@ -126,18 +128,15 @@ async fn plan(
             let ready = ready(job, &plan, ticks, bases, (width, height), frame)?;
             return Ok((ticks, ready));
         }
-        Begun::Running(run, why) => {
-            // Why the colony runs: the replan could not be answered with the last answer.
-            if let Some(why) = why {
-                defmt::info!(
-                    "plan {}: not reused: {}",
-                    job.id,
-                    defmt::Display2Format(&why)
-                );
-            }
-            run
-        }
-    };
+        // Why the colony runs: the replan could not be answered with the last answer.
+        Err(Some(why)) => defmt::info!(
+            "plan {}: not reused: {}",
+            job.id,
+            defmt::Display2Format(&why)
+        ),
+        Err(None) => {}
+    }
+    let mut run = session::start(&grid, ends, params, ws, memory, job.warm)?;
     if job.warm {
         defmt::info!("plan {}: warm start asked, warm {}", job.id, run.is_warm());
     }

@@ -21,7 +21,7 @@
 //! | `lend` | one typed view of the workspace per phase (setup, colony, polish) and what a buffer idle in a phase lends to it |
 //! | `run` | [`Run`]: the loop as a state machine ([`Run::poll`]: setup, walk + update + record, polish) |
 //! | `plan` | [`Plan`], [`RawPath`], [`CurvePoint`]: the result |
-//! | [`session`] | one replan's dispatch for the firmware and the host: the last answer, else a warm or cold run, and what it leaves ([`session::begin`], [`session::end`]) |
+//! | [`session`] | one replan's dispatch for the firmware and the host: the last answer ([`session::answer`]), else a warm or cold run ([`session::start`]), and what it leaves ([`session::end`]) |
 //! | `short` | [`Shortfalls`]: the steps that ran short of scratch, in the result |
 //! | `placed` | [`Placed`], [`Bases`]: where a plan lies in its workspace, to read it again later (the firmware's path parts) |
 //! | `warm` | [`Memory`], [`Area`]: warm starts after map changes, and the pheromone repair |

@@ -105,9 +105,9 @@ pub fn reuse<'a>(
 /// A replan answered from the last answer ([`answer`]): its lengths and origin; where it lies
 /// in the workspace is the memory's answer now. It borrows nothing, so a caller that owns the
 /// workspace can still hand it to a run when there is no such answer
-/// ([`super::session::begin`]).
+/// ([`super::session::answer`]).
 #[derive(Clone, Copy, Debug)]
-pub(super) struct Reused {
+pub struct Reused {
     pub(super) raw_length: f32,
     pub(super) length: f32,
     pub(super) origin: Origin,
