@@ -55,6 +55,8 @@ use crate::geometry::steps_length;
 use crate::map::dir::{is_diagonal, opposite, Dir, DX, DY};
 use crate::map::grid::{Grid, Point};
 
+use super::heap::{Full, Heap, Keyed};
+
 /// Nibble of a cell not closed yet.
 pub const FREE: u8 = 0;
 /// Nibble of the start cell once closed (it has no parent).
@@ -291,10 +293,18 @@ fn set_nib(nibbles: &mut [u8], i: usize, v: u8) {
     }
 }
 
-/// The binary min-heap of open entries over the caller's slice.
+impl Keyed for Entry {
+    type Key = u64;
+    #[inline(always)]
+    fn key(&self) -> u64 {
+        self.rank()
+    }
+}
+
+/// The open list: the crate's binary min-heap ([`super::heap`]) of entries over the caller's
+/// slice, and what the search reports of it.
 struct Open<'h> {
-    a: &'h mut [Entry],
-    len: usize,
+    heap: Heap<'h, Entry>,
     peak: usize,
     pushes: u32,
 }
@@ -302,117 +312,32 @@ struct Open<'h> {
 impl Open<'_> {
     #[inline(never)]
     fn push(&mut self, e: Entry) -> Result<(), AstarError> {
-        let len = self.len;
-        // `len <= a.len()` always, so `len + 1` cannot wrap.
-        let Some(a) = self.a.get_mut(..len.wrapping_add(1)) else {
-            return Err(AstarError::HeapFull {
-                capacity: self.a.len(),
-            });
-        };
-        self.len = len.wrapping_add(1);
-        if self.len > self.peak {
-            self.peak = self.len;
+        self.heap
+            .push(e)
+            .map_err(|Full { capacity }| AstarError::HeapFull { capacity })?;
+        if self.heap.len() > self.peak {
+            self.peak = self.heap.len();
         }
         self.pushes = self.pushes.wrapping_add(1);
-        // Sift the hole at `len` up.
-        Self::sift_up(a, len, e);
         Ok(())
-    }
-
-    /// Put `e` into the hole at `hole` of the heap `a`, moving it up past every parent that
-    /// ranks after it.
-    #[inline(always)]
-    fn sift_up(a: &mut [Entry], mut hole: usize, e: Entry) {
-        let r = e.rank();
-        while hole > 0 {
-            let parent = hole.wrapping_sub(1) >> 1;
-            let Some(&p) = a.get(parent) else { break };
-            if r >= p.rank() {
-                break;
-            }
-            if let Some(slot) = a.get_mut(hole) {
-                *slot = p;
-            }
-            hole = parent;
-        }
-        if let Some(slot) = a.get_mut(hole) {
-            *slot = e;
-        }
     }
 
     /// The top entry ([`Entry::NONE`] if the heap is empty).
     #[inline(always)]
     fn top(&self) -> Entry {
-        match self.a.first() {
-            Some(&t) if self.len > 0 => t,
-            _ => Entry::NONE,
-        }
-    }
-
-    /// Put `e` into the root's hole of the heap `a`: walk the hole down to a leaf along the
-    /// smaller children (one comparison a level), then sift `e` up from there (usually a step or
-    /// none). Out of line, on the entries' words (three an entry: `ng`, `f`, `key`), so that the
-    /// loop keeps its own registers.
-    #[inline(never)]
-    fn settle(a: &mut [Entry], e: Entry) {
-        let w: &mut [u32] = bytemuck::cast_slice_mut(a);
-        // Word indices: the hole `h`, its left child `c = 2 h + 3`. Below `2 len + 6` words, far
-        // from usize::MAX: no wrap.
-        let mut h = 0usize;
-        let mut c = 3usize;
-        while let Some(&[l0, l1, l2, r0, r1, r2]) = w.get(c..c.wrapping_add(6)) {
-            let right =
-                (u64::from(r1) << 32 | u64::from(r0)) < (u64::from(l1) << 32 | u64::from(l0));
-            let (e0, e1, e2, cc) = if right {
-                (r0, r1, r2, c.wrapping_add(3))
-            } else {
-                (l0, l1, l2, c)
-            };
-            if let Some([s0, s1, s2]) = w.get_mut(h..).and_then(|s| s.first_chunk_mut::<3>()) {
-                *s0 = e0;
-                *s1 = e1;
-                *s2 = e2;
-            }
-            h = cc;
-            c = cc.wrapping_mul(2).wrapping_add(3);
-        }
-        // A last, lone left child.
-        if let Some(&[l0, l1, l2]) = w.get(c..c.wrapping_add(3)) {
-            if let Some([s0, s1, s2]) = w.get_mut(h..).and_then(|s| s.first_chunk_mut::<3>()) {
-                *s0 = l0;
-                *s1 = l1;
-                *s2 = l2;
-            }
-            h = c;
-        }
-        let a: &mut [Entry] = bytemuck::cast_slice_mut(w);
-        Self::sift_up(a, h / 3, e);
+        self.heap.top().unwrap_or(Entry::NONE)
     }
 
     #[inline(always)]
     fn pop(&mut self) -> Option<Entry> {
-        if self.len == 0 {
-            return None;
-        }
-        let top = self.top();
-        let n = self.len.wrapping_sub(1);
-        self.len = n;
-        // The last entry (now just past the heap) fills the root's hole.
-        let last = self.a.get(n).copied().unwrap_or(Entry::NONE);
-        if let Some(a) = self.a.get_mut(..n) {
-            Self::settle(a, last);
-        }
-        Some(top)
+        self.heap.pop()
     }
 
     /// Pop the top and push `e` in one sift (the heap must not be empty).
     #[inline(always)]
     fn replace_top(&mut self, e: Entry) -> Entry {
-        let top = self.top();
-        let a = self.a.get_mut(..self.len).unwrap_or(&mut []);
-        Self::settle(a, e);
         self.pushes = self.pushes.wrapping_add(1);
-        top
+        self.heap.replace_top(e).unwrap_or(Entry::NONE)
     }
 }
 
@@ -517,8 +442,7 @@ fn run<S: Store>(
         );
     }
     let mut open = Open {
-        a: heap,
-        len: 0,
+        heap: Heap::new(heap),
         peak: 0,
         pushes: 0,
     };
