@@ -53,6 +53,7 @@
 use ohaca::astar::{self, AstarError, End, Entry, DIAGONAL, MAX_LENGTH, STRAIGHT};
 use ohaca::geometry::steps_length;
 use ohaca::grid::{is_diagonal, neighbour};
+use ohaca::search::heap;
 use ohaca::{Grid, Point};
 
 use crate::map::Map;
@@ -215,8 +216,8 @@ impl Node {
 
 const _: () = assert!(ENTRY_BYTES == 16);
 
-/// The queue: an indexed binary min-heap (a vertex's position in `pos`, [`NOT_OPEN`] if it is
-/// not in the queue).
+/// The queue: an indexed binary min-heap, the core's ([`heap`]), over the entries' vector (a
+/// vertex's position in `pos`, [`NOT_OPEN`] if it is not in the queue).
 #[derive(Clone, Debug)]
 struct Open {
     heap: Vec<Node>,
@@ -244,74 +245,34 @@ impl Open {
         self.call_peak = self.heap.len();
     }
 
-    /// Put `n` at heap slot `i` and record its position.
-    fn place(&mut self, i: usize, n: Node) {
-        if let Some(slot) = self.heap.get_mut(i) {
-            *slot = n;
+    /// The queue as the core's heap sees it ([`heap::Slots`]).
+    fn slots(&mut self) -> Slots<'_> {
+        Slots {
+            heap: &mut self.heap,
+            pos: &mut self.pos,
         }
-        if let Some(p) = self.pos.get_mut(n.cell as usize) {
-            // `i < heap.len() <= cells <= MAX_CELLS < 2^32`.
-            *p = i as u32;
-        }
-    }
-
-    fn sift_up(&mut self, mut i: usize) {
-        let Some(&n) = self.heap.get(i) else { return };
-        while i > 0 {
-            let parent = (i - 1) / 2;
-            let Some(&p) = self.heap.get(parent) else {
-                break;
-            };
-            if p <= n {
-                break;
-            }
-            self.place(i, p);
-            i = parent;
-        }
-        self.place(i, n);
-    }
-
-    fn sift_down(&mut self, mut i: usize) {
-        let Some(&n) = self.heap.get(i) else { return };
-        loop {
-            let l = 2 * i + 1;
-            let Some(&left) = self.heap.get(l) else { break };
-            let (c, child) = match self.heap.get(l + 1) {
-                Some(&right) if right < left => (l + 1, right),
-                _ => (l, left),
-            };
-            if n <= child {
-                break;
-            }
-            self.place(i, child);
-            i = c;
-        }
-        self.place(i, n);
     }
 
     fn insert(&mut self, cell: usize, key: Key) {
         let i = self.heap.len();
-        self.heap.push(Node::new(cell, key));
+        let n = Node::new(cell, key);
+        self.heap.push(n);
         self.peak = self.peak.max(self.heap.len());
         self.call_peak = self.call_peak.max(self.heap.len());
-        if let Some(p) = self.pos.get_mut(cell) {
-            *p = i as u32;
-        }
-        self.sift_up(i);
+        heap::sift_up(&mut self.slots(), i, n);
     }
 
     fn update(&mut self, cell: usize, key: Key) {
         let Some(&i) = self.pos.get(cell) else { return };
         let i = i as usize;
-        let Some(slot) = self.heap.get_mut(i) else {
+        let Some(old) = self.heap.get(i).map(Node::key) else {
             return;
         };
-        let old = slot.key();
-        *slot = Node::new(cell, key);
+        let n = Node::new(cell, key);
         if key < old {
-            self.sift_up(i);
+            heap::sift_up(&mut self.slots(), i, n);
         } else {
-            self.sift_down(i);
+            heap::sift_down(&mut self.slots(), i, n);
         }
     }
 
@@ -322,15 +283,36 @@ impl Open {
         let i = *p as usize;
         *p = NOT_OPEN;
         let Some(last) = self.heap.pop() else { return };
-        if i < self.heap.len() {
-            self.place(i, last);
-            self.sift_up(i);
-            if let Some(&n) = self.heap.get(i) {
-                if n == last {
-                    self.sift_down(i);
-                }
-            }
+        if i < self.heap.len() && heap::sift_up(&mut self.slots(), i, last) == i {
+            heap::sift_down(&mut self.slots(), i, last);
         }
+    }
+}
+
+/// The queue's entries and positions as the core's heap sees them: a slice of [`Node`]s in
+/// their own order, each one's slot recorded in `pos`.
+struct Slots<'a> {
+    heap: &'a mut [Node],
+    pos: &'a mut [u32],
+}
+
+impl heap::Slots for Slots<'_> {
+    type Item = Node;
+    fn at(&self, slot: usize) -> Option<Node> {
+        self.heap.get(slot).copied()
+    }
+    /// Put `n` at heap slot `i` and record its position.
+    fn put(&mut self, i: usize, n: Node) {
+        if let Some(slot) = self.heap.get_mut(i) {
+            *slot = n;
+        }
+        if let Some(p) = self.pos.get_mut(n.cell as usize) {
+            // `i < heap.len() <= cells <= MAX_CELLS < 2^32`.
+            *p = i as u32;
+        }
+    }
+    fn before(&self, a: Node, b: Node) -> bool {
+        a < b
     }
 }
 

@@ -48,6 +48,7 @@
 
 use crate::colony::pheromone::Blocks;
 use crate::map::grid::{Moves, Point, DX, DY};
+use crate::search::heap;
 
 use super::{dist, DIST_SHIFT, KNOWN, LINKS, NEXT_SHIFT};
 
@@ -385,9 +386,25 @@ impl Heap<'_> {
         self.set_slot(b, (i as u32).wrapping_add(1)); // i < blocks < 2^16 - 1
     }
 
+    /// The heap with the blocks' keys, as the crate's heap sees it (a copy of the fields, so
+    /// that the sifts keep them in registers).
+    #[inline(always)]
+    fn keys<'k>(&'k mut self, words: &'k [u32]) -> Keys<'k> {
+        Keys {
+            heap: Heap {
+                w: &mut *self.w,
+                len: self.len,
+                across: self.across,
+                start: self.start,
+                goal: self.goal,
+            },
+            words,
+        }
+    }
+
     /// Insert `b` or move it up after its distance dropped.
     fn push(&mut self, words: &[u32], b: usize) {
-        let mut i = match self.slot(b) {
+        let i = match self.slot(b) {
             0 => {
                 let i = self.len;
                 self.len = self.len.wrapping_add(1); // <= blocks
@@ -396,17 +413,7 @@ impl Heap<'_> {
             0xFFFF => return, // done
             s => s.wrapping_sub(1) as usize,
         };
-        // Sift up: move parents down until `b` fits.
-        while i > 0 {
-            let parent = i.wrapping_sub(1) >> 1;
-            let pb = self.block_at(parent);
-            if !self.before(words, b, pb) {
-                break;
-            }
-            self.place(i, pb);
-            i = parent;
-        }
-        self.place(i, b);
+        heap::sift_up(&mut self.keys(words), i, b);
     }
 
     /// Remove and return the block of least distance (`len > 0`).
@@ -418,27 +425,31 @@ impl Heap<'_> {
             return top;
         }
         let last = self.block_at(self.len);
-        // Sift down from the root with `last`.
-        let mut i = 0usize;
-        loop {
-            let l = i.wrapping_mul(2).wrapping_add(1);
-            if l >= self.len {
-                break;
-            }
-            let r = l.wrapping_add(1);
-            let mut c = l;
-            if r < self.len && self.before(words, self.block_at(r), self.block_at(l)) {
-                c = r;
-            }
-            let cb = self.block_at(c);
-            if !self.before(words, cb, last) {
-                break;
-            }
-            self.place(i, cb);
-            i = c;
-        }
-        self.place(i, last);
+        heap::sift_down(&mut self.keys(words), 0, last);
         top
+    }
+}
+
+/// The route's heap as the crate's heap sees it ([`heap::Slots`]): its live slots, their
+/// blocks' keys in `words`, and [`Heap::before`] as the order.
+struct Keys<'k> {
+    heap: Heap<'k>,
+    words: &'k [u32],
+}
+
+impl heap::Slots for Keys<'_> {
+    type Item = usize;
+    #[inline(always)]
+    fn at(&self, slot: usize) -> Option<usize> {
+        (slot < self.heap.len).then(|| self.heap.block_at(slot))
+    }
+    #[inline(always)]
+    fn put(&mut self, slot: usize, b: usize) {
+        self.heap.place(slot, b);
+    }
+    #[inline(always)]
+    fn before(&self, a: usize, b: usize) -> bool {
+        self.heap.before(self.words, a, b)
     }
 }
 
