@@ -16,8 +16,8 @@
 //! [`ohaca::Grid::step`]: the eight king moves between free cells, a diagonal only when both
 //! orthogonally adjacent cells are free (no corner is ever cut), read with
 //! [`ohaca::Grid::mask_at`]. The edges are symmetric, so a vertex's predecessors are its
-//! successors. Costs are the exact integers of [`ohaca::astar`]: [`STRAIGHT`] = 33,461 units a
-//! straight step, [`DIAGONAL`] = 47,321 a diagonal one, and the heuristic is the octile distance
+//! successors. Costs are the exact scale of [`ohaca::search::cost`], as in [`ohaca::astar`]:
+//! [`STRAIGHT`] = 33,461 units a straight step, [`cost::DIAGONAL`] = 47,321 a diagonal one, and the heuristic is the octile distance
 //! in those units (consistent: `STRAIGHT <= DIAGONAL <= 2 STRAIGHT`). A `g` or `rhs` above
 //! [`MAX_LENGTH`]` * STRAIGHT` is stored as infinite, so within that bound every comparison is
 //! exact in the reals (the proof is `ohaca::astar`'s) and the path found is a shortest path, with
@@ -50,10 +50,10 @@
 //! ([`DStarError`]): a cell off the map, a blocked start or goal (as [`ohaca::astar`]'s
 //! `BadCell`), a map too large; nothing panics and every table access is checked.
 
-use ohaca::astar::{self, AstarError, End, Entry, DIAGONAL, MAX_LENGTH, STRAIGHT};
+use ohaca::astar::{self, AstarError, End, Entry, MAX_LENGTH, STRAIGHT};
 use ohaca::geometry::steps_length;
 use ohaca::grid::{is_diagonal, neighbour};
-use ohaca::search::heap;
+use ohaca::search::{cost, heap};
 use ohaca::{Grid, Point};
 
 use crate::map::Map;
@@ -332,21 +332,9 @@ struct State {
     stats: Stats,
 }
 
-/// The octile distance between `a` and `b` in cost units.
+/// The octile distance between `a` and `b` in cost units (exact in u32 for u16 coordinates).
 fn octile(a: Point, b: Point) -> u64 {
-    let dx = u64::from(a.x.abs_diff(b.x));
-    let dy = u64::from(a.y.abs_diff(b.y));
-    let (lo, hi) = (dx.min(dy), dx.max(dy));
-    (hi - lo) * u64::from(STRAIGHT) + lo * u64::from(DIAGONAL)
-}
-
-/// Cost units of a move in direction `d`.
-fn step_cost(d: u8) -> u32 {
-    if is_diagonal(d) {
-        DIAGONAL
-    } else {
-        STRAIGHT
-    }
+    u64::from(cost::EXACT.octile(u32::from(a.x.abs_diff(b.x)), u32::from(a.y.abs_diff(b.y))))
 }
 
 /// The moves from `p` (bit `d` set iff [`Grid::step`] allows move `d`; 0 at a blocked cell):
@@ -415,7 +403,7 @@ impl State {
         let m = moves(grid, p);
         (0..8u8)
             .filter(|d| m & (1 << d) != 0)
-            .map(|d| add(step_cost(d), self.g(grid.index(neighbour(p, d)))))
+            .map(|d| add(cost::step(d), self.g(grid.index(neighbour(p, d)))))
             .min()
             .unwrap_or(INF)
     }
@@ -465,7 +453,7 @@ impl State {
                     let q = neighbour(p, d);
                     let qi = grid.index(q);
                     if q != self.goal {
-                        let via = add(step_cost(d), rhs_u);
+                        let via = add(cost::step(d), rhs_u);
                         if via < self.rhs(qi) {
                             self.set_rhs(qi, via);
                         }
@@ -480,7 +468,7 @@ impl State {
                 for d in (0..8u8).filter(|d| m & (1 << d) != 0) {
                     let q = neighbour(p, d);
                     let qi = grid.index(q);
-                    if q != self.goal && self.rhs(qi) == add(step_cost(d), g_u) {
+                    if q != self.goal && self.rhs(qi) == add(cost::step(d), g_u) {
                         let r = self.best_rhs(grid, qi);
                         self.set_rhs(qi, r);
                     }
@@ -512,7 +500,7 @@ impl State {
                 .filter(|d| m & (1 << d) != 0)
                 .map(|d| {
                     let q = neighbour(p, d);
-                    (d, q, add(step_cost(d), self.g(grid.index(q))))
+                    (d, q, add(cost::step(d), self.g(grid.index(q))))
                 })
                 .min_by_key(|&(_, _, c)| c)?;
             if c == INF {

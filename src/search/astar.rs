@@ -14,23 +14,16 @@
 //! orthogonally adjacent cells are free, so no corner is ever cut; read from the map's bits with
 //! [`Grid::mask_at`]). The map's bits are only read: neither variant copies them.
 //!
-//! **Costs, exact.** A straight step costs [`STRAIGHT`] units, a diagonal [`DIAGONAL`]:
-//! `DIAGONAL / STRAIGHT = 47321 / 33461` is a convergent of `sqrt 2` with
-//! `DIAGONAL^2 - 2 STRAIGHT^2 = -1` (a Pell solution). Every cost compared (`g`, and `f = g + h`
-//! with `h` the octile distance, consistent for these costs) is `A STRAIGHT + B DIAGONAL` for
-//! non-negative integers `A`, `B`; while `A + B <= `[`MAX_LENGTH`] (checked on every push: a
-//! cost above `MAX_LENGTH * STRAIGHT` is never stored or queued), two such integers compare
-//! exactly as the real lengths `A + B sqrt 2` do, equality included. Proof: with `x = dA + dB
-//! sqrt 2 != 0` and `y = dA - dB sqrt 2`, `x y = dA^2 - 2 dB^2` is a non-zero integer, so
-//! `|x| >= 1 / |y| >= 1 / (N (1 + sqrt 2))` for `|dA|, |dB| <= N`; the integer difference is
-//! `STRAIGHT x + dB (DIAGONAL - STRAIGHT sqrt 2)` and `|DIAGONAL - STRAIGHT sqrt 2| = 1 /
-//! (DIAGONAL + STRAIGHT sqrt 2)`, so the sign survives while `N^2 < STRAIGHT (DIAGONAL +
-//! STRAIGHT sqrt 2) / (1 + sqrt 2)`, i.e. `N < 36218` (the unit test `costs_order_exactly`
-//! checks it for every `dB` exhaustively). The search is therefore exact in the reals, not only
-//! up to a float's rounding: the path found is a shortest 8-connected no-corner-cutting path, and
-//! [`Search::length`] is recomputed from its step counts with [`steps_length`], the core's own
-//! formula, so it compares bit for bit with a core path of the same steps. A goal whose optimum
-//! exceeds `MAX_LENGTH` is [`AstarError::TooFar`], never a wrong path.
+//! **Costs, exact.** A straight step costs [`STRAIGHT`] units, a diagonal [`DIAGONAL`]: the
+//! exact scale of [`super::cost`], on which two costs of at most [`MAX_LENGTH`] steps compare
+//! exactly as the real lengths do, equality included (the proof is there). Every cost compared
+//! (`g`, and `f = g + h` with `h` the octile distance, consistent for these costs) is checked on
+//! every push: a cost above `MAX_LENGTH * STRAIGHT` is never stored or queued. The search is
+//! therefore exact in the reals, not only up to a float's rounding: the path found is a shortest
+//! 8-connected no-corner-cutting path, and [`Search::length`] is recomputed from its step counts
+//! with [`steps_length`], the core's own formula, so it compares bit for bit with a core path of
+//! the same steps. A goal whose optimum exceeds `MAX_LENGTH` is [`AstarError::TooFar`], never a
+//! wrong path.
 //!
 //! **Order.** The open list is a binary min-heap of [`Entry`] (12 bytes: `f`, `g`, cell and
 //! direction) in a caller slice, ordered by smaller `f`, then larger `g` (deeper first). At each
@@ -55,6 +48,7 @@ use crate::geometry::steps_length;
 use crate::map::dir::{is_diagonal, opposite, Dir, DX, DY};
 use crate::map::grid::{Grid, Point};
 
+use super::cost;
 use super::heap::{Full, Heap, Keyed};
 
 /// Nibble of a cell not closed yet.
@@ -64,14 +58,12 @@ pub const START: u8 = 9;
 /// What a nibble beyond the slice reads as (never stored).
 const OFF: u8 = 15;
 
-/// Cost units of a straight step.
-pub const STRAIGHT: u32 = 33_461;
-/// Cost units of a diagonal step: `DIAGONAL^2 - 2 STRAIGHT^2 = -1`.
-pub const DIAGONAL: u32 = 47_321;
+pub use super::cost::{DIAGONAL, STRAIGHT};
+
 /// Longest optimum (in straight-step lengths) the search decides exactly: costs up to
-/// `MAX_LENGTH * STRAIGHT` units are compared exactly (module docs); anything beyond is dropped
-/// and, if the goal is not reached, reported as [`AstarError::TooFar`].
-pub const MAX_LENGTH: u32 = 36_000;
+/// `MAX_LENGTH * STRAIGHT` units are compared exactly ([`super::cost::EXACT_STEPS`]); anything
+/// beyond is dropped and, if the goal is not reached, reported as [`AstarError::TooFar`].
+pub const MAX_LENGTH: u32 = cost::EXACT_STEPS;
 /// The largest cost stored or queued.
 const LIMIT: u32 = MAX_LENGTH * STRAIGHT;
 
@@ -223,27 +215,11 @@ impl fmt::Display for AstarError {
     }
 }
 
-/// Cost units of a step in direction `d`.
-#[inline(always)]
-const fn step_cost(d: Dir) -> u32 {
-    if is_diagonal(d) {
-        DIAGONAL
-    } else {
-        STRAIGHT
-    }
-}
-
 /// The octile distance between cells `(ax, ay)` and `(bx, by)` in cost units (at most
 /// `65535 * DIAGONAL < 2^32` on a map of u16 sides).
 #[inline(always)]
 fn octile(ax: u32, ay: u32, bx: u32, by: u32) -> u32 {
-    let dx = ax.abs_diff(bx);
-    let dy = ay.abs_diff(by);
-    let (lo, hi) = if dx < dy { (dx, dy) } else { (dy, dx) };
-    // hi >= lo, both < 2^16: no wrap.
-    hi.wrapping_sub(lo)
-        .wrapping_mul(STRAIGHT)
-        .wrapping_add(lo.wrapping_mul(DIAGONAL))
+    cost::EXACT.octile(ax.abs_diff(bx), ay.abs_diff(by))
 }
 
 /// The moves worth trying from a cell entered by direction `d` (`d >= 8`: the start, every
@@ -436,7 +412,7 @@ fn run<S: Store>(
     for (d, m) in moves.iter_mut().enumerate() {
         *m = (
             offs.get(d).copied().unwrap_or(0),
-            step_cost(d as u8),
+            cost::step(d as u8),
             DX.get(d).copied().unwrap_or(0) as u32,
             DY.get(d).copied().unwrap_or(0) as u32,
         );
@@ -707,7 +683,7 @@ impl Iterator for PathBackCosts<'_, '_> {
         // The costs strictly decrease along the walk, so it ends.
         for d in 0..8u8 {
             if let Some(p) = self.grid.step(self.at, opposite(d)) {
-                if cost(p).and_then(|c| c.checked_add(step_cost(d))) == Some(g) {
+                if cost(p).and_then(|c| c.checked_add(cost::step(d))) == Some(g) {
                     self.at = p;
                     return Some(Ok(d));
                 }
@@ -859,38 +835,8 @@ mod tests {
         solve(v, &grid, s, g, 8 * grid.cells())
     }
 
-    /// Every pair of costs `A STRAIGHT + B DIAGONAL` with `A, B <= MAX_LENGTH` compares as
-    /// `A + B sqrt 2` does. The fixed-point difference `dA STRAIGHT + dB DIAGONAL` grows with
-    /// `dA`, so for each `dB` it suffices that it is negative at the largest `dA` with
-    /// `dA + dB sqrt 2 < 0` and positive at the next (within `|dA| <= MAX_LENGTH`); `sqrt 2` is
-    /// irrational, so no real difference is 0 unless both are. (At `dB = STRAIGHT`, beyond the
-    /// bound, `dA = -DIAGONAL` would give a false tie.)
     #[test]
-    fn costs_order_exactly() {
-        let (s, d, n) = (
-            i64::from(STRAIGHT),
-            i64::from(DIAGONAL),
-            i64::from(MAX_LENGTH),
-        );
-        assert_eq!(d * d - 2 * s * s, -1);
-        for db in 1..=n {
-            // k < db sqrt 2 < k + 1.
-            let two = 2 * db * db;
-            let mut k = (two as f64).sqrt() as i64;
-            while k * k > two {
-                k -= 1;
-            }
-            while (k + 1) * (k + 1) <= two {
-                k += 1;
-            }
-            assert_ne!(k * k, two);
-            // dA = -(k + 1): real negative; dA = -k: real positive (and -dB mirrors both). Only
-            // |dA| <= N occurs: below -N, the smallest dA that does.
-            if k < n {
-                assert!(-(k + 1) * s + db * d < 0, "dB {db}");
-            }
-            assert!(-k.min(n) * s + db * d > 0, "dB {db}");
-        }
+    fn costs_stay_below_2_31() {
         // The largest sums stay below 2^32 (f = g + h saturates above LIMIT).
         assert!(u64::from(LIMIT) + u64::from(DIAGONAL) < 1 << 31);
     }

@@ -2,9 +2,9 @@
 //! exact A* inside it (integer costs, ties broken by a fixed rule, so the same on every platform).
 
 use crate::map::grid::{Grid, Point, DX, DY};
-use crate::search::heap;
+use crate::search::{cost, heap};
 
-use super::{octile, Budget, Scratch, CLOSED, DIAGONAL, MAX_SIDE, STRAIGHT, UNREACHED};
+use super::{octile, Budget, Scratch, CLOSED, MAX_SIDE, UNREACHED};
 
 /// The cell before `p` (box index `i`) on a shortest path of the last [`search`]: its first
 /// neighbour, in direction order, inside the box and reached, one allowed move away, with
@@ -41,7 +41,7 @@ pub(super) fn pred(
         let q = Point::new(qx as u16, qy as u16);
         let Some(j) = bbox.local(q) else { continue };
         let gq = scratch.g.get(j).copied().unwrap_or(UNREACHED);
-        let cost = if d & 1 == 1 { DIAGONAL } else { STRAIGHT };
+        let cost = cost::step(d);
         if gq != UNREACHED && gq.checked_add(cost) == Some(gp) {
             return Some((q, j));
         }
@@ -349,17 +349,12 @@ pub(super) fn search(
             // The move stays inside the box: j is its box index.
             let j = iu.wrapping_add_signed(off.get(d).copied().unwrap_or(0));
             let Some(&gj) = g.get(j) else { continue };
-            let ng = gi.saturating_add(if d & 1 == 1 { DIAGONAL } else { STRAIGHT });
+            let ng = gi.saturating_add(cost::step(d as u8));
             if gj == UNREACHED {
                 // Box coordinates below MAX_SIDE: no overflow in i32.
                 let qx = (lx as i32).wrapping_add(DX.get(d).copied().unwrap_or(0));
                 let qy = (ly as i32).wrapping_add(DY.get(d).copied().unwrap_or(0));
-                let (dx, dy) = (qx.abs_diff(tx), qy.abs_diff(ty));
-                let (hi, lo) = (dx.max(dy), dx.min(dy));
-                let h = hi
-                    .wrapping_sub(lo)
-                    .wrapping_mul(STRAIGHT)
-                    .wrapping_add(lo.wrapping_mul(DIAGONAL));
+                let h = cost::EXACT.octile(qx.abs_diff(tx), qy.abs_diff(ty));
                 if let (Some(gs), Some(fs)) = (g.get_mut(j), f.get_mut(j)) {
                     *gs = ng;
                     *fs = ng.saturating_add(h);
