@@ -31,6 +31,8 @@
 //! | [`corridor`] | the exact any-angle path through the cells around a smoothed path (small maps) |
 //! | [`refine`] | local search: the exact shortest path in a window sliding along a raw path |
 //! | [`astar`] | the exact A* baseline: a whole-map search in 4 bits a cell plus a heap (not used by the planner) |
+//! | [`search::heap`] | the one binary min-heap every open list is built on (A*, the route, the refine window) |
+//! | [`search::cost`] | the step costs of every integer search: the exact scale and the route's coarse one |
 //! | [`planner`] | parameters, caller-provided storage, the iteration loop and the result; warm starts, reused and repaired answers |
 //! | [`board`] | what each board's firmware holds (cells, longest path, buffer layout), described once for the firmware and the host |
 //! | `heap` | (feature `alloc`) the planner's storage on the heap, sized at run time |

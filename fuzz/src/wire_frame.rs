@@ -14,7 +14,10 @@
 //!   decodes back;
 //! * a decoded message re-encodes (never larger than the original payload, so within the
 //!   protocol limits whenever the original was) and decodes back to the same value, bit for bit;
-//! * a decoded path reply streamed by [`PathStream`] gives exactly the bytes of [`encode_reply`];
+//! * a decoded path reply sent in parts as the firmware sends it ([`PathBody`] read a piece at a
+//!   time, each piece a [`PathPart`] frame of [`encode_reply`]) reassembles to exactly the body
+//!   of its whole frame, and [`PathBody::new`] refuses it exactly when that frame with the widest
+//!   id would not fit [`MAX_REPLY_WIRE`];
 //! * map uploads (raw and run-length) and cell updates go through the device's own state machine
 //!   ([`Upload`], [`set_rect`], [`set_cells`]) on a 512x512 buffer, kept across the frames of one
 //!   input as on the device: a completed map fits the limits, an accepted update did what it said.
@@ -23,7 +26,7 @@ use core::fmt::Debug;
 
 use ohaca::protocol::{
     decode_reply, decode_request, encode_reply, encode_request, set_cells, set_rect, DecodeError,
-    EncodeError, Encoding, ErrorReply, MapChunk, MapLimits, PathStream, Reply, ReplyReader,
+    EncodeError, Encoding, ErrorReply, MapChunk, MapLimits, PathBody, PathPart, Reply, ReplyReader,
     Request, RequestReader, Upload, MAX_REPLY, MAX_REPLY_WIRE, MAX_REQUEST, MAX_REQUEST_WIRE,
     UNKNOWN_ID,
 };
@@ -339,7 +342,7 @@ fn check_reply_frame(frame: &mut [u8], piece: usize) -> bool {
                     if let Ok(raw) = d.raw(Point::new(1000, 1000)) {
                         assert_eq!(raw.len(), d.directions.len() + 1);
                     }
-                    check_stream(id, &reply, piece);
+                    check_parts(id, &reply, piece);
                 }
                 (Reply::Error(e), _) => {
                     let _ = format!("{e}");
@@ -370,29 +373,45 @@ fn check_reply_frame(frame: &mut [u8], piece: usize) -> bool {
     }
 }
 
-/// A path reply streamed a piece at a time must be `encode_reply`'s frame, and refused exactly
-/// when that frame does not fit [`MAX_REPLY_WIRE`].
-fn check_stream(id: u32, reply: &Reply<'_>, piece: usize) {
+/// A path reply sent in [`PathPart`] frames of `piece` bytes (as the firmware sends a long path)
+/// must reassemble to the body of `encode_reply`'s whole frame, and [`PathBody::new`] must
+/// refuse it exactly when that frame with the widest id does not fit [`MAX_REPLY_WIRE`].
+fn check_parts(id: u32, reply: &Reply<'_>, piece: usize) {
     let Reply::Path(p) = reply else { return };
     let mut whole = vec![0u8; MAX_REPLY_WIRE];
-    let encoded = encode_reply(id, reply, &mut whole);
-    match (PathStream::new(id, p), encoded) {
-        (Ok(mut stream), Ok(n)) => {
-            let mut wire = Vec::with_capacity(n);
-            let mut buf = vec![0u8; piece.clamp(1, 300)];
+    let widest = encode_reply(u32::MAX, reply, &mut whole);
+    match (PathBody::new(p), widest) {
+        (Ok(body), Ok(_)) => {
+            let n = encode_reply(id, reply, &mut whole).expect("fits with the widest id");
+            let payload = reference_unframe(&whole[..n - 1]).expect("own frame");
+            let mut got = Vec::with_capacity(body.len());
+            let mut buf = vec![0u8; piece.clamp(1, ohaca::protocol::PART_BYTES)];
+            let mut frame = vec![0u8; MAX_REPLY_WIRE];
             loop {
-                let k = stream.fill(&mut buf);
+                let k = body.read(got.len(), &mut buf);
                 if k == 0 {
                     break;
                 }
-                wire.extend_from_slice(&buf[..k]);
-                assert!(wire.len() <= n, "stream longer than the frame");
+                let part = PathPart {
+                    offset: got.len() as u32,
+                    total_len: body.len() as u32,
+                    bytes: &buf[..k],
+                };
+                let m = encode_reply(id, &Reply::PathPart(part), &mut frame).expect("a part fits");
+                match decode_reply(&mut frame[..m - 1]) {
+                    Ok((i, Reply::PathPart(back))) if i == id => {
+                        assert_eq!(back.offset as usize, got.len());
+                        got.extend_from_slice(back.bytes);
+                    }
+                    other => panic!("a part decodes as {other:?}"),
+                }
+                assert!(got.len() <= body.len(), "parts longer than the body");
             }
-            assert!(stream.is_done());
-            assert_eq!(wire, whole[..n]);
+            assert!(payload.ends_with(&got), "parts are not the whole reply's body");
+            assert_eq!(got.len(), body.len());
         }
-        (Err(EncodeError::BufferTooSmall { .. }), Err(EncodeError::BufferTooSmall { .. })) => {}
-        (s, e) => panic!("PathStream {:?} vs encode_reply {e:?}", s.map(|_| ())),
+        (Err(a), Err(b)) => assert_eq!(a, b),
+        (a, b) => panic!("PathBody {:?} vs encode_reply {b:?}", a.map(|_| ())),
     }
 }
 

@@ -120,7 +120,7 @@ fn run(variant: &str, data: &[u8], enc: &[u8], buf: &mut [u8]) -> u64 {
         "crc-notable" => CRC_NOTABLE.checksum(data).into(),
         "crc-table1" => CRC_T1.checksum(data).into(),
         "crc-table16" => CRC_T16.checksum(data).into(),
-        // A byte at a time, as `PathStream` feeds its CRC.
+        // A byte at a time, as a frame encoded piece by piece would feed its CRC.
         "crc-hand-bytewise" => {
             let mut r = frame::CRC32_INIT;
             for &b in data {

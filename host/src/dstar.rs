@@ -16,8 +16,8 @@
 //! [`ohaca::Grid::step`]: the eight king moves between free cells, a diagonal only when both
 //! orthogonally adjacent cells are free (no corner is ever cut), read with
 //! [`ohaca::Grid::mask_at`]. The edges are symmetric, so a vertex's predecessors are its
-//! successors. Costs are the exact integers of [`ohaca::astar`]: [`STRAIGHT`] = 33,461 units a
-//! straight step, [`DIAGONAL`] = 47,321 a diagonal one, and the heuristic is the octile distance
+//! successors. Costs are the exact scale of [`ohaca::search::cost`], as in [`ohaca::astar`]:
+//! [`STRAIGHT`] = 33,461 units a straight step, [`cost::DIAGONAL`] = 47,321 a diagonal one, and the heuristic is the octile distance
 //! in those units (consistent: `STRAIGHT <= DIAGONAL <= 2 STRAIGHT`). A `g` or `rhs` above
 //! [`MAX_LENGTH`]` * STRAIGHT` is stored as infinite, so within that bound every comparison is
 //! exact in the reals (the proof is `ohaca::astar`'s) and the path found is a shortest path, with
@@ -50,9 +50,10 @@
 //! ([`DStarError`]): a cell off the map, a blocked start or goal (as [`ohaca::astar`]'s
 //! `BadCell`), a map too large; nothing panics and every table access is checked.
 
-use ohaca::astar::{self, AstarError, End, Entry, DIAGONAL, MAX_LENGTH, STRAIGHT};
+use ohaca::astar::{self, AstarError, End, Entry, MAX_LENGTH, STRAIGHT};
 use ohaca::geometry::steps_length;
 use ohaca::grid::{is_diagonal, neighbour};
+use ohaca::search::{cost, heap};
 use ohaca::{Grid, Point};
 
 use crate::map::Map;
@@ -215,8 +216,8 @@ impl Node {
 
 const _: () = assert!(ENTRY_BYTES == 16);
 
-/// The queue: an indexed binary min-heap (a vertex's position in `pos`, [`NOT_OPEN`] if it is
-/// not in the queue).
+/// The queue: an indexed binary min-heap, the core's ([`heap`]), over the entries' vector (a
+/// vertex's position in `pos`, [`NOT_OPEN`] if it is not in the queue).
 #[derive(Clone, Debug)]
 struct Open {
     heap: Vec<Node>,
@@ -244,74 +245,34 @@ impl Open {
         self.call_peak = self.heap.len();
     }
 
-    /// Put `n` at heap slot `i` and record its position.
-    fn place(&mut self, i: usize, n: Node) {
-        if let Some(slot) = self.heap.get_mut(i) {
-            *slot = n;
+    /// The queue as the core's heap sees it ([`heap::Slots`]).
+    fn slots(&mut self) -> Slots<'_> {
+        Slots {
+            heap: &mut self.heap,
+            pos: &mut self.pos,
         }
-        if let Some(p) = self.pos.get_mut(n.cell as usize) {
-            // `i < heap.len() <= cells <= MAX_CELLS < 2^32`.
-            *p = i as u32;
-        }
-    }
-
-    fn sift_up(&mut self, mut i: usize) {
-        let Some(&n) = self.heap.get(i) else { return };
-        while i > 0 {
-            let parent = (i - 1) / 2;
-            let Some(&p) = self.heap.get(parent) else {
-                break;
-            };
-            if p <= n {
-                break;
-            }
-            self.place(i, p);
-            i = parent;
-        }
-        self.place(i, n);
-    }
-
-    fn sift_down(&mut self, mut i: usize) {
-        let Some(&n) = self.heap.get(i) else { return };
-        loop {
-            let l = 2 * i + 1;
-            let Some(&left) = self.heap.get(l) else { break };
-            let (c, child) = match self.heap.get(l + 1) {
-                Some(&right) if right < left => (l + 1, right),
-                _ => (l, left),
-            };
-            if n <= child {
-                break;
-            }
-            self.place(i, child);
-            i = c;
-        }
-        self.place(i, n);
     }
 
     fn insert(&mut self, cell: usize, key: Key) {
         let i = self.heap.len();
-        self.heap.push(Node::new(cell, key));
+        let n = Node::new(cell, key);
+        self.heap.push(n);
         self.peak = self.peak.max(self.heap.len());
         self.call_peak = self.call_peak.max(self.heap.len());
-        if let Some(p) = self.pos.get_mut(cell) {
-            *p = i as u32;
-        }
-        self.sift_up(i);
+        heap::sift_up(&mut self.slots(), i, n);
     }
 
     fn update(&mut self, cell: usize, key: Key) {
         let Some(&i) = self.pos.get(cell) else { return };
         let i = i as usize;
-        let Some(slot) = self.heap.get_mut(i) else {
+        let Some(old) = self.heap.get(i).map(Node::key) else {
             return;
         };
-        let old = slot.key();
-        *slot = Node::new(cell, key);
+        let n = Node::new(cell, key);
         if key < old {
-            self.sift_up(i);
+            heap::sift_up(&mut self.slots(), i, n);
         } else {
-            self.sift_down(i);
+            heap::sift_down(&mut self.slots(), i, n);
         }
     }
 
@@ -322,15 +283,36 @@ impl Open {
         let i = *p as usize;
         *p = NOT_OPEN;
         let Some(last) = self.heap.pop() else { return };
-        if i < self.heap.len() {
-            self.place(i, last);
-            self.sift_up(i);
-            if let Some(&n) = self.heap.get(i) {
-                if n == last {
-                    self.sift_down(i);
-                }
-            }
+        if i < self.heap.len() && heap::sift_up(&mut self.slots(), i, last) == i {
+            heap::sift_down(&mut self.slots(), i, last);
         }
+    }
+}
+
+/// The queue's entries and positions as the core's heap sees them: a slice of [`Node`]s in
+/// their own order, each one's slot recorded in `pos`.
+struct Slots<'a> {
+    heap: &'a mut [Node],
+    pos: &'a mut [u32],
+}
+
+impl heap::Slots for Slots<'_> {
+    type Item = Node;
+    fn at(&self, slot: usize) -> Option<Node> {
+        self.heap.get(slot).copied()
+    }
+    /// Put `n` at heap slot `i` and record its position.
+    fn put(&mut self, i: usize, n: Node) {
+        if let Some(slot) = self.heap.get_mut(i) {
+            *slot = n;
+        }
+        if let Some(p) = self.pos.get_mut(n.cell as usize) {
+            // `i < heap.len() <= cells <= MAX_CELLS < 2^32`.
+            *p = i as u32;
+        }
+    }
+    fn before(&self, a: Node, b: Node) -> bool {
+        a < b
     }
 }
 
@@ -350,21 +332,9 @@ struct State {
     stats: Stats,
 }
 
-/// The octile distance between `a` and `b` in cost units.
+/// The octile distance between `a` and `b` in cost units (exact in u32 for u16 coordinates).
 fn octile(a: Point, b: Point) -> u64 {
-    let dx = u64::from(a.x.abs_diff(b.x));
-    let dy = u64::from(a.y.abs_diff(b.y));
-    let (lo, hi) = (dx.min(dy), dx.max(dy));
-    (hi - lo) * u64::from(STRAIGHT) + lo * u64::from(DIAGONAL)
-}
-
-/// Cost units of a move in direction `d`.
-fn step_cost(d: u8) -> u32 {
-    if is_diagonal(d) {
-        DIAGONAL
-    } else {
-        STRAIGHT
-    }
+    u64::from(cost::EXACT.octile(u32::from(a.x.abs_diff(b.x)), u32::from(a.y.abs_diff(b.y))))
 }
 
 /// The moves from `p` (bit `d` set iff [`Grid::step`] allows move `d`; 0 at a blocked cell):
@@ -433,7 +403,7 @@ impl State {
         let m = moves(grid, p);
         (0..8u8)
             .filter(|d| m & (1 << d) != 0)
-            .map(|d| add(step_cost(d), self.g(grid.index(neighbour(p, d)))))
+            .map(|d| add(cost::step(d), self.g(grid.index(neighbour(p, d)))))
             .min()
             .unwrap_or(INF)
     }
@@ -483,7 +453,7 @@ impl State {
                     let q = neighbour(p, d);
                     let qi = grid.index(q);
                     if q != self.goal {
-                        let via = add(step_cost(d), rhs_u);
+                        let via = add(cost::step(d), rhs_u);
                         if via < self.rhs(qi) {
                             self.set_rhs(qi, via);
                         }
@@ -498,7 +468,7 @@ impl State {
                 for d in (0..8u8).filter(|d| m & (1 << d) != 0) {
                     let q = neighbour(p, d);
                     let qi = grid.index(q);
-                    if q != self.goal && self.rhs(qi) == add(step_cost(d), g_u) {
+                    if q != self.goal && self.rhs(qi) == add(cost::step(d), g_u) {
                         let r = self.best_rhs(grid, qi);
                         self.set_rhs(qi, r);
                     }
@@ -530,7 +500,7 @@ impl State {
                 .filter(|d| m & (1 << d) != 0)
                 .map(|d| {
                     let q = neighbour(p, d);
-                    (d, q, add(step_cost(d), self.g(grid.index(q))))
+                    (d, q, add(cost::step(d), self.g(grid.index(q))))
                 })
                 .min_by_key(|&(_, _, c)| c)?;
             if c == INF {

@@ -12,7 +12,7 @@ pub fn crc32(data: &[u8]) -> u32 {
 /// The CRC register before the first byte (the result is `!register` after the last one).
 pub(crate) const CRC32_INIT: u32 = !0;
 
-/// Feed one byte into the CRC register: [`crc32`] a byte at a time, for streamed frames.
+/// Feed one byte into the CRC register: [`crc32`] a byte at a time.
 pub(crate) fn crc32_step(mut crc: u32, b: u8) -> u32 {
     crc ^= u32::from(b);
     for _ in 0..8 {

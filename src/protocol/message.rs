@@ -10,8 +10,8 @@ use crate::planner::{Origin, Params};
 use super::wire::PointDef;
 #[cfg(doc)] // the doc links
 use super::{
-    ErrorCode, PathStream, RleEncoder, MAX_CHUNK, MAX_DIRECTIONS, MAX_REPLY, MAX_REQUEST,
-    MAX_STEPS, MAX_UPDATE_CELLS, MAX_WAYPOINTS, PART_BYTES, VERSION,
+    ErrorCode, RleEncoder, MAX_CHUNK, MAX_DIRECTIONS, MAX_REPLY, MAX_REQUEST, MAX_STEPS,
+    MAX_UPDATE_CELLS, MAX_WAYPOINTS, PART_BYTES, VERSION,
 };
 use super::{ErrorReply, PathPart, Waypoints};
 

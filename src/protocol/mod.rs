@@ -38,7 +38,6 @@
 //! | `frame` | CRC-32, COBS and the byte-at-a-time [`FrameReader`] |
 //! | `wire` | serde glue: points on the wire, the packed [`Waypoints`] |
 //! | `parts` | [`PathBody`], [`PathPart`]: a long path reply in frames other replies can pass |
-//! | `stream` | [`PathStream`]: a path reply as one frame, encoded piece by piece |
 //! | `map` | map uploads (raw and run-length) and cell updates as the device applies them |
 
 use core::fmt;
@@ -50,7 +49,6 @@ mod frame;
 mod map;
 mod message;
 mod parts;
-mod stream;
 mod wire;
 
 pub use error_reply::{ErrorCode, ErrorReply, UnknownCode};
@@ -62,7 +60,6 @@ pub use map::{
 };
 pub use message::{Capacity, HelloReply, PathReply, Reply, Request, StatsReply};
 pub use parts::{decode_path_body, PathBody, PathPart, PART_BYTES};
-pub use stream::PathStream;
 pub use wire::{Waypoints, WAYPOINT_BYTES};
 
 /// Protocol version, reported in [`HelloReply::protocol_version`]. Bumped on any change to the
@@ -125,8 +122,9 @@ pub const fn path_payload(waypoints: usize, directions: usize) -> usize {
 
 /// Largest reply payload (postcard bytes plus CRC) a host must accept: a [`PathReply`] with
 /// [`MAX_WAYPOINTS`] waypoints and [`MAX_DIRECTIONS`] directions, every path of [`MAX_STEPS`]
-/// steps, fits (81,985 bytes). A device need not hold one: [`PathStream`] encodes a path frame
-/// piece by piece.
+/// steps, fits (81,985 bytes). A device need not hold one: it sends a long path in
+/// [`PathPart`] frames read from a [`PathBody`], each encoded by the one encoder,
+/// [`encode_reply`].
 pub const MAX_REPLY: usize = path_payload(MAX_WAYPOINTS, MAX_DIRECTIONS);
 
 // The figure docs/PROTOCOL.md gives (`host-tests/tests/documents.rs` reads it there and encodes

@@ -92,8 +92,8 @@ impl<'a> PathBody<'a> {
         Ok(body)
     }
 
-    /// The body of `path`, whatever its length (`super::PathStream` checks its frame's).
-    pub(super) fn unchecked(path: &PathReply<'a>) -> Result<Self, EncodeError> {
+    /// The body of `path`, whatever its length ([`PathBody::new`] checks it).
+    fn unchecked(path: &PathReply<'a>) -> Result<Self, EncodeError> {
         let fixed = PathReply {
             waypoints: Waypoints::Points(&[]),
             directions: &[],

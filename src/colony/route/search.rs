@@ -5,7 +5,8 @@
 //! goal. They walk near the route's corridor, so the route needs to be right there and nowhere
 //! else. The search is therefore an A* rooted at the goal's block (the route's distances are to
 //! the goal), led by the octile block distance to the start's block (10 / 14 per straight /
-//! diagonal block step: the steps' own costs, so the estimate is consistent and a closed block's
+//! diagonal block step, the coarse scale [`BLOCKS`] of `search::cost`, which says why not the
+//! exact one: the steps' own costs, so the estimate is consistent and a closed block's
 //! distance is exact), ties broken towards the straight line between the ends ([`Heap::tie`]).
 //! It runs until it closes the start's block, at `F`, the length of the shortest block route;
 //! by then it has closed every block whose shortest block route through it is shorter than `F`
@@ -48,13 +49,15 @@
 
 use crate::colony::pheromone::Blocks;
 use crate::map::grid::{Moves, Point, DX, DY};
+use crate::search::cost::BLOCKS;
+use crate::search::heap;
 
 use super::{dist, DIST_SHIFT, KNOWN, LINKS, NEXT_SHIFT};
 
 /// After the start's block, the search closes the blocks whose key is at most `F + SLACK`
 /// (four straight block steps: block routes are coarse, and a corridor whose cells are as short
 /// may be a few block steps longer on blocks) ...
-pub const SLACK: u32 = 40;
+pub const SLACK: u32 = 4 * BLOCKS.straight;
 
 /// ... up to `WIDEN` times the blocks it had closed by then (at least [`WIDEN_MIN`] more), in
 /// the search's order: the ties at `F` nearest the straight line first (a wider band), then the
@@ -86,14 +89,12 @@ pub struct Searched {
     pub length: Option<u32>,
 }
 
-/// The octile block distance between blocks `(ax, ay)` and `(bx, by)`: 10 a straight step, 14 a
-/// diagonal one.
+/// The octile block distance between blocks `(ax, ay)` and `(bx, by)` on the route's coarse
+/// scale ([`BLOCKS`]: 10 a straight step, 14 a diagonal one).
 #[inline]
 pub(super) fn octile(ax: usize, ay: usize, bx: usize, by: usize) -> u32 {
-    let dx = ax.abs_diff(bx) as u32; // < 2^16
-    let dy = ay.abs_diff(by) as u32;
-    let (hi, lo) = (dx.max(dy), dx.min(dy));
-    hi.wrapping_mul(10).wrapping_add(lo.wrapping_mul(4))
+    // Block coordinates are below 2^16.
+    BLOCKS.octile(ax.abs_diff(bx) as u32, ay.abs_diff(by) as u32)
 }
 
 /// A* over the blocks from the goal's block, towards the start's block, as the module docs say
@@ -280,7 +281,7 @@ pub(super) fn resume(
             if heap.slot(nb) == DONE {
                 continue;
             }
-            let step = if d % 2 == 1 { 14 } else { 10 };
+            let step = BLOCKS.step(d as u8);
             let nf = g.wrapping_add(step).wrapping_add(octile(nx, ny, sx, sy));
             if nf < dist(wn) {
                 // The neighbour's next block is `b`, the opposite direction of `d`.
@@ -385,9 +386,25 @@ impl Heap<'_> {
         self.set_slot(b, (i as u32).wrapping_add(1)); // i < blocks < 2^16 - 1
     }
 
+    /// The heap with the blocks' keys, as the crate's heap sees it (a copy of the fields, so
+    /// that the sifts keep them in registers).
+    #[inline(always)]
+    fn keys<'k>(&'k mut self, words: &'k [u32]) -> Keys<'k> {
+        Keys {
+            heap: Heap {
+                w: &mut *self.w,
+                len: self.len,
+                across: self.across,
+                start: self.start,
+                goal: self.goal,
+            },
+            words,
+        }
+    }
+
     /// Insert `b` or move it up after its distance dropped.
     fn push(&mut self, words: &[u32], b: usize) {
-        let mut i = match self.slot(b) {
+        let i = match self.slot(b) {
             0 => {
                 let i = self.len;
                 self.len = self.len.wrapping_add(1); // <= blocks
@@ -396,17 +413,7 @@ impl Heap<'_> {
             0xFFFF => return, // done
             s => s.wrapping_sub(1) as usize,
         };
-        // Sift up: move parents down until `b` fits.
-        while i > 0 {
-            let parent = i.wrapping_sub(1) >> 1;
-            let pb = self.block_at(parent);
-            if !self.before(words, b, pb) {
-                break;
-            }
-            self.place(i, pb);
-            i = parent;
-        }
-        self.place(i, b);
+        heap::sift_up(&mut self.keys(words), i, b);
     }
 
     /// Remove and return the block of least distance (`len > 0`).
@@ -418,27 +425,31 @@ impl Heap<'_> {
             return top;
         }
         let last = self.block_at(self.len);
-        // Sift down from the root with `last`.
-        let mut i = 0usize;
-        loop {
-            let l = i.wrapping_mul(2).wrapping_add(1);
-            if l >= self.len {
-                break;
-            }
-            let r = l.wrapping_add(1);
-            let mut c = l;
-            if r < self.len && self.before(words, self.block_at(r), self.block_at(l)) {
-                c = r;
-            }
-            let cb = self.block_at(c);
-            if !self.before(words, cb, last) {
-                break;
-            }
-            self.place(i, cb);
-            i = c;
-        }
-        self.place(i, last);
+        heap::sift_down(&mut self.keys(words), 0, last);
         top
+    }
+}
+
+/// The route's heap as the crate's heap sees it ([`heap::Slots`]): its live slots, their
+/// blocks' keys in `words`, and [`Heap::before`] as the order.
+struct Keys<'k> {
+    heap: Heap<'k>,
+    words: &'k [u32],
+}
+
+impl heap::Slots for Keys<'_> {
+    type Item = usize;
+    #[inline(always)]
+    fn at(&self, slot: usize) -> Option<usize> {
+        (slot < self.heap.len).then(|| self.heap.block_at(slot))
+    }
+    #[inline(always)]
+    fn put(&mut self, slot: usize, b: usize) {
+        self.heap.place(slot, b);
+    }
+    #[inline(always)]
+    fn before(&self, a: usize, b: usize) -> bool {
+        self.heap.before(self.words, a, b)
     }
 }
 
@@ -571,7 +582,7 @@ mod tests {
                 }
                 let nb = (by.wrapping_add_signed(DY[d] as isize)) * across
                     + bx.wrapping_add_signed(DX[d] as isize);
-                let step = if d % 2 == 1 { 14 } else { 10 };
+                let step = BLOCKS.step(d as u8);
                 assert!(closed(&pheap, nb), "{why}");
                 assert_eq!(
                     dist(plan[nb]) - h_of(nb) + step,

@@ -32,12 +32,11 @@
 //! far apart). Both are rare on the Moving AI maps; `docs/ALGORITHM.md` has the figures of the
 //! `refine_large` example.
 //!
-//! **Exact integer costs.** A straight step costs [`STRAIGHT`] = 13860 and a diagonal
-//! [`DIAGONAL`] = 19601 (a convergent of `sqrt 2`: `19601 / 13860 = 1.41421356`, off by
-//! `1.8e-9`). Two step mixes `(a, b)` (straight, diagonal) of different true length
-//! `a + b sqrt 2` compare the same way in these units as long as the diagonal counts differ by
-//! less than about 9800, far beyond any window; equal integer cost means equal step mix. So the
-//! search is exact, not just close. The heap orders by `f = g + h`, then larger `g`, then the
+//! **Exact integer costs.** A straight step costs [`STRAIGHT`] and a diagonal [`DIAGONAL`], the
+//! exact scale of `search::cost` (`47321 / 33461`, a convergent of `sqrt 2`). Two step mixes
+//! `(a, b)` (straight, diagonal) of different true length `a + b sqrt 2` compare the same way in
+//! these units up to 36,000 steps, far beyond any window; equal integer cost means equal step
+//! mix. So the search is exact, not just close. The heap orders by `f = g + h`, then larger `g`, then the
 //! lower box index. The open list is an indexed binary heap (decrease-key in place); since that
 //! order is total, which cell leaves next depends only on the open cells and their keys, so the
 //! expansion order, the costs left in the scratch and the path read back are fixed by the rule
@@ -68,10 +67,8 @@ mod window;
 pub use memo::{words as memo_words, Memo, RECORD_WORDS};
 use window::{place, pred, search, Box2, Shape};
 
-/// Cost of a straight step in search units.
-pub const STRAIGHT: u32 = 13860;
-/// Cost of a diagonal step in search units (`STRAIGHT * sqrt 2`, rounded, see the module docs).
-pub const DIAGONAL: u32 = 19601;
+/// Costs of a straight and a diagonal step in search units (the exact scale, module docs).
+pub use crate::search::cost::{DIAGONAL, STRAIGHT};
 /// The largest window side (box indices and heap slots are `u16`, with `0xFFFF` kept free).
 pub const MAX_SIDE: usize = 255;
 /// The smallest window side worth searching; with less scratch the path is returned unchanged.
@@ -277,13 +274,8 @@ fn step_cost(a: Point, b: Point) -> u32 {
 
 /// The obstacle-free cost between two cells.
 fn octile(a: Point, b: Point) -> u32 {
-    let dx = u32::from(a.x.abs_diff(b.x));
-    let dy = u32::from(a.y.abs_diff(b.y));
-    let (hi, lo) = (dx.max(dy), dx.min(dy));
-    // Both below 2^16, costs below 2^15: the result is below 2^32.
-    hi.wrapping_sub(lo)
-        .wrapping_mul(STRAIGHT)
-        .wrapping_add(lo.wrapping_mul(DIAGONAL))
+    // Both below 2^16: the result is below 65535 * DIAGONAL < 2^32.
+    crate::search::cost::EXACT.octile(u32::from(a.x.abs_diff(b.x)), u32::from(a.y.abs_diff(b.y)))
 }
 
 /// A resumable refinement of one path, streaming inside `out` (see the module docs).

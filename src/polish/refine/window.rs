@@ -2,8 +2,9 @@
 //! exact A* inside it (integer costs, ties broken by a fixed rule, so the same on every platform).
 
 use crate::map::grid::{Grid, Point, DX, DY};
+use crate::search::{cost, heap};
 
-use super::{octile, Budget, Scratch, CLOSED, DIAGONAL, MAX_SIDE, STRAIGHT, UNREACHED};
+use super::{octile, Budget, Scratch, CLOSED, MAX_SIDE, UNREACHED};
 
 /// The cell before `p` (box index `i`) on a shortest path of the last [`search`]: its first
 /// neighbour, in direction order, inside the box and reached, one allowed move away, with
@@ -40,7 +41,7 @@ pub(super) fn pred(
         let q = Point::new(qx as u16, qy as u16);
         let Some(j) = bbox.local(q) else { continue };
         let gq = scratch.g.get(j).copied().unwrap_or(UNREACHED);
-        let cost = if d & 1 == 1 { DIAGONAL } else { STRAIGHT };
+        let cost = cost::step(d);
         if gq != UNREACHED && gq.checked_add(cost) == Some(gp) {
             return Some((q, j));
         }
@@ -167,48 +168,74 @@ fn before(g: &[u32], f: &[u32], a: u16, b: u16) -> bool {
     a < b
 }
 
-/// The open list: a binary min-heap of box indices in [`before`] order, root at slot 1, with
-/// each open cell's slot in `pos`. Which cell leaves next depends only on the set of open cells
-/// and their keys (the order is total), not on how the heap is laid out.
+/// The open list: the crate's binary min-heap ([`heap`]) of box indices in [`before`] order,
+/// root at slot 1 of `heap` (its slot 0 unused), with each open cell's slot in `pos`. Which cell
+/// leaves next depends only on the set of open cells and their keys (the order is total), not on
+/// how the heap is laid out.
 struct Open<'s> {
     heap: &'s mut [u16],
     pos: &'s mut [u16],
     len: usize,
 }
 
-impl Open<'_> {
-    /// Put cell `i` in slot `slot`.
+/// The open list as the crate's heap sees it ([`heap::Slots`]): its live slots (slot `s` is
+/// `heap[s + 1]`), the positions, and the keys `g` and `f`.
+struct Keys<'k> {
+    live: &'k mut [u16],
+    pos: &'k mut [u16],
+    g: &'k [u32],
+    f: &'k [u32],
+}
+
+impl heap::Slots for Keys<'_> {
+    type Item = u16;
+    #[inline(always)]
+    fn at(&self, slot: usize) -> Option<u16> {
+        self.live.get(slot).copied()
+    }
     #[inline(always)]
     fn put(&mut self, slot: usize, i: u16) {
-        if let Some(s) = self.heap.get_mut(slot) {
+        if let Some(s) = self.live.get_mut(slot) {
             *s = i;
         }
-        // slot <= len < cells <= MAX_SIDE^2 < 0xFFFF.
+        // slot < len < cells <= MAX_SIDE^2 < 0xFFFF.
         if let Some(p) = self.pos.get_mut(usize::from(i)) {
-            *p = slot as u16;
+            *p = slot.wrapping_add(1) as u16;
         }
     }
-
-    /// Sift cell `i` up from the hole at `slot`.
     #[inline(always)]
-    fn up(&mut self, g: &[u32], f: &[u32], mut slot: usize, i: u16) {
-        while slot > 1 {
-            let parent = slot >> 1;
-            let pi = self.heap.get(parent).copied().unwrap_or(0);
-            if !before(g, f, i, pi) {
-                break;
-            }
-            self.put(slot, pi);
-            slot = parent;
+    fn before(&self, a: u16, b: u16) -> bool {
+        before(self.g, self.f, a, b)
+    }
+    #[inline(always)]
+    fn pair(&self, c: usize) -> Option<(u16, u16)> {
+        match self.live.get(c..c.wrapping_add(2)) {
+            Some(&[a, b]) => Some((a, b)),
+            _ => None,
         }
-        self.put(slot, i);
+    }
+}
+
+impl Open<'_> {
+    /// The live slots with the keys (`None` only if `len` outgrew `heap`, which it never does).
+    #[inline(always)]
+    fn keys<'k>(&'k mut self, g: &'k [u32], f: &'k [u32]) -> Option<Keys<'k>> {
+        Some(Keys {
+            live: self.heap.get_mut(1..=self.len)?,
+            pos: &mut *self.pos,
+            g,
+            f,
+        })
     }
 
     /// Add the new cell `i`.
     #[inline(never)]
     fn push(&mut self, g: &[u32], f: &[u32], i: u16) {
+        let hole = self.len;
         self.len = self.len.wrapping_add(1); // len < cells
-        self.up(g, f, self.len, i);
+        if let Some(mut k) = self.keys(g, f) {
+            heap::sift_up(&mut k, hole, i);
+        }
     }
 
     /// Cell `i`, open, got a smaller key.
@@ -216,11 +243,13 @@ impl Open<'_> {
     fn decreased(&mut self, g: &[u32], f: &[u32], i: u16) {
         let slot = usize::from(self.pos.get(usize::from(i)).copied().unwrap_or(0));
         if slot >= 1 && slot <= self.len {
-            self.up(g, f, slot, i);
+            if let Some(mut k) = self.keys(g, f) {
+                heap::sift_up(&mut k, slot.wrapping_sub(1), i);
+            }
         }
     }
 
-    /// Take the first cell out.
+    /// Take the first cell out (the last one [`heap::settle`]s into the root's hole).
     #[inline(always)]
     fn pop(&mut self, g: &[u32], f: &[u32]) -> Option<u16> {
         if self.len == 0 {
@@ -230,41 +259,11 @@ impl Open<'_> {
         let last = self.heap.get(self.len).copied()?;
         self.len = self.len.wrapping_sub(1);
         if self.len > 0 {
-            self.settle(g, f, last);
+            if let Some(mut k) = self.keys(g, f) {
+                heap::settle(&mut k, last);
+            }
         }
         Some(top)
-    }
-
-    /// Fill the root's hole with `e`: walk the hole down to a leaf along the first child of each
-    /// pair (one comparison a level), then sift `e` up from there (usually a step or none). Out
-    /// of line, so that the search loop keeps its registers.
-    #[inline(never)]
-    fn settle(&mut self, g: &[u32], f: &[u32], e: u16) {
-        let len = self.len;
-        let mut hole = 1usize;
-        // Children `c` and `c + 1`; `hole <= len < 2^16`: no wrap.
-        let mut c = 2usize;
-        while c < len {
-            let (a, b) = match self.heap.get(c..c.wrapping_add(2)) {
-                Some(&[a, b]) => (a, b),
-                _ => break,
-            };
-            let (ci, cs) = if before(g, f, b, a) {
-                (b, c.wrapping_add(1))
-            } else {
-                (a, c)
-            };
-            self.put(hole, ci);
-            hole = cs;
-            c = cs.wrapping_mul(2);
-        }
-        if c == len {
-            // A last, lone child.
-            let ci = self.heap.get(c).copied().unwrap_or(0);
-            self.put(hole, ci);
-            hole = c;
-        }
-        self.up(g, f, hole, e);
     }
 }
 
@@ -350,17 +349,12 @@ pub(super) fn search(
             // The move stays inside the box: j is its box index.
             let j = iu.wrapping_add_signed(off.get(d).copied().unwrap_or(0));
             let Some(&gj) = g.get(j) else { continue };
-            let ng = gi.saturating_add(if d & 1 == 1 { DIAGONAL } else { STRAIGHT });
+            let ng = gi.saturating_add(cost::step(d as u8));
             if gj == UNREACHED {
                 // Box coordinates below MAX_SIDE: no overflow in i32.
                 let qx = (lx as i32).wrapping_add(DX.get(d).copied().unwrap_or(0));
                 let qy = (ly as i32).wrapping_add(DY.get(d).copied().unwrap_or(0));
-                let (dx, dy) = (qx.abs_diff(tx), qy.abs_diff(ty));
-                let (hi, lo) = (dx.max(dy), dx.min(dy));
-                let h = hi
-                    .wrapping_sub(lo)
-                    .wrapping_mul(STRAIGHT)
-                    .wrapping_add(lo.wrapping_mul(DIAGONAL));
+                let h = cost::EXACT.octile(qx.abs_diff(tx), qy.abs_diff(ty));
                 if let (Some(gs), Some(fs)) = (g.get_mut(j), f.get_mut(j)) {
                     *gs = ng;
                     *fs = ng.saturating_add(h);

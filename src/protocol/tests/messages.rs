@@ -1,5 +1,5 @@
-//! Messages: every request and reply round trips, the largest fit their limits, a streamed path
-//! is byte-exact, and the planner's errors map to wire codes and back.
+//! Messages: every request and reply round trips, the largest fit their limits, a path sent in
+//! parts is the whole reply's body byte for byte, and the planner's errors map to wire codes and back.
 
 use super::*;
 
@@ -85,23 +85,45 @@ fn largest_messages_fit_their_limits() {
     assert_eq!(got.unwrap().unwrap(), (u32::MAX, format!("{r:?}")));
 }
 
-/// The frame [`PathStream`] produces, read `piece` bytes at a time.
-fn streamed(id: u32, p: &PathReply<'_>, piece: usize) -> Vec<u8> {
-    let mut s = PathStream::new(id, p).unwrap();
+/// `p` sent as the firmware sends a long path: its [`PathBody`] read `piece` bytes at a time,
+/// each piece a [`PathPart`] frame of the one encoder ([`encode_reply`]); returns the bytes the
+/// host reassembles from the frames it decodes.
+fn in_parts(id: u32, p: &PathReply<'_>, piece: usize) -> Vec<u8> {
+    let body = PathBody::new(p).unwrap();
     let mut out = vec![];
     let mut buf = vec![0u8; piece];
-    while !s.is_done() {
-        let n = s.fill(&mut buf);
-        assert!(n == piece || s.is_done(), "a short piece before the end");
-        out.extend_from_slice(&buf[..n]);
+    loop {
+        let n = body.read(out.len(), &mut buf);
+        if n == 0 {
+            break;
+        }
+        assert!(
+            n == piece || out.len() + n == body.len(),
+            "a short piece before the end"
+        );
+        let part = PathPart {
+            offset: out.len() as u32,
+            total_len: body.len() as u32,
+            bytes: &buf[..n],
+        };
+        let mut f = enc_rep(id, &Reply::PathPart(part));
+        assert_eq!(f.pop(), Some(0));
+        let (got_id, got) = decode_reply(&mut f).unwrap();
+        assert_eq!(got_id, id);
+        let Reply::PathPart(got) = got else {
+            panic!("not a part: {got:?}")
+        };
+        assert_eq!(
+            (got.offset as usize, got.total_len as usize),
+            (out.len(), body.len())
+        );
+        out.extend_from_slice(got.bytes);
     }
-    assert_eq!(s.fill(&mut buf), 0);
-    assert!(s.is_done());
     out
 }
 
 #[test]
-fn path_stream_is_byte_exact() {
+fn a_path_in_parts_is_the_whole_replys_body() {
     let mut rng = Lcg(7);
     // Lengths around COBS's 254-byte blocks, bytes with and without zeros, every id size.
     let mut cases: Vec<(Vec<Point>, Vec<u8>)> = vec![
@@ -137,31 +159,47 @@ fn path_stream_is_byte_exact() {
                 directions: dirs,
                 ..path()
             };
-            let want = enc_rep(id, &Reply::Path(p));
-            for piece in [1, 2, 7, 64, 255, 256, 6000] {
+            // The whole reply's frame, COBS and CRC undone: the id, the variant, the body.
+            let mut whole = enc_rep(id, &Reply::Path(p));
+            assert_eq!(whole.pop(), Some(0));
+            let n = cobs_decode_in_place(&mut whole).unwrap();
+            let payload = &whole[..n - 4];
+            for piece in [1, 2, 7, 64, 255, 256, PART_BYTES] {
+                let body = in_parts(id, &p, piece);
+                let head = payload.len() - body.len();
                 assert_eq!(
-                    streamed(id, &p, piece),
-                    want,
+                    &payload[head..],
+                    &body[..],
                     "case {i} id {id} piece {piece}"
                 );
+                // What is before the body is the id's varint and the variant.
+                assert_eq!(head, varint_len(id as usize) + 1, "case {i} id {id}");
+                let back = decode_path_body(&body).unwrap();
+                assert_eq!(back.directions, &dirs[..]);
             }
         }
     }
 }
 
 #[test]
-fn path_stream_refuses_what_encode_reply_refuses() {
-    let wp = vec![Point::new(u16::MAX, u16::MAX); MAX_WAYPOINTS + 40];
-    let dirs = vec![7u8; MAX_DIRECTIONS];
-    let p = PathReply {
-        waypoints: Waypoints::Points(&wp),
-        directions: &dirs,
-        ..path()
-    };
-    let mut buf = vec![0u8; MAX_REPLY_WIRE];
-    let whole = encode_reply(1, &Reply::Path(p), &mut buf);
-    assert!(matches!(whole, Err(EncodeError::BufferTooSmall { .. })));
-    assert_eq!(PathStream::new(1, &p).err(), whole.err());
+fn a_path_body_is_refused_exactly_when_no_path_frame_could_carry_it() {
+    // Refused exactly when the reply with the widest id would not fit MAX_REPLY_WIRE.
+    for extra in [0usize, 1, 2, 3, 4, 5, 40] {
+        let wp = vec![Point::new(u16::MAX, u16::MAX); MAX_WAYPOINTS + extra];
+        let dirs = vec![7u8; MAX_DIRECTIONS];
+        let p = PathReply {
+            waypoints: Waypoints::Points(&wp),
+            directions: &dirs,
+            ..path()
+        };
+        let mut buf = vec![0u8; MAX_REPLY_WIRE];
+        let whole = encode_reply(u32::MAX, &Reply::Path(p), &mut buf);
+        assert_eq!(
+            PathBody::new(&p).err(),
+            whole.err(),
+            "{extra} more waypoints"
+        );
+    }
 }
 
 #[test]
