@@ -55,8 +55,8 @@ pub fn tighten(
 }
 
 /// Work units of [`Tightening::resume`]: indexing a path cell, or a step of the pass over the
-/// path where no neighbour but the path's previous and next cells is on it (about 50
-/// instructions on the device).
+/// path where no neighbour but the path's previous and next cells is on it (about 90
+/// instructions a unit on the device, measured on maze512's path).
 pub const CELL_UNITS: u32 = 1;
 /// Work units of a step of the pass that looks its neighbours up (up to eight, in the index):
 /// `LOOK_UNITS` plus one a look-up.
@@ -174,7 +174,9 @@ impl Tightening {
             let Some(mut k) = Keyed::new(pos, cells, grid.cells(), n, false) else {
                 return Some(self.rest(tour));
             };
-            if !self.index(start, tour, budget, |i, p| k.insert(grid.index(p), i as u32)) {
+            if !self.index(start, tour, budget, |i, p| {
+                k.insert(grid.index(p), i as u32)
+            }) {
                 return None;
             }
             self.straighten(moves, tour, visited, budget, |cell| k.find(cell))
@@ -781,7 +783,11 @@ mod tests {
             let n = wd.walk.steps + 1;
             let g = Grid::new(w, h, &wd.bits).unwrap();
             let moves = Moves::new(g, &[]);
-            for links in [usize::from(w) * usize::from(h), hash_words(n), keyed_words(n)] {
+            for links in [
+                usize::from(w) * usize::from(h),
+                hash_words(n),
+                keyed_words(n),
+            ] {
                 let direct = run(links);
                 shortened += usize::from(direct.0.steps < wd.walk.steps);
                 for piece in [LOOK_UNITS + 8, 11, 37, 500] {
@@ -797,7 +803,13 @@ mod tests {
                         let mut budget = piece;
                         calls += 1;
                         let done = tg.resume(
-                            &moves, start, &mut t, &mut cells, &mut pos, &wd.tabu, &mut budget,
+                            &moves,
+                            start,
+                            &mut t,
+                            &mut cells,
+                            &mut pos,
+                            &wd.tabu,
+                            &mut budget,
                         );
                         if let Some(out) = done {
                             break out;
@@ -806,7 +818,10 @@ mod tests {
                         assert!(calls <= 2 * n, "{w}x{h} seed {seed}: no progress");
                     };
                     let got = (out, t[..out.steps].to_vec());
-                    assert_eq!(got, direct, "{w}x{h} seed {seed} links {links} piece {piece}");
+                    assert_eq!(
+                        got, direct,
+                        "{w}x{h} seed {seed} links {links} piece {piece}"
+                    );
                     // At least the cells' indexing and a step a piece at this budget.
                     assert!(calls >= n / piece as usize, "{calls} {n} {piece}");
                     split += usize::from(calls > 2);
@@ -834,7 +849,15 @@ mod tests {
             // Index every cell and a few steps of the pass.
             let mut budget = n as u32 + 40;
             let mut state = None;
-            let first = tg.resume(&moves, start, &mut t, &mut cells, &mut pos, &wd.tabu, &mut budget);
+            let first = tg.resume(
+                &moves,
+                start,
+                &mut t,
+                &mut cells,
+                &mut pos,
+                &wd.tabu,
+                &mut budget,
+            );
             if first.is_none() {
                 state = Some(tg);
             }
@@ -842,7 +865,15 @@ mod tests {
             let mut none: Vec<u32> = Vec::new();
             let mut budget = u32::MAX;
             let out = tg
-                .resume(&moves, start, &mut t, &mut cells, &mut none, &wd.tabu, &mut budget)
+                .resume(
+                    &moves,
+                    start,
+                    &mut t,
+                    &mut cells,
+                    &mut none,
+                    &wd.tabu,
+                    &mut budget,
+                )
                 .expect("done at once");
             let end = t[..out.steps]
                 .iter()
