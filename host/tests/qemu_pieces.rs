@@ -82,7 +82,12 @@ fn no_piece_of_a_large_plan_exceeds_a_million_instructions() {
     // Each map with its seeds (maze512's plan alone is 164 M instructions: one seed).
     let cases: [(&str, Point, Point, &[u64]); 4] = [
         ("large/NewYork_0_512.map", ny_start, ny_goal, &[1, 2]),
-        ("depot-r20.map", Point::new(14, 10), Point::new(590, 294), &[1, 2]),
+        (
+            "depot-r20.map",
+            Point::new(14, 10),
+            Point::new(590, 294),
+            &[1, 2],
+        ),
         // Its longest scenario (random-1), as `scripts/bench_pieces.py` plans it.
         (
             "large/maze-128-128-2.map",

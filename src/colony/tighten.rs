@@ -66,7 +66,8 @@ pub const LOOK_UNITS: u32 = 2;
 /// so a firmware can yield inside a long path's tightening: first every path cell goes into the
 /// index, then the pass over the path writes the tightened steps to the front of the tour. The
 /// index lives in the caller's `cells` and `pos`, the path in its tour; this holds where the work
-/// stands (seven words). However the work is cut, the result is [`tighten`]'s, bit for bit. The
+/// stands (six words: a walk in progress holds it in place of its finished [`crate::colony::ant::Trail`],
+/// no larger). However the work is cut, the result is [`tighten`]'s, bit for bit. The
 /// caller passes the same buffers and the same `start` and tabu set to every call, and changes
 /// none of them in between.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -77,15 +78,18 @@ pub struct Tightening {
     moves: u32,
     /// Indexing: the next position to index; the pass: the position reached. Below `steps + 1`.
     i: usize,
-    /// Steps of the tightened path written to the front of the tour (at most `i`).
+    /// Steps of the tightened path written to the front of the tour (at most `i`), or
+    /// [`INDEXING`] while the cells go into the index.
     out: usize,
     /// Diagonal steps among them.
     diagonal: u32,
     /// The cell at position `i`.
     at: Point,
-    /// Every cell is indexed: the pass is under way.
-    indexed: bool,
 }
+
+/// [`Tightening::out`] while the cells go into the index (a flag of its own would make the state
+/// a word larger than a walk's).
+const INDEXING: usize = usize::MAX;
 
 impl Tightening {
     /// Start tightening `walk` (its path is `tour[..walk.steps]`): clears the index (a hash table
@@ -116,10 +120,9 @@ impl Tightening {
             steps: walk.steps,
             moves: walk.moves,
             i: 0,
-            out: 0,
+            out: INDEXING,
             diagonal: 0,
             at: start,
-            indexed: false,
         })
     }
 
@@ -194,7 +197,7 @@ impl Tightening {
         budget: &mut u32,
         mut put: impl FnMut(usize, Point),
     ) -> bool {
-        if self.indexed {
+        if self.out != INDEXING {
             return true;
         }
         let n = self.steps.wrapping_add(1);
@@ -213,7 +216,7 @@ impl Tightening {
             }
             i = i.wrapping_add(1);
         }
-        (self.i, self.at, self.indexed) = (0, start, true);
+        (self.i, self.out, self.at) = (0, 0, start);
         true
     }
 
@@ -221,9 +224,11 @@ impl Tightening {
     /// `tour[i..steps]` still holds its original steps (the output, `tour[..out]`, never passes
     /// `i`).
     fn rest(&self, tour: &mut [Dir]) -> Walk {
-        let mut out = self.out;
+        let (mut out, mut k) = match self.out {
+            INDEXING => (0, 0),
+            out => (out, self.i),
+        };
         let mut diagonal = self.diagonal;
-        let mut k = self.i;
         while k < self.steps {
             let (Some(&d), true) = (tour.get(k), out <= k) else {
                 break;
