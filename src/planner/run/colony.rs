@@ -148,8 +148,8 @@ const FILL_CELLS: usize = 32;
 const PATH_COST: usize = 2;
 /// Work units of a path's tightening ([`Tightening::resume`]) a move of the budget pays for.
 /// Measured under `-icount` (`scripts/bench_pieces.py`): a unit is about 90 instructions, and the
-/// largest piece on maze512 (a 4,000-step path tightened over several pieces) is 0.73 M at 5
-/// units a move (0.69 M at 4, 1.05 M at 8).
+/// largest piece on maze512 (a 4,000-step path tightened over several pieces) is 0.73-0.75 M at
+/// 5 units a move (0.69 M at 4, 1.05 M at 8).
 const UNITS_A_MOVE: u32 = 5;
 /// The most of a piece's budget the deposit of a path whose tightening ends in it may need: the
 /// tightening leaves that much ([`go`]), so the deposit after it stays inside the piece.
