@@ -2,7 +2,9 @@
 //! drives `Run::poll` and yields after every piece, and no piece of a plan may take more than
 //! 1 M instructions (10 ms at 100 MHz), on the large maps where a piece was largest (the
 //! coarse route of NewYork_0_512 was 6.3 M instructions in one piece, an iteration on Nav2's
-//! depot 5.9 M, before the pieces were bounded).
+//! depot 5.9 M, before the pieces were bounded), and on the mazes, whose long paths made the
+//! largest pieces once those were bounded (a walk's tightening on maze-128-128-2, 1.27 M, and on
+//! maze512 with its smoothing's tail, 1.56 M, until both went in pieces too).
 //!
 //! The firmware (F411-capacity QEMU build) runs under `qemu-system-arm -icount shift=0`, where
 //! its timer counts executed instructions exactly (a tick is 1 us of virtual time = 1,000
@@ -77,17 +79,36 @@ fn no_piece_of_a_large_plan_exceeds_a_million_instructions() {
     let log = dir.join("defmt.bin");
     let (mut child, addr) = boot(&log);
     let (ny_start, ny_goal) = longest_scenario("large/NewYork_0_512.map.scen");
-    let cases = [
-        ("large/NewYork_0_512.map", ny_start, ny_goal),
-        ("depot-r20.map", Point::new(14, 10), Point::new(590, 294)),
+    // Each map with its seeds (maze512's plan alone is 164 M instructions: one seed).
+    let cases: [(&str, Point, Point, &[u64]); 4] = [
+        ("large/NewYork_0_512.map", ny_start, ny_goal, &[1, 2]),
+        (
+            "depot-r20.map",
+            Point::new(14, 10),
+            Point::new(590, 294),
+            &[1, 2],
+        ),
+        // Its longest scenario (random-1), as `scripts/bench_pieces.py` plans it.
+        (
+            "large/maze-128-128-2.map",
+            Point::new(86, 122),
+            Point::new(17, 99),
+            &[1, 2],
+        ),
+        (
+            "large/maze512-1-0.map",
+            Point::new(40, 125),
+            Point::new(502, 437),
+            &[1],
+        ),
     ];
     let mut plans = Vec::new();
     {
         let mut link = Link::tcp(&addr, TIMEOUT).expect("connect");
-        for (name, start, goal) in cases {
+        for (name, start, goal, seeds) in cases {
             let map = Map::load(maps().join(name)).expect(name);
             link.set_map(&map).expect("upload");
-            for seed in [1, 2] {
+            for &seed in seeds {
                 let path = link.plan(start, goal, Some(seed)).expect("a path");
                 plans.push((name, seed, path.ticks));
             }

@@ -13,6 +13,7 @@ use crate::map::grid::{is_diagonal, neighbour, opposite, Dir, Moves, Point};
 
 /// Straighten a finished walk in place: from each cell of the path, jump to the furthest later
 /// path cell that is one allowed move away, dropping the detour in between. Returns the new walk.
+/// The same as [`Tightening::begin`] and [`Tightening::resume`] without a budget.
 ///
 /// This is not in the paper. A depth-first ant path is loop-free but can still bulge (go around
 /// three sides of a square where one step would do). Cutting such bulges before the pheromone
@@ -41,162 +42,329 @@ pub fn tighten(
     pos: &mut [u32],
     visited: &[u32],
 ) -> Walk {
-    let grid = moves.grid();
-    // Cannot wrap for a real walk (steps < cells); were `steps` usize::MAX, `tour.get(..steps)`
-    // below would fail and the walk come back unchanged.
-    let n = walk.steps.wrapping_add(1);
-    if cells.len() < n {
-        return walk;
-    }
-    let Some(path) = tour.get(..walk.steps) else {
+    let Some(mut t) = Tightening::begin(moves, start, walk, tour, cells, pos) else {
         return walk;
     };
-    // The index: positions in `pos` (a per-cell array, or a hash table) checked against the path
-    // laid out in `cells`, or, when `pos` is too short for that, a table of packed
-    // (cell, position) keys over `pos` and `cells`' words together ([`Keyed`]).
-    if PathIndex::fits(pos.len(), grid.cells(), n) {
-        let Some(mut ix) = PathIndex::new(pos, grid.cells(), n) else {
-            return walk;
-        };
-        let laid = cells.get_mut(..n).unwrap_or_default();
-        // Lay the path out as cells and remember each cell's position on it.
-        let mut p = start;
-        for (i, slot) in laid.iter_mut().enumerate() {
-            *slot = p;
-            ix.insert(grid.index(p), i as u32);
-            if let Some(&d) = path.get(i) {
-                p = neighbour(p, d);
-            }
+    let mut budget = u32::MAX;
+    loop {
+        if let Some(w) = t.resume(moves, start, tour, cells, pos, visited, &mut budget) {
+            return w;
         }
-        let laid: &[Point] = laid;
-        straighten(moves, start, walk, tour, visited, |cell| {
-            ix.find(cell, |j| laid.get(j).map(|&q| grid.index(q)))
-        })
-    } else {
-        let Some(mut k) = Keyed::new(pos, cells, grid.cells(), n) else {
-            return walk;
-        };
-        let mut p = start;
-        for i in 0..n {
-            k.insert(grid.index(p), i as u32);
-            if let Some(&d) = path.get(i) {
-                p = neighbour(p, d);
-            }
-        }
-        straighten(moves, start, walk, tour, visited, |cell| k.find(cell))
+        budget = u32::MAX;
     }
 }
 
-/// [`tighten`]'s pass over the path in `tour`, with `find(cell)`: the cell's position on it.
-/// Generic over the index, so the look-ups of the inner loop branch on nothing else.
-#[inline(always)]
-fn straighten(
-    moves: &Moves<'_>,
-    start: Point,
-    walk: Walk,
-    tour: &mut [Dir],
-    visited: &[u32],
-    find: impl Fn(usize) -> Option<usize>,
-) -> Walk {
-    let grid = moves.grid();
-    let n = walk.steps.wrapping_add(1);
-    let offsets = grid.offsets();
-    let mut i = 0usize;
-    let mut out = 0usize;
-    let (mut straight, mut diagonal) = (0u32, 0u32);
-    let (width, height) = (usize::from(grid.width()), usize::from(grid.height()));
-    // The cell at position `i`, followed along the path (a jump to `j` by move `d` lands on the
-    // cell at `j`: that is how `j` was found).
-    let mut cp = start;
-    // `i < n` throughout (it only ever becomes a valid position on the path), so no `wrapping_`
-    // below wraps: `out <= i` and `straight + diagonal == out`.
-    while i.wrapping_add(1) < n {
-        let ci = grid.index(cp);
-        // Fast path, away from the map's border: when no neighbour but the path's previous and
-        // next cells was visited, the next cell is the furthest. `tour[i]` still holds the step
-        // from cell `i` to `i + 1` and `tour[i - 1]` the step into cell `i` (the output so far
-        // ends at index `out - 1 < i`, and its last step, if at `i - 1`, is that same step).
-        if let Some(&next_d) = tour.get(i) {
-            let (x, y) = (usize::from(cp.x), usize::from(cp.y));
-            if x > 0 && y > 0 && x.wrapping_add(1) < width && y.wrapping_add(1) < height {
-                let mut others = bitmap::around(visited, ci, width) & !(1u8 << (next_d & 7));
-                if let Some(&in_d) = i.checked_sub(1).and_then(|k| tour.get(k)) {
-                    others &= !(1u8 << (opposite(in_d) & 7));
+/// Work units of [`Tightening::resume`]: indexing a path cell, or a step of the pass over the
+/// path where no neighbour but the path's previous and next cells is on it (about 90
+/// instructions a unit on the device, measured on maze512's path).
+pub const CELL_UNITS: u32 = 1;
+/// Work units of a step of the pass that looks its neighbours up (up to eight, in the index):
+/// `LOOK_UNITS` plus one a look-up.
+pub const LOOK_UNITS: u32 = 2;
+
+/// A walk's [`tighten`] in progress, a bounded amount of work at a time ([`Tightening::resume`]),
+/// so a firmware can yield inside a long path's tightening: first every path cell goes into the
+/// index, then the pass over the path writes the tightened steps to the front of the tour. The
+/// index lives in the caller's `cells` and `pos`, the path in its tour; this holds where the work
+/// stands (six words: a walk in progress holds it in place of its finished [`crate::colony::ant::Trail`],
+/// no larger). However the work is cut, the result is [`tighten`]'s, bit for bit. The
+/// caller passes the same buffers and the same `start` and tabu set to every call, and changes
+/// none of them in between.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Tightening {
+    /// Steps of the walk's path (`tour[..steps]`).
+    steps: usize,
+    /// The walk's moves (tightening keeps them).
+    moves: u32,
+    /// Indexing: the next position to index; the pass: the position reached. Below `steps + 1`.
+    i: usize,
+    /// Steps of the tightened path written to the front of the tour (at most `i`), or
+    /// [`INDEXING`] while the cells go into the index.
+    out: usize,
+    /// Diagonal steps among them.
+    diagonal: u32,
+    /// The cell at position `i`.
+    at: Point,
+}
+
+/// [`Tightening::out`] while the cells go into the index (a flag of its own would make the state
+/// a word larger than a walk's).
+const INDEXING: usize = usize::MAX;
+
+impl Tightening {
+    /// Start tightening `walk` (its path is `tour[..walk.steps]`): clears the index (a hash table
+    /// over `pos`, or over `pos` and `cells`' words) and does nothing else. `None` when no index
+    /// fits the path: it stays as it is (see [`tighten`]).
+    pub fn begin(
+        moves: &Moves<'_>,
+        start: Point,
+        walk: Walk,
+        tour: &[Dir],
+        cells: &mut [Point],
+        pos: &mut [u32],
+    ) -> Option<Self> {
+        let map = moves.grid().cells();
+        // Cannot wrap for a real walk (steps < cells); were `steps` usize::MAX, `tour.get(..steps)`
+        // below would fail and the walk come back unchanged.
+        let n = walk.steps.wrapping_add(1);
+        if cells.len() < n {
+            return None;
+        }
+        tour.get(..walk.steps)?;
+        if PathIndex::fits(pos.len(), map, n) {
+            PathIndex::new(pos, map, n, true)?;
+        } else {
+            Keyed::new(pos, cells, map, n, true)?;
+        }
+        Some(Tightening {
+            steps: walk.steps,
+            moves: walk.moves,
+            i: 0,
+            out: INDEXING,
+            diagonal: 0,
+            at: start,
+        })
+    }
+
+    /// Steps of the walk's path before tightening (the tightened path has at most as many).
+    pub fn steps(&self) -> usize {
+        self.steps
+    }
+
+    /// Go on for at most about `budget` work units ([`CELL_UNITS`], [`LOOK_UNITS`]), taking what
+    /// it spends from `budget`: `Some(walk)` once the path is tightened (in `tour[..walk.steps]`),
+    /// `None` while work is left (with `budget` at 0). A call with a budget below
+    /// `LOOK_UNITS + 8` (a step that looks up all eight neighbours) makes no progress in the pass.
+    /// Should the index not reopen in the buffers (not those of [`Tightening::begin`]), the path
+    /// so far tightened is completed with the rest untightened: a valid path, never a panic.
+    #[allow(clippy::too_many_arguments)]
+    pub fn resume(
+        &mut self,
+        moves: &Moves<'_>,
+        start: Point,
+        tour: &mut [Dir],
+        cells: &mut [Point],
+        pos: &mut [u32],
+        visited: &[u32],
+        budget: &mut u32,
+    ) -> Option<Walk> {
+        let grid = moves.grid();
+        let n = self.steps.wrapping_add(1);
+        // The index: positions in `pos` (a per-cell array, or a hash table) checked against the
+        // path laid out in `cells`, or, when `pos` is too short for that, a table of packed
+        // (cell, position) keys over `pos` and `cells`' words together ([`Keyed`]).
+        if PathIndex::fits(pos.len(), grid.cells(), n) {
+            let (Some(mut ix), Some(laid)) = (
+                PathIndex::new(pos, grid.cells(), n, false),
+                cells.get_mut(..n),
+            ) else {
+                return Some(self.rest(tour));
+            };
+            // Lay the path out as cells and remember each cell's position on it.
+            if !self.index(start, tour, budget, |i, p| {
+                if let Some(slot) = laid.get_mut(i) {
+                    *slot = p;
                 }
-                if others == 0 {
-                    if let Some(slot) = tour.get_mut(out) {
-                        *slot = next_d;
+                ix.insert(grid.index(p), i as u32);
+            }) {
+                return None;
+            }
+            let laid: &[Point] = laid;
+            self.straighten(moves, tour, visited, budget, |cell| {
+                ix.find(cell, |j| laid.get(j).map(|&q| grid.index(q)))
+            })
+        } else {
+            let Some(mut k) = Keyed::new(pos, cells, grid.cells(), n, false) else {
+                return Some(self.rest(tour));
+            };
+            if !self.index(start, tour, budget, |i, p| {
+                k.insert(grid.index(p), i as u32)
+            }) {
+                return None;
+            }
+            self.straighten(moves, tour, visited, budget, |cell| k.find(cell))
+        }
+    }
+
+    /// The index's part of [`Tightening::resume`]: `put(i, cell)` for the path's positions from
+    /// `i` on, while `budget` lasts; `true` once every position is in (the pass then starts at
+    /// the start).
+    #[inline(always)]
+    fn index(
+        &mut self,
+        start: Point,
+        tour: &[Dir],
+        budget: &mut u32,
+        mut put: impl FnMut(usize, Point),
+    ) -> bool {
+        if self.out != INDEXING {
+            return true;
+        }
+        let n = self.steps.wrapping_add(1);
+        let path = tour.get(..self.steps).unwrap_or_default();
+        let (mut i, mut p) = (self.i, self.at);
+        while i < n {
+            if *budget < CELL_UNITS {
+                *budget = 0;
+                (self.i, self.at) = (i, p);
+                return false;
+            }
+            *budget = budget.wrapping_sub(CELL_UNITS);
+            put(i, p);
+            if let Some(&d) = path.get(i) {
+                p = neighbour(p, d);
+            }
+            i = i.wrapping_add(1);
+        }
+        (self.i, self.out, self.at) = (0, 0, start);
+        true
+    }
+
+    /// The rest of the path from position `i` on, untightened, after the steps written so far:
+    /// `tour[i..steps]` still holds its original steps (the output, `tour[..out]`, never passes
+    /// `i`).
+    fn rest(&self, tour: &mut [Dir]) -> Walk {
+        let (mut out, mut k) = match self.out {
+            INDEXING => (0, 0),
+            out => (out, self.i),
+        };
+        let mut diagonal = self.diagonal;
+        while k < self.steps {
+            let (Some(&d), true) = (tour.get(k), out <= k) else {
+                break;
+            };
+            if let Some(slot) = tour.get_mut(out) {
+                *slot = d;
+            }
+            diagonal = diagonal.wrapping_add(u32::from(is_diagonal(d)));
+            out = out.wrapping_add(1);
+            k = k.wrapping_add(1);
+        }
+        self.walk(out, diagonal)
+    }
+
+    /// The tightened walk of `out` steps, `diagonal` of them diagonal.
+    fn walk(&self, out: usize, diagonal: u32) -> Walk {
+        Walk {
+            steps: out,
+            straight: (out as u32).wrapping_sub(diagonal),
+            diagonal,
+            moves: self.moves,
+            may_tighten: false,
+        }
+    }
+
+    /// The pass of [`Tightening::resume`] over the path in `tour`, with `find(cell)`: the cell's
+    /// position on it, from position `i` on while `budget` lasts. Generic over the index, so the
+    /// look-ups of the inner loop branch on nothing else.
+    #[inline(always)]
+    fn straighten(
+        &mut self,
+        moves: &Moves<'_>,
+        tour: &mut [Dir],
+        visited: &[u32],
+        budget: &mut u32,
+        find: impl Fn(usize) -> Option<usize>,
+    ) -> Option<Walk> {
+        let grid = moves.grid();
+        let n = self.steps.wrapping_add(1);
+        let offsets = grid.offsets();
+        let (mut i, mut out, mut diagonal) = (self.i, self.out, self.diagonal);
+        let (width, height) = (usize::from(grid.width()), usize::from(grid.height()));
+        // The cell at position `i`, followed along the path (a jump to `j` by move `d` lands on
+        // the cell at `j`: that is how `j` was found).
+        let mut cp = self.at;
+        let mut left = *budget;
+        // `i < n` throughout (it only ever becomes a valid position on the path), so no
+        // `wrapping_` below wraps: `out <= i` and `diagonal <= out`.
+        while i.wrapping_add(1) < n {
+            if left < LOOK_UNITS.wrapping_add(8) {
+                // Maybe not enough for the next step: the rest in the next call.
+                *budget = 0;
+                (self.i, self.out, self.diagonal, self.at) = (i, out, diagonal, cp);
+                return None;
+            }
+            let ci = grid.index(cp);
+            // Fast path, away from the map's border: when no neighbour but the path's previous
+            // and next cells was visited, the next cell is the furthest. `tour[i]` still holds
+            // the step from cell `i` to `i + 1` and `tour[i - 1]` the step into cell `i` (the
+            // output so far ends at index `out - 1 < i`, and its last step, if at `i - 1`, is
+            // that same step).
+            if let Some(&next_d) = tour.get(i) {
+                let (x, y) = (usize::from(cp.x), usize::from(cp.y));
+                if x > 0 && y > 0 && x.wrapping_add(1) < width && y.wrapping_add(1) < height {
+                    let mut others = bitmap::around(visited, ci, width) & !(1u8 << (next_d & 7));
+                    if let Some(&in_d) = i.checked_sub(1).and_then(|k| tour.get(k)) {
+                        others &= !(1u8 << (opposite(in_d) & 7));
                     }
-                    out = out.wrapping_add(1);
-                    if is_diagonal(next_d) {
-                        diagonal = diagonal.wrapping_add(1);
-                    } else {
-                        straight = straight.wrapping_add(1);
+                    if others == 0 {
+                        left = left.wrapping_sub(CELL_UNITS);
+                        if let Some(slot) = tour.get_mut(out) {
+                            *slot = next_d;
+                        }
+                        out = out.wrapping_add(1);
+                        diagonal = diagonal.wrapping_add(u32::from(is_diagonal(next_d)));
+                        i = i.wrapping_add(1);
+                        cp = neighbour(cp, next_d);
+                        continue;
                     }
-                    i = i.wrapping_add(1);
-                    cp = neighbour(cp, next_d);
+                }
+            }
+            left = left.wrapping_sub(LOOK_UNITS);
+            // The path's cells before and after this one are known without a look-up: `tour[i]`
+            // is the step out of this cell and `tour[i - 1]` the step into it (see above).
+            // (Index arithmetic: both are cells of the map, one move from this one.)
+            let step = |d: Dir| offsets.get(usize::from(d & 7)).copied().unwrap_or(0);
+            let prev = match i.checked_sub(1).and_then(|k| tour.get(k)) {
+                Some(&d) => ci.wrapping_add_signed(step(d).wrapping_neg()),
+                None => usize::MAX,
+            };
+            let next = tour
+                .get(i)
+                .map_or(usize::MAX, |&d| ci.wrapping_add_signed(step(d)));
+            let mut mask = moves.at(ci, cp);
+            // Furthest later path cell one allowed move away (the next cell always qualifies).
+            let mut best = (i, 0u8);
+            while mask != 0 {
+                let d = mask.trailing_zeros() as u8;
+                mask &= mask.wrapping_sub(1);
+                let nb = ci.wrapping_add_signed(offsets.get(usize::from(d)).copied().unwrap_or(0));
+                // Not visited: not on the path (a cell beyond the set reads as visited). The
+                // previous cell cannot be the furthest; the next one is at `i + 1` (cells are
+                // unique on a path).
+                if !bitmap::get(visited, nb) || nb == prev {
                     continue;
                 }
-            }
-        }
-        // The path's cells before and after this one are known without a look-up: `tour[i]` is
-        // the step out of this cell and `tour[i - 1]` the step into it (see above).
-        // (Index arithmetic: both are cells of the map, one move from this one.)
-        let step = |d: Dir| offsets.get(usize::from(d & 7)).copied().unwrap_or(0);
-        let prev = match i.checked_sub(1).and_then(|k| tour.get(k)) {
-            Some(&d) => ci.wrapping_add_signed(step(d).wrapping_neg()),
-            None => usize::MAX,
-        };
-        let next = tour
-            .get(i)
-            .map_or(usize::MAX, |&d| ci.wrapping_add_signed(step(d)));
-        let mut mask = moves.at(ci, cp);
-        // Furthest later path cell one allowed move away (the next cell always qualifies).
-        let mut best = (i, 0u8);
-        while mask != 0 {
-            let d = mask.trailing_zeros() as u8;
-            mask &= mask.wrapping_sub(1);
-            let nb = ci.wrapping_add_signed(offsets.get(usize::from(d)).copied().unwrap_or(0));
-            // Not visited: not on the path (a cell beyond the set reads as visited). The previous
-            // cell cannot be the furthest; the next one is at `i + 1` (cells are unique on a path).
-            if !bitmap::get(visited, nb) || nb == prev {
-                continue;
-            }
-            if nb == next {
-                if i.wrapping_add(1) > best.0 {
-                    best = (i.wrapping_add(1), d);
+                if nb == next {
+                    if i.wrapping_add(1) > best.0 {
+                        best = (i.wrapping_add(1), d);
+                    }
+                    continue;
                 }
-                continue;
-            }
-            if let Some(j) = find(nb) {
-                if j > best.0 {
-                    best = (j, d);
+                // At most eight look-ups a step: `left` was at least `LOOK_UNITS + 8`.
+                left = left.saturating_sub(1);
+                if let Some(j) = find(nb) {
+                    if j > best.0 {
+                        best = (j, d);
+                    }
                 }
             }
+            let (j, d) = best;
+            if j == i {
+                // Cannot happen for a path made of allowed moves; stop rather than loop.
+                break;
+            }
+            if let Some(slot) = tour.get_mut(out) {
+                *slot = d;
+            }
+            out = out.wrapping_add(1);
+            diagonal = diagonal.wrapping_add(u32::from(is_diagonal(d)));
+            i = j;
+            cp = neighbour(cp, d);
         }
-        let (j, d) = best;
-        if j == i {
-            // Cannot happen for a path made of allowed moves; stop rather than loop.
-            break;
-        }
-        if let Some(slot) = tour.get_mut(out) {
-            *slot = d;
-        }
-        out = out.wrapping_add(1);
-        if is_diagonal(d) {
-            diagonal = diagonal.wrapping_add(1);
-        } else {
-            straight = straight.wrapping_add(1);
-        }
-        i = j;
-        cp = neighbour(cp, d);
-    }
-    Walk {
-        steps: out,
-        straight,
-        diagonal,
-        moves: walk.moves,
-        may_tighten: false,
+        *budget = left;
+        (self.i, self.out, self.diagonal, self.at) = (i, out, diagonal, cp);
+        Some(self.walk(out, diagonal))
     }
 }
 
@@ -277,7 +445,15 @@ struct Keyed<'a> {
 }
 
 impl<'a> Keyed<'a> {
-    fn new(a: &'a mut [u32], cells: &'a mut [Point], map_cells: usize, n: usize) -> Option<Self> {
+    /// The table for a path of `n` cells, emptied when `clear` (a new path), else as the last
+    /// call left it (a tightening resumed, [`Tightening::resume`]).
+    fn new(
+        a: &'a mut [u32],
+        cells: &'a mut [Point],
+        map_cells: usize,
+        n: usize,
+        clear: bool,
+    ) -> Option<Self> {
         if !keyed_fits(map_cells, n) {
             return None;
         }
@@ -292,8 +468,10 @@ impl<'a> Keyed<'a> {
         if len < n.checked_add(n.div_ceil(2))? || u32::try_from(len).is_err() {
             return None;
         }
-        a.fill(0);
-        b.fill(0);
+        if clear {
+            a.fill(0);
+            b.fill(0);
+        }
         Some(Keyed { a, b, len, bits })
     }
 
@@ -378,7 +556,9 @@ impl<'a> PathIndex<'a> {
         words >= cells || hash_slots(n, words).is_some()
     }
 
-    fn new(pos: &'a mut [u32], cells: usize, n: usize) -> Option<Self> {
+    /// The index for a path of `n` cells on a map of `cells` cells; its hash table emptied when
+    /// `clear` (a new path), else as the last call left it (a tightening resumed).
+    fn new(pos: &'a mut [u32], cells: usize, n: usize, clear: bool) -> Option<Self> {
         if pos.len() >= cells {
             return Some(PathIndex {
                 slots: pos,
@@ -392,7 +572,9 @@ impl<'a> PathIndex<'a> {
         let slots = hash_slots(n, pos.len())?;
         let half = n < usize::from(u16::MAX);
         let table = pos.get_mut(..if half { slots.div_ceil(2) } else { slots })?;
-        table.fill(0);
+        if clear {
+            table.fill(0);
+        }
         Some(PathIndex {
             slots: table,
             hash: Some(slots.trailing_zeros()),
@@ -596,6 +778,121 @@ mod tests {
     }
 
     #[test]
+    fn tightening_in_pieces_tightens_as_at_once() {
+        // Wandering walks, each tightened with the per-cell index, the hash table and the keyed
+        // table, at once and in pieces of a few work units (the least that makes progress, and
+        // more): the same walk and path, bit for bit, and every piece but the last spends its
+        // whole budget.
+        let (mut split, mut shortened) = (0, 0);
+        each_walk(&[(48, 40), (120, 90)], 0..16, |(w, h, seed), wd, run| {
+            let n = wd.walk.steps + 1;
+            let g = Grid::new(w, h, &wd.bits).unwrap();
+            let moves = Moves::new(g, &[]);
+            for links in [
+                usize::from(w) * usize::from(h),
+                hash_words(n),
+                keyed_words(n),
+            ] {
+                let direct = run(links);
+                shortened += usize::from(direct.0.steps < wd.walk.steps);
+                for piece in [LOOK_UNITS + 8, 11, 37, 500] {
+                    let mut t = wd.tour.clone();
+                    let mut cells = vec![Point::default(); n];
+                    let mut pos = vec![0u32; links];
+                    let start = Point::new(0, 0);
+                    let mut tg =
+                        Tightening::begin(&moves, start, wd.walk, &t, &mut cells, &mut pos)
+                            .expect("an index");
+                    let mut calls = 0;
+                    let out = loop {
+                        let mut budget = piece;
+                        calls += 1;
+                        let done = tg.resume(
+                            &moves,
+                            start,
+                            &mut t,
+                            &mut cells,
+                            &mut pos,
+                            &wd.tabu,
+                            &mut budget,
+                        );
+                        if let Some(out) = done {
+                            break out;
+                        }
+                        assert_eq!(budget, 0);
+                        assert!(calls <= 2 * n, "{w}x{h} seed {seed}: no progress");
+                    };
+                    let got = (out, t[..out.steps].to_vec());
+                    assert_eq!(
+                        got, direct,
+                        "{w}x{h} seed {seed} links {links} piece {piece}"
+                    );
+                    // At least the cells' indexing and a step a piece at this budget.
+                    assert!(calls >= n / piece as usize, "{calls} {n} {piece}");
+                    split += usize::from(calls > 2);
+                }
+            }
+        });
+        assert!(split >= 40 && shortened >= 10, "{split} {shortened}");
+    }
+
+    #[test]
+    fn a_resumed_tightening_without_its_index_completes_the_path_untightened() {
+        // The index gone between two pieces (buffers too short): the steps tightened so far and
+        // the rest of the path as it was, a valid path of the same start and end.
+        let mut checked = 0;
+        each_walk(&[(120, 90)], 0..8, |(w, h, seed), wd, run| {
+            let n = wd.walk.steps + 1;
+            let g = Grid::new(w, h, &wd.bits).unwrap();
+            let moves = Moves::new(g, &[]);
+            let start = Point::new(0, 0);
+            let mut t = wd.tour.clone();
+            let mut cells = vec![Point::default(); n];
+            let mut pos = vec![0u32; hash_words(n)];
+            let mut tg = Tightening::begin(&moves, start, wd.walk, &t, &mut cells, &mut pos)
+                .expect("an index");
+            // Index every cell and a few steps of the pass.
+            let mut budget = n as u32 + 40;
+            let mut state = None;
+            let first = tg.resume(
+                &moves,
+                start,
+                &mut t,
+                &mut cells,
+                &mut pos,
+                &wd.tabu,
+                &mut budget,
+            );
+            if first.is_none() {
+                state = Some(tg);
+            }
+            let Some(mut tg) = state else { return };
+            let mut none: Vec<u32> = Vec::new();
+            let mut budget = u32::MAX;
+            let out = tg
+                .resume(
+                    &moves,
+                    start,
+                    &mut t,
+                    &mut cells,
+                    &mut none,
+                    &wd.tabu,
+                    &mut budget,
+                )
+                .expect("done at once");
+            let end = t[..out.steps]
+                .iter()
+                .fold(start, |p, &d| crate::map::grid::neighbour(p, d));
+            assert_eq!(end, Point::new(w - 1, h - 1), "seed {seed}");
+            assert_eq!(out.straight + out.diagonal, out.steps as u32);
+            assert!(out.steps >= run(usize::from(w) * usize::from(h)).0.steps);
+            assert!(out.steps <= wd.walk.steps);
+            checked += 1;
+        });
+        assert!(checked >= 3, "{checked}");
+    }
+
+    #[test]
     fn the_hash_tables_tighten_as_the_per_cell_index_does() {
         // Wandering walks on a 48 x 40 map; each is tightened with a per-cell index, with the
         // smallest hash table of 16-bit slots (half a word a slot) of a load factor of 1/2, and
@@ -677,7 +974,7 @@ mod tests {
         let n = 16_385;
         assert_eq!(hash_words(n), 16_384);
         let mut pos = vec![0u32; 16_384];
-        let mut ix = PathIndex::new(&mut pos, 1 << 22, n).expect("a table");
+        let mut ix = PathIndex::new(&mut pos, 1 << 22, n, true).expect("a table");
         assert_eq!(ix.len(), 32_768);
         let cell = |i: usize| (i * 193 + 7) % (1 << 22);
         for i in 0..n {
@@ -691,7 +988,7 @@ mod tests {
             assert_eq!(ix.find(cell(i), at), None);
         }
         let mut fewer = vec![0u32; 16_383];
-        assert!(PathIndex::new(&mut fewer, 1 << 22, n).is_none());
+        assert!(PathIndex::new(&mut fewer, 1 << 22, n, true).is_none());
     }
 
     #[test]
@@ -705,7 +1002,7 @@ mod tests {
         let cell = |i: usize| (i * 193 + 7) % map;
         let mut links = vec![0u32; keyed_words(n)];
         let mut cells = vec![Point::default(); n];
-        let mut k = Keyed::new(&mut links, &mut cells, map, n).expect("a table");
+        let mut k = Keyed::new(&mut links, &mut cells, map, n, true).expect("a table");
         assert_eq!((k.len, k.bits), (6144, 13));
         for i in 0..n {
             k.insert(cell(i), i as u32);
@@ -717,9 +1014,9 @@ mod tests {
             assert_eq!(k.find(cell(i)), None);
         }
         let mut links = vec![0u32; keyed_words(n) - 1];
-        assert!(Keyed::new(&mut links, &mut cells, map, n).is_none());
+        assert!(Keyed::new(&mut links, &mut cells, map, n, true).is_none());
         let mut links = vec![0u32; keyed_words(n)];
-        assert!(Keyed::new(&mut links, &mut cells, 1 << 20, n).is_none());
+        assert!(Keyed::new(&mut links, &mut cells, 1 << 20, n, true).is_none());
     }
 
     #[test]

@@ -31,6 +31,7 @@ pub use crate::geometry::drop_collinear;
 use crate::geometry::{distance, drop_middles, segment_clear};
 use crate::map::grid::{Grid, Point};
 use crate::named::named;
+use crate::polish::taut::{segment_units, Pass};
 
 /// How to post-process the raw path.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
@@ -121,15 +122,22 @@ pub struct Smoother {
     tail: Tail,
 }
 
-/// The steps of [`SmoothingKind::Shortest`] after the DP, one a piece
+/// The steps of [`SmoothingKind::Shortest`] after the DP, a budget at a time
 /// ([`Smoother::finish_piece`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Tail {
-    /// The trace of the DP's links (and the merge of a bounded scan) is next.
+    /// The trace of the DP's links is next.
     Trace,
-    /// Passes of [`crate::polish::taut::pull`] over the first `k` waypoints, `passes` done.
-    Pull { k: usize, passes: u8 },
+    /// The greedy merge ([`merge`]) of the waypoints `pts[..k]` (a path longer than the ring):
+    /// `pts[..out]` kept so far, `i` the next interior waypoint to try.
+    Merge { k: usize, i: usize, out: usize },
+    /// Passes of [`crate::polish::taut::pull`]: `passes` done, the current one where it stands.
+    Pull { pass: Pass, passes: u8 },
 }
+
+/// Work units of the trace of the DP's links a raw cell (a link followed and a cell copied; the
+/// units of [`segment_units`]).
+const TRACE_CELLS: usize = 4;
 
 impl Smoother {
     /// Prepare to smooth `pts[..n]` with `kind`. Falls back to [`SmoothingKind::Greedy`] when
@@ -207,45 +215,76 @@ impl Smoother {
     }
 
     /// [`Smoother::finish`] a piece at a time, once the DP is done ([`Smoother::resume`]
-    /// returned `false`): the trace (and merge), then each pass of the taut pull; `Some(k)` with
-    /// the waypoint count once done (the pieces write what `finish` writes), `None` while
-    /// pieces remain. The other kinds finish in one piece.
+    /// returned `false`): the trace, the merge of a bounded scan and the passes of the taut pull,
+    /// for at most about `budget` work units a call (the units of
+    /// [`crate::polish::taut::segment_units`]; a call with a budget always does some work, and
+    /// may overrun it by a waypoint's segment tests). `Some(k)` with the waypoint count once done
+    /// (the pieces write what `finish` writes, however the work is cut), `None` while work
+    /// remains. The other kinds finish in one piece.
     pub fn finish_piece(
         &mut self,
         grid: &Grid<'_>,
         pts: &mut [Point],
         dist: &mut [f32],
         prev: &mut [u32],
+        budget: u32,
     ) -> Option<usize> {
         let n = self.n.min(pts.len());
         if n < 3 || self.kind != SmoothingKind::Shortest {
             return Some(self.finish(grid, pts, dist, prev));
         }
-        match self.tail {
-            Tail::Trace => {
-                while self.resume(grid, pts, dist, prev, usize::MAX) {}
-                let k = trace(pts, n, prev);
-                let k = if self.ring < n {
-                    merge(grid, pts, k)
-                } else {
-                    k
-                };
-                self.tail = Tail::Pull {
-                    k: drop_collinear(pts, k),
-                    passes: 0,
-                };
-                None
+        let mut left = budget.max(1);
+        loop {
+            if left == 0 {
+                return None;
             }
-            Tail::Pull { k, passes } => {
-                let (k, changed) = crate::polish::taut::pass(grid, pts, k);
-                let passes = passes.saturating_add(1);
-                if changed && passes < crate::polish::taut::MAX_PASSES {
-                    self.tail = Tail::Pull { k, passes };
-                    return None;
+            match self.tail {
+                Tail::Trace => {
+                    while self.resume(grid, pts, dist, prev, usize::MAX) {}
+                    let k = trace(pts, n, prev);
+                    let cost = u32::try_from(n / TRACE_CELLS).unwrap_or(u32::MAX);
+                    left = left.saturating_sub(cost);
+                    self.tail = if self.ring < n {
+                        Tail::Merge { k, i: 1, out: 1 }
+                    } else {
+                        Tail::Pull {
+                            pass: Pass::new(drop_collinear(pts, k)),
+                            passes: 0,
+                        }
+                    };
                 }
-                // `taut::pull`'s end, then `finish`'s.
-                let k = drop_collinear(pts, k);
-                Some(drop_collinear(pts, k))
+                Tail::Merge { k, i, out } => {
+                    let clear = |a: Point, c: Point| segment_clear(grid, a, c);
+                    match merge_resume(clear, pts, k, (i, out), &mut left) {
+                        Ok(k) => {
+                            self.tail = Tail::Pull {
+                                pass: Pass::new(drop_collinear(pts, k)),
+                                passes: 0,
+                            }
+                        }
+                        Err((i, out)) => {
+                            self.tail = Tail::Merge { k, i, out };
+                            return None;
+                        }
+                    }
+                }
+                Tail::Pull { mut pass, passes } => {
+                    let Some((k, changed)) = pass.resume(grid, pts, &mut left) else {
+                        self.tail = Tail::Pull { pass, passes };
+                        return None;
+                    };
+                    let passes = passes.saturating_add(1);
+                    if changed && passes < crate::polish::taut::MAX_PASSES {
+                        self.tail = Tail::Pull {
+                            pass: Pass::new(k),
+                            passes,
+                        };
+                        continue;
+                    }
+                    // `taut::pull`'s end, then `finish`'s.
+                    let k = drop_collinear(pts, k);
+                    return Some(drop_collinear(pts, k));
+                }
             }
         }
     }
@@ -567,6 +606,50 @@ fn merge(grid: &Grid<'_>, pts: &mut [Point], k: usize) -> usize {
     drop_middles(pts, k, |a, _, c| segment_clear(grid, a, c))
 }
 
+/// [`merge`] from where it stands, `(i, out)` (the next interior waypoint of `pts[..k]` and the
+/// waypoints kept so far, `(1, 1)` at first), while `left` lasts ([`segment_units`] a test, and
+/// one): `Ok(count)` once done (what `merge` returns), `Err((i, out))` when `left` ran out first
+/// (then 0). Each call with `left > 0` tries at least one waypoint. `clear` is the segment test.
+fn merge_resume(
+    mut clear: impl FnMut(Point, Point) -> bool,
+    pts: &mut [Point],
+    k: usize,
+    (mut i, mut out): (usize, usize),
+    left: &mut u32,
+) -> Result<usize, (usize, usize)> {
+    let n = k.min(pts.len());
+    if n < 3 {
+        return Ok(n);
+    }
+    // As `drop_middles`: 1 <= out <= i < n - 1 inside the loop, so no `wrapping_` here wraps.
+    let last_i = n.wrapping_sub(1);
+    while i < last_i {
+        if *left == 0 {
+            return Err((i, out));
+        }
+        let (Some(&a), Some(&b), Some(&c)) = (
+            pts.get(out.wrapping_sub(1)),
+            pts.get(i),
+            pts.get(i.wrapping_add(1)),
+        ) else {
+            break;
+        };
+        *left = left.saturating_sub(segment_units(a, c).wrapping_add(1));
+        if !clear(a, c) {
+            if let Some(slot) = pts.get_mut(out) {
+                *slot = b;
+            }
+            out = out.wrapping_add(1);
+        }
+        i = i.wrapping_add(1);
+    }
+    let last = pts.get(last_i).copied();
+    if let (Some(last), Some(slot)) = (last, pts.get_mut(out)) {
+        *slot = last;
+    }
+    Ok(out.wrapping_add(1))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -796,6 +879,50 @@ mod tests {
                 assert_eq!(p1[..k1], p2[..k2], "{kind:?} case {case}");
             }
         }
+    }
+
+    #[test]
+    fn the_tail_in_pieces_finishes_as_at_once() {
+        // Random walks short and longer than the ring, both scans: the DP, then the tail (trace,
+        // merge, taut passes) in pieces of a few work units and of many, gives `finish`'s
+        // waypoints bit for bit; small budgets take many pieces.
+        let mut rng = crate::rng::Xoshiro128pp::from_u64(5);
+        let (mut merged, mut many) = (0, 0);
+        for case in 0..40 {
+            let steps = 20 + case * 13;
+            let (b, raw) = random_walk(&mut rng, 64, 48, 0.12, steps);
+            let g = Grid::new(64, 48, &b).unwrap();
+            let n = raw.len();
+            for bounded in [false, true] {
+                let start = |d: &mut Vec<f32>, r: &mut Vec<u32>| {
+                    let sm = Smoother::new(SmoothingKind::Shortest, n, d, r);
+                    if bounded {
+                        sm.bounded()
+                    } else {
+                        sm
+                    }
+                };
+                let (mut p1, mut d1, mut r1) = (raw.clone(), vec![0.0; n], vec![0; n]);
+                let k1 = start(&mut d1, &mut r1).finish(&g, &mut p1, &mut d1, &mut r1);
+                for budget in [1u32, 7, 60, 100_000] {
+                    let (mut p2, mut d2, mut r2) = (raw.clone(), vec![0.0; n], vec![0; n]);
+                    let mut sm = start(&mut d2, &mut r2);
+                    while sm.resume(&g, &p2, &mut d2, &mut r2, 9) {}
+                    let mut pieces = 1;
+                    let k2 = loop {
+                        if let Some(k) = sm.finish_piece(&g, &mut p2, &mut d2, &mut r2, budget) {
+                            break k;
+                        }
+                        pieces += 1;
+                        assert!(pieces < 100 * n, "no progress");
+                    };
+                    assert_eq!(p1[..k1], p2[..k2], "case {case} bounded {bounded} {budget}");
+                    many += usize::from(pieces > 10);
+                }
+                merged += usize::from(n > LOOKBACK + 1);
+            }
+        }
+        assert!(merged >= 40 && many >= 40, "{merged} {many}");
     }
 
     #[test]

@@ -12,6 +12,7 @@
 //!   segments are clear and the two segments get shorter.
 //!
 //! Passes over the waypoints repeat until a pass changes nothing, at most [`MAX_PASSES`] times.
+//! A pass can go a bounded amount of work at a time ([`Pass`]), with the same result.
 //!
 //! Guarantees: the result is never longer than the input (every move shortens it, by at least
 //! [`MIN_GAIN`] cells, so a pass cannot cycle), every segment obeys the segment rule (each move
@@ -35,7 +36,7 @@ pub const MIN_GAIN: f32 = 1e-4;
 
 /// Pull `pts[..n]` taut in place (see the module docs); returns the new waypoint count. The
 /// same as [`pass`] until one changes nothing (at most [`MAX_PASSES`]), then
-/// [`drop_collinear`]: the planner does it a pass a piece.
+/// [`drop_collinear`]: the planner does it a bounded piece of a pass at a time ([`Pass`]).
 pub fn pull(grid: &Grid<'_>, pts: &mut [Point], n: usize) -> usize {
     let mut n = n.min(pts.len());
     for _ in 0..MAX_PASSES {
@@ -49,13 +50,75 @@ pub fn pull(grid: &Grid<'_>, pts: &mut [Point], n: usize) -> usize {
 }
 
 /// One pass of [`pull`] over `pts[..n]`: returns the new count and whether it changed anything.
+/// The same as a [`Pass`] without a budget.
 pub fn pass(grid: &Grid<'_>, pts: &mut [Point], n: usize) -> (usize, bool) {
-    let mut n = n.min(pts.len());
-    {
-        let mut changed = false;
-        let mut i = 1usize;
+    let mut p = Pass::new(n.min(pts.len()));
+    loop {
+        let mut budget = u32::MAX;
+        if let Some(done) = p.resume(grid, pts, &mut budget) {
+            return done;
+        }
+    }
+}
+
+/// Work units of a segment test from `a` to `b` ([`segment_clear`] at its worst: a walk over
+/// the rows it spans, a byte of the map at a time in each): four, one a row, one for eight
+/// columns. The smoothing's merge and the taut pull charge their budgets with it.
+pub fn segment_units(a: Point, b: Point) -> u32 {
+    let rows = u32::from(a.y.abs_diff(b.y));
+    let cols = u32::from(a.x.abs_diff(b.x));
+    4u32.wrapping_add(rows).wrapping_add(cols >> 3)
+}
+
+/// Work units of a waypoint of a [`Pass`] besides its segment tests (eight candidate lengths).
+pub const WAYPOINT_UNITS: u32 = 8;
+
+/// A pass of [`pull`] in progress, a bounded amount of work at a time ([`Pass::resume`]), so a
+/// firmware can yield inside the pull of a long path: where it stands (the next waypoint and
+/// the count) and whether it changed anything so far. However the work is cut, the pass does
+/// what [`pass`] does, bit for bit; the caller passes the same points to every call.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Pass {
+    /// Waypoints now.
+    n: usize,
+    /// The next interior waypoint to try (`1 <= i`).
+    i: usize,
+    /// A waypoint was dropped or shifted so far.
+    changed: bool,
+}
+
+impl Pass {
+    /// A pass over `pts[..n]`.
+    pub fn new(n: usize) -> Self {
+        Pass {
+            n,
+            i: 1,
+            changed: false,
+        }
+    }
+
+    /// Go on while `budget` lasts (work units: [`segment_units`] a segment test,
+    /// [`WAYPOINT_UNITS`] a waypoint), taking what it spends from it; at least one waypoint a
+    /// call, so a waypoint's tests may take it below zero (then it is 0). `Some((count,
+    /// changed))` once the pass is over, `None` while waypoints are left.
+    pub fn resume(
+        &mut self,
+        grid: &Grid<'_>,
+        pts: &mut [Point],
+        budget: &mut u32,
+    ) -> Option<(usize, bool)> {
+        let mut n = self.n.min(pts.len());
+        let mut i = self.i.max(1);
+        let mut left = *budget;
+        let mut first = true;
         // Bounds: 1 <= i and i + 1 < n <= pts.len() inside the loop.
         while i.wrapping_add(1) < n {
+            if left == 0 && !first {
+                (self.n, self.i) = (n, i);
+                *budget = 0;
+                return None;
+            }
+            first = false;
             let (Some(&a), Some(&b), Some(&c)) = (
                 pts.get(i.wrapping_sub(1)),
                 pts.get(i),
@@ -63,6 +126,7 @@ pub fn pass(grid: &Grid<'_>, pts: &mut [Point], n: usize) -> (usize, bool) {
             ) else {
                 break;
             };
+            let mut spent = WAYPOINT_UNITS.wrapping_add(segment_units(a, c));
             if segment_clear(grid, a, c) {
                 // Drop b: pts[i + 1..n] moves one to the left (by hand: no bounds panic).
                 for j in i..n.wrapping_sub(1) {
@@ -72,25 +136,42 @@ pub fn pass(grid: &Grid<'_>, pts: &mut [Point], n: usize) -> (usize, bool) {
                         }
                     }
                 }
+                spent =
+                    spent.saturating_add(u32::try_from(n.wrapping_sub(i) >> 4).unwrap_or(u32::MAX));
                 n = n.wrapping_sub(1);
-                changed = true;
+                self.changed = true;
+                left = left.saturating_sub(spent);
                 continue;
             }
-            if let Some(q) = best_shift(grid, a, b, c) {
+            let mut clear = |p: Point, q: Point| {
+                spent = spent.saturating_add(segment_units(p, q));
+                segment_clear(grid, p, q)
+            };
+            if let Some(q) = best_shift(&mut clear, grid, a, b, c) {
                 if let Some(slot) = pts.get_mut(i) {
                     *slot = q;
                 }
-                changed = true;
+                self.changed = true;
             }
+            left = left.saturating_sub(spent);
             i = i.wrapping_add(1);
         }
-        (n, changed)
+        (self.n, self.i) = (n, i);
+        *budget = left;
+        Some((n, self.changed))
     }
 }
 
 /// The neighbour `q` of `b` (in direction order) that makes `a - q - c` the shortest, if it is at
-/// least [`MIN_GAIN`] shorter than `a - b - c` and both its segments are clear.
-fn best_shift(grid: &Grid<'_>, a: Point, b: Point, c: Point) -> Option<Point> {
+/// least [`MIN_GAIN`] shorter than `a - b - c` and both its segments are clear (`clear`: the
+/// segment test).
+fn best_shift(
+    clear: &mut impl FnMut(Point, Point) -> bool,
+    grid: &Grid<'_>,
+    a: Point,
+    b: Point,
+    c: Point,
+) -> Option<Point> {
     let now = distance(a, b) + distance(b, c);
     let mut best: Option<(f32, Point)> = None;
     for (dx, dy) in DX.iter().zip(DY.iter()) {
@@ -108,7 +189,7 @@ fn best_shift(grid: &Grid<'_>, a: Point, b: Point, c: Point) -> Option<Point> {
         }
         let len = distance(a, q) + distance(q, c);
         let beats = best.map_or(now - MIN_GAIN, |(l, _)| l);
-        if len < beats && segment_clear(grid, a, q) && segment_clear(grid, q, c) {
+        if len < beats && clear(a, q) && clear(q, c) {
             best = Some((len, q));
         }
     }

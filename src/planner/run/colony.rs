@@ -5,7 +5,7 @@
 
 use crate::colony::ant::{Ant, DeadEnd, Lost, Trail, Walk};
 use crate::colony::pheromone::Table;
-use crate::colony::tighten::tighten;
+use crate::colony::tighten::Tightening;
 use crate::colony::update::{deposit, wolves_amounts};
 use crate::geometry::steps_length;
 use crate::map::grid::{Dir, Filling, Moves, Point, Reach};
@@ -125,10 +125,11 @@ pub(super) struct Iteration {
 /// Moves of the ants' walks (forward or back) one piece of the colony makes at most
 /// ([`Run::poll`]); starting a walk (a pass over the tabu set's words), tightening and depositing
 /// a path, and the flood fill of an ant that outgrew its tour are charged on the same budget
-/// (`start_cost`, [`PATH_COST`], [`FILL_CELLS`]). Measured under `-icount`
+/// (`start_cost`, [`UNITS_A_MOVE`], [`PATH_COST`], [`FILL_CELLS`]). Measured under `-icount`
 /// (`scripts/bench_pieces.py`, `BENCHMARKS.md` 4d): the largest walk piece is 0.64-0.92 M
-/// instructions on NewYork, the depot and Sydney (2,048 moves gave 0.96 M on NewYork); a piece
-/// that ends a long walk also tightens it, about 1.5 M on maze512's 4,000-step path.
+/// instructions on NewYork, the depot and Sydney (2,048 moves gave 0.96 M on NewYork). A long
+/// path's tightening goes on over as many pieces as it needs ([`Tightening`]: in one piece it was
+/// 1.5 M on maze512's 4,000-step path).
 pub(super) const MOVES_A_PIECE: u32 = 1536;
 /// Moves a walk's start is charged for: its copy of the pruning marks into the tabu set, one word
 /// for 32 cells (a 512 x 512 map: 8,192 words, as much as about 512 moves).
@@ -143,9 +144,25 @@ const fn start_cost(cells: usize) -> u32 {
 /// Cells of the flood fill a move of the budget pays for (a cell costs about 15 instructions, a
 /// move a few hundred).
 const FILL_CELLS: usize = 32;
-/// Path steps a move of the budget pays for in tightening and depositing a path (each step is
-/// read a few times: tightening's index, the deposit).
+/// Path steps a move of the budget pays for in depositing a path.
 const PATH_COST: usize = 2;
+/// Work units of a path's tightening ([`Tightening::resume`]) a move of the budget pays for.
+/// Measured under `-icount` (`scripts/bench_pieces.py`): a unit is about 90 instructions, and the
+/// largest piece on maze512 (a 4,000-step path tightened over several pieces) is 0.73-0.75 M at
+/// 5 units a move (0.69 M at 4, 1.05 M at 8).
+const UNITS_A_MOVE: u32 = 5;
+/// The most of a piece's budget the deposit of a path whose tightening ends in it may need: the
+/// tightening leaves that much ([`go`]), so the deposit after it stays inside the piece.
+const DEPOSIT_RESERVE: u32 = MOVES_A_PIECE / 4;
+
+/// A walk in progress: the ant walking, then its path's tightening.
+#[derive(Clone, Debug)]
+enum Going {
+    /// The ant walks: where it stands.
+    Walk(Trail),
+    /// Its path is tightened: where that stands.
+    Tighten(Tightening),
+}
 
 /// Where the colony's iteration stands between two pieces ([`Run::poll`]).
 #[derive(Clone, Debug, Default)]
@@ -154,13 +171,14 @@ pub(super) struct Walking {
     it: Iteration,
     /// Ants whose walk ended.
     ant: u16,
-    /// The walk in progress: where it stands, the generator's state before it (for a
-    /// [`Replay`]) and its move budget.
-    now: Option<(Trail, Option<Replay>, u32)>,
+    /// The walk in progress: where it (or its tightening) stands, the generator's state before
+    /// it (for a [`Replay`]) and its move budget.
+    now: Option<(Going, Option<Replay>, u32)>,
     /// After the ants: what is left of the iteration.
     close: Close,
-    /// A walk again in progress (a [`Replay`]): where it stands and its generator.
-    again: Option<(Trail, Xoshiro128pp)>,
+    /// A walk again in progress (a [`Replay`]): where it (or its tightening) stands and its
+    /// generator.
+    again: Option<(Going, Xoshiro128pp)>,
     /// The best path was walked again into `best` for the wolves rule.
     placed: bool,
     /// The flood fill an ant that outgrew its tour started (see `Lost::Overflow` below), where it
@@ -201,26 +219,63 @@ enum Close {
     Update,
 }
 
-/// Tighten `walk` ([`tighten`]) when `tight` and the walk may have a shortcut: the path the ant
-/// deposits on, in `tour`.
-fn tightened(
+/// Go on with the walk `going` of `ant` on the piece's budget `left`, then tighten its path
+/// ([`Tightening`]) when `tight` and the walk may have a shortcut: `Ok(Some(walk))` once that is
+/// done (the path the ant deposits on, in `tour`), `Ok(None)` when the piece's budget ran out
+/// first (where it stands in `going`), `Err` when the ant was lost. The tightening leaves the
+/// budget the path's deposit needs ([`DEPOSIT_RESERVE`] at most) and ends the piece rather than
+/// eat into it.
+#[allow(clippy::too_many_arguments)]
+fn go(
     ant: &Ant<'_, '_, '_>,
     tight: bool,
-    walk: Walk,
+    going: &mut Going,
+    rng: &mut Xoshiro128pp,
+    tabu: &mut [u32],
     tour: &mut [Dir],
-    (points, links, tabu): (&mut [Point], &mut [u32], &[u32]),
-) -> Walk {
-    if tight && walk.may_tighten {
-        tighten(ant.moves, ant.start, walk, tour, points, links, tabu)
-    } else {
-        walk
+    (points, links): (&mut [Point], &mut [u32]),
+    left: &mut u32,
+) -> Result<Option<Walk>, Lost> {
+    loop {
+        match going {
+            Going::Walk(trail) => {
+                let Some(walk) = ant.resume(trail, rng, tabu, tour, left)? else {
+                    return Ok(None);
+                };
+                if !(tight && walk.may_tighten) {
+                    return Ok(Some(walk));
+                }
+                match Tightening::begin(ant.moves, ant.start, walk, tour, points, links) {
+                    Some(t) => *going = Going::Tighten(t),
+                    None => return Ok(Some(walk)),
+                }
+            }
+            Going::Tighten(t) => {
+                let reserve = deposit_cost(t.steps()).min(DEPOSIT_RESERVE);
+                let Some(spare) = left.checked_sub(reserve).filter(|&s| s > 0) else {
+                    *left = 0;
+                    return Ok(None);
+                };
+                let mut units = spare.saturating_mul(UNITS_A_MOVE);
+                let done = t.resume(ant.moves, ant.start, tour, points, links, tabu, &mut units);
+                *left = match done {
+                    Some(_) => reserve.saturating_add(units / UNITS_A_MOVE),
+                    None => 0,
+                };
+                return Ok(done);
+            }
+        }
     }
 }
 
-/// Charge `steps` path steps on the piece's budget `left`.
+/// Moves of the budget the deposit of a path of `steps` steps costs.
+fn deposit_cost(steps: usize) -> u32 {
+    u32::try_from(steps / PATH_COST).unwrap_or(u32::MAX)
+}
+
+/// Charge the deposit of `steps` path steps on the piece's budget `left`.
 fn charge(left: &mut u32, steps: usize) {
-    let cost = u32::try_from(steps / PATH_COST).unwrap_or(u32::MAX);
-    *left = left.saturating_sub(cost);
+    *left = left.saturating_sub(deposit_cost(steps));
 }
 
 /// Walk the ant of `r` again into `buf` (the path it deposited on, tightened), a piece at a time:
@@ -232,32 +287,27 @@ fn again(
     tight: bool,
     r: &Option<Replay>,
     steps: usize,
-    slot: &mut Option<(Trail, Xoshiro128pp)>,
+    slot: &mut Option<(Going, Xoshiro128pp)>,
     tabu: &mut [u32],
     buf: &mut [Dir],
     index: (&mut [Point], &mut [u32]),
     left: &mut u32,
 ) -> Option<bool> {
     let Some(r) = r else { return Some(false) };
-    let (mut trail, mut rng) = match slot.take() {
+    let (mut going, mut rng) = match slot.take() {
         Some(s) => s,
         None => {
             *left = left.saturating_sub(start_cost(ant.moves.grid().cells()));
-            (ant.begin(tabu, buf), r.rng.clone())
+            (Going::Walk(ant.begin(tabu, buf)), r.rng.clone())
         }
     };
     ant.budget = r.budget;
-    match ant.resume(&mut trail, &mut rng, tabu, buf, left) {
+    match go(ant, tight, &mut going, &mut rng, tabu, buf, index, left) {
         Ok(None) => {
-            *slot = Some((trail, rng));
+            *slot = Some((going, rng));
             None
         }
-        Ok(Some(walk)) => {
-            charge(left, walk.steps);
-            let (points, links) = index;
-            let w = tightened(ant, tight, walk, buf, (points, links, tabu));
-            Some(w.steps == steps)
-        }
+        Ok(Some(w)) => Some(w.steps == steps),
         Err(_) => Some(false),
     }
 }
@@ -341,7 +391,7 @@ impl Run<'_, '_> {
                         }
                         continue;
                     }
-                    let (mut trail, before, budget) = match w.now.take() {
+                    let (mut going, before, budget) = match w.now.take() {
                         Some(now) => now,
                         None if w.ant < p.ants && !w.it.no_path => {
                             let budget = match (bounded, self.cheapest) {
@@ -354,7 +404,7 @@ impl Run<'_, '_> {
                             });
                             left = left.saturating_sub(start_cost(cells));
                             w.it.walked = w.ant.saturating_add(1);
-                            (ant.begin(tabu, tour), before, budget)
+                            (Going::Walk(ant.begin(tabu, tour)), before, budget)
                         }
                         None => {
                             w.close = Close::Best;
@@ -362,14 +412,16 @@ impl Run<'_, '_> {
                         }
                     };
                     ant.budget = budget;
-                    let walk = match ant.resume(&mut trail, &mut self.rng, tabu, tour, &mut left) {
+                    let idx = (&mut *points, &mut *links);
+                    let rng = &mut self.rng;
+                    let walk = match go(&ant, tight, &mut going, rng, tabu, tour, idx, &mut left) {
                         Ok(None) => {
-                            w.now = Some((trail, before, budget));
+                            w.now = Some((going, before, budget));
                             continue;
                         }
                         Ok(Some(walk)) => {
                             charge(&mut left, walk.steps);
-                            tightened(&ant, tight, walk, tour, (points, links, tabu))
+                            walk
                         }
                         Err(lost) => {
                             w.ant = w.ant.saturating_add(1);

@@ -48,6 +48,9 @@ const REFINE_SLICE: u64 = 1;
 /// [`crate::polish::smoothing::LOOKBACK`] segments, or the bounded scan's fewer; 48 were up to 2.8 M
 /// instructions on maze512's 4,000-cell path, 4 keep the DP's pieces under 0.4 M).
 const SMOOTH_SLICE: usize = 4;
+/// Work units of the smoothing's tail ([`Smoother::finish_piece`]: the trace, the merge and the
+/// taut pull; about a segment test's row each) in one piece of [`Run::poll`].
+const TAIL_UNITS: u32 = 8192;
 
 /// Words at the end of the pheromone increments that the route's stash holds (the local
 /// `sm`, with [`Shortfalls::SMOOTHING`] noted in `short` when it smooths with a cheaper rule
@@ -213,7 +216,7 @@ impl Run<'_, '_> {
             Polish::Tail(mut sm) => {
                 let dist = ws.delta.as_flattened_mut();
                 let links = ws.idle.smoothing(sm.cells());
-                match sm.finish_piece(grid, ws.points, dist, links) {
+                match sm.finish_piece(grid, ws.points, dist, links, TAIL_UNITS) {
                     None => Phase::Polish(Polish::Tail(sm)),
                     Some(k) => {
                         let waypoints = if corridor {

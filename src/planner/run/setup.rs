@@ -20,8 +20,9 @@ const ROUTE_BLOCKS: u32 = 112;
 /// Cells the pruning from scratch tries in one piece of [`Run::poll`] (`prune::resume`: a
 /// 32-cell window of the first pass counts as one; a few hundred instructions each, the settling
 /// of a pruned cell's dead branch included). Measured under `-icount`
-/// (`scripts/bench_pieces.py`).
-const PRUNE_TRIES: u32 = 2_000;
+/// (`scripts/bench_pieces.py`): at 2,000 Sydney's largest pruning piece (H743 twin) was 1.035 M
+/// instructions, at 1,600 it is 0.83 M.
+const PRUNE_TRIES: u32 = 1_600;
 
 impl Run<'_, '_> {
     /// The coarse route's search ended (`Ok(Some(_))`), was not wanted (`Ok(None)`) or found no
