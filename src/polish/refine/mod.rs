@@ -62,6 +62,7 @@
 use crate::error::Error;
 use crate::map::grid::{direction, Grid, Point};
 
+mod line;
 mod memo;
 mod scratch;
 mod window;
@@ -96,6 +97,8 @@ pub struct Budget {
     pub improved: u32,
     /// Windows not searched because the memo knew they would not improve ([`Memo`]).
     pub remembered: u32,
+    /// Windows replaced by the straight line between their ends, without a search (`line`).
+    pub lines: u32,
 }
 
 impl Budget {
@@ -107,6 +110,7 @@ impl Budget {
             windows: 0,
             improved: 0,
             remembered: 0,
+            lines: 0,
         }
     }
 
@@ -410,7 +414,12 @@ impl Refiner {
         };
         // Search unless the piece is already as short as it can be.
         let mut replaced = false;
-        if old > octile(ps, pt) {
+        if old > octile(ps, pt) && line::free(grid, ps, pt) {
+            // The straight line is a shortest path between the ends (`line`'s proof): the
+            // window's search would find its cost; write the line instead of searching.
+            budget.lines = budget.lines.saturating_add(1);
+            replaced = self.replace_line(out, s, t, ps, pt);
+        } else if old > octile(ps, pt) {
             let ex = usize::from(x1.wrapping_sub(x0)).saturating_add(1);
             let ey = usize::from(y1.wrapping_sub(y0)).saturating_add(1);
             let (bw, bh) = shape.dims(ex, ey);
@@ -522,9 +531,46 @@ impl Refiner {
             i = qi;
             k = k.wrapping_sub(1); // k > s >= 0
         }
-        // Commit the new path up to its middle (but not less than was committed before) and hand
-        // the rest back to the pending part, so the next window overlaps this one by half: move
-        // out[mid + 1..=end] to just before the first pending cell (back to front: it moves up).
+        self.settle(out, s, steps, t_out);
+        true
+    }
+
+    /// Write the line from `P[s]` = `from` to `P[t]` = `to` over the piece (it always fits: the
+    /// line has `max(dx, dy)` steps, no more than any path between the ends); false if not.
+    fn replace_line(
+        &mut self,
+        out: &mut [Point],
+        s: usize,
+        t: usize,
+        from: Point,
+        to: Point,
+    ) -> bool {
+        let line = line::Line::new(from, to);
+        let steps = line.len() as usize;
+        let Some(t_out) = self.r.checked_add(t.saturating_sub(self.w)) else {
+            return false;
+        };
+        let Some(end) = s.checked_add(steps) else {
+            return false;
+        };
+        if end > t_out || end >= out.len() {
+            return false;
+        }
+        let slots = out.get_mut(s.saturating_add(1)..=end).unwrap_or_default();
+        for (slot, p) in slots.iter_mut().zip(line) {
+            *slot = p;
+        }
+        self.settle(out, s, steps, t_out);
+        true
+    }
+
+    /// After a replacement written to `out[s + 1..=s + steps]` (the piece's last cell, virtual
+    /// index `t`, was at `out[t_out]`): commit the new path up to its middle (but not less than
+    /// was committed before) and hand the rest back to the pending part, so the next window
+    /// overlaps this one by half: move `out[mid + 1..=end]` to just before the first pending cell
+    /// (back to front: it moves up).
+    fn settle(&mut self, out: &mut [Point], s: usize, steps: usize, t_out: usize) {
+        let end = s.saturating_add(steps);
         let mid = s.saturating_add(steps / 2).max(self.w).min(end);
         let keep = end.wrapping_sub(mid); // mid <= end
         let r = t_out.saturating_add(1).saturating_sub(keep);
@@ -537,7 +583,6 @@ impl Refiner {
         }
         self.w = mid.saturating_add(1);
         self.r = r;
-        true
     }
 }
 
