@@ -24,7 +24,9 @@
 //! inside it. A strictly shorter result replaces the piece. Either way the path is committed up
 //! to the middle of the piece (the rest stays pending), so consecutive windows overlap by half.
 //! Passes repeat until one changes nothing or `max_passes` ran. Pieces whose length already
-//! equals the obstacle-free octile distance are skipped without a search.
+//! equals the obstacle-free octile distance are skipped without a search, and a longer piece
+//! whose ends' straight line is free takes that line without a search (it is a shortest path in
+//! any box: the proof is in `line`'s docs).
 //!
 //! **What it cannot do.** A window only sees its piece: a detour around the wrong side of a block
 //! larger than the window stays (the colony's choice of corridor), and so does a path that runs
