@@ -328,43 +328,46 @@ pub(super) fn block(
     };
     let bit = |v: u64, k: usize| (v >> (k & 63)) & 1;
     let (last, east) = (n, n.wrapping_add(1));
-    // Rows r = 0 ..= n + 1 are y0 - 1 ..= y0 + n (off the map: no cell). The four the north
-    // and south links read, as rows (free, live) ...
-    let (mut north, mut top, mut bottom, mut south) = ((0, 0), (0, 0), (0, 0), (0, 0));
-    // ... and the four columns the west and east links read, as vectors over the rows (bit r):
-    // x0 - 1, x0, x0 + n - 1, x0 + n (bits 0, 1, n, n + 1 of a row), free and live.
-    let mut cols = [(0u64, 0u64); 4];
-    for r in 0..n.wrapping_add(2) {
+    // Row r = 0 ..= n + 1 is y0 - 1 ..= y0 + n (off the map: no cell).
+    let row = |r: usize| -> (u64, u64) {
         let y = y0.wrapping_add(r).wrapping_sub(1);
         if y >= h {
-            continue; // y0 - 1 above the top row wraps round
+            (0, 0) // y0 - 1 above the top row wraps round
+        } else {
+            window(y)
         }
-        let (f, l) = window(y);
-        if r == 0 {
-            north = (f, l);
-        }
-        if r == 1 {
-            top = (f, l);
-        }
-        if r == n {
-            bottom = (f, l);
-        }
-        if r == n.wrapping_add(1) {
-            south = (f, l);
-        }
-        // The side links read the block's own rows only (bits 1..=n of a column).
-        if (1..=n).contains(&r) {
-            for (c, k) in cols.iter_mut().zip([0, 1, last, east]) {
-                c.0 |= bit(f, k) << r;
-                c.1 |= bit(l, k) << r;
-            }
-        }
+    };
+    // The four rows the north and south links and the corners read.
+    let (north, top) = (row(0), row(1));
+    let bottom = if n == 1 { top } else { row(n) };
+    let south = row(n.wrapping_add(1));
+    // The east and west links (bits 0 and 1 here): a move from the block's last (first) column
+    // to the column beyond it whose both ends lie in the block's rows 1..=n: straight within a
+    // row, or diagonal between two consecutive rows (both ends live, the two cells beside it
+    // free: the no-corner-cutting rule). Rows are read top to bottom only while a side link is
+    // still missing: on open ground the first row finds both.
+    let straight = |(_, l): (u64, u64)| -> u8 {
+        (bit(l, last) & bit(l, east)) as u8 | ((bit(l, 1) & bit(l, 0)) as u8) << 1
+    };
+    let diagonal = |(fa, la): (u64, u64), (fb, lb): (u64, u64), edge: usize, out: usize| -> u64 {
+        (bit(la, edge) & bit(lb, out) & bit(fa, out) & bit(fb, edge))
+            | (bit(lb, edge) & bit(la, out) & bit(fb, out) & bit(fa, edge))
+    };
+    let mut sides = straight(top);
+    let mut prev = top;
+    let mut r = 2usize;
+    while sides != 3 && r <= n {
+        let cur = if r == n { bottom } else { row(r) };
+        sides |= straight(cur)
+            | diagonal(prev, cur, last, east) as u8
+            | (diagonal(prev, cur, 1, 0) as u8) << 1;
+        prev = cur;
+        r = r.wrapping_add(1);
     }
-    // The block's own rows, or columns: bits 1..=n.
+    // A move from the block's edge row `a` to the row `b` beyond it, straight or diagonal, whose
+    // far end stays within the block's columns: both ends live, and a diagonal's two side cells
+    // free (the no-corner-cutting rule).
     let inner = row_bits & !1 & !(1u64 << east);
-    // A move from the block's edge `a` (a row or a column, free and live) to the line `b`
-    // beyond it, straight or diagonal, whose far end stays within the block's extent: both
-    // ends live, and a diagonal's two side cells free (the no-corner-cutting rule).
     let side = |(fa, la): (u64, u64), (fb, lb): (u64, u64)| -> bool {
         let straight = la & lb;
         let up = la & (lb >> 1) & fb & (fa >> 1) & (inner >> 1);
@@ -375,13 +378,12 @@ pub(super) fn block(
     let corner = |(fa, la): (u64, u64), ka: usize, (fb, lb): (u64, u64), kb: usize| -> bool {
         bit(la, ka) & bit(lb, kb) & bit(fa, kb) & bit(fb, ka) == 1
     };
-    let [west, first, end, beyond] = cols;
     let links = [
-        side(end, beyond),                 // 0: east
+        sides & 1 != 0,                    // 0: east
         corner(bottom, last, south, east), // 1: south-east
         side(bottom, south),               // 2: south
         corner(bottom, 1, south, 0),       // 3: south-west
-        side(first, west),                 // 4: west
+        sides & 2 != 0,                    // 4: west
         corner(top, 1, north, 0),          // 5: north-west
         side(top, north),                  // 6: north
         corner(top, last, north, east),    // 7: north-east

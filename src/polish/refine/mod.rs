@@ -24,7 +24,9 @@
 //! inside it. A strictly shorter result replaces the piece. Either way the path is committed up
 //! to the middle of the piece (the rest stays pending), so consecutive windows overlap by half.
 //! Passes repeat until one changes nothing or `max_passes` ran. Pieces whose length already
-//! equals the obstacle-free octile distance are skipped without a search.
+//! equals the obstacle-free octile distance are skipped without a search, and a longer piece
+//! whose ends' straight line is free takes that line without a search (it is a shortest path in
+//! any box: the proof is in `line`'s docs).
 //!
 //! **What it cannot do.** A window only sees its piece: a detour around the wrong side of a block
 //! larger than the window stays (the colony's choice of corridor), and so does a path that runs
@@ -61,10 +63,14 @@
 use crate::error::Error;
 use crate::map::grid::{direction, Grid, Point};
 
+mod line;
 mod memo;
+mod scratch;
 mod window;
 
 pub use memo::{words as memo_words, Memo, RECORD_WORDS};
+pub use scratch::{RefineStorage, Scratch};
+use scratch::{CLOSED, UNREACHED};
 use window::{place, pred, search, Box2, Shape};
 
 /// Costs of a straight and a diagonal step in search units (the exact scale, module docs).
@@ -75,134 +81,6 @@ pub const MAX_SIDE: usize = 255;
 pub const MIN_SIDE: usize = 8;
 /// Default pass limit of [`refine`].
 pub const DEFAULT_PASSES: u8 = 4;
-
-/// Search scratch for one window, lent for each call: two word slices, each holding one `u32`
-/// and half a `u32` per window cell (`g` and the open list in the first, `f` and the heap
-/// positions in the second; see [`Scratch::new`]).
-///
-/// Two plain `u32` slices, so that a planner can lend buffers it no longer needs (the device's
-/// coarse route and links, after the colony's last iteration) instead of setting RAM aside.
-#[derive(Debug)]
-pub struct Scratch<'a> {
-    /// Cost from the window's start per box cell; [`UNREACHED`] for a cell not reached yet.
-    g: &'a mut [u32],
-    /// `g` plus the octile heuristic, per box cell.
-    f: &'a mut [u32],
-    /// The open list: a binary heap of box cell indices, root at slot 1 (the tail of the first
-    /// word slice seen as `u16`s).
-    heap: &'a mut [u16],
-    /// Position of each box cell in `heap` ([`CLOSED`] once expanded; the tail of the second).
-    pos: &'a mut [u16],
-    /// The windows searched so far, if lent ([`Scratch::with_memo`]).
-    memo: Option<Memo<'a>>,
-}
-
-/// `g` of a cell not reached yet.
-const UNREACHED: u32 = u32::MAX;
-/// `pos` of an expanded cell (heap slots are below [`MAX_SIDE`]`^2 < 0xFFFF`).
-const CLOSED: u16 = u16::MAX;
-
-/// The words as `u16`s (two a word; empty if the cast were impossible, which it never is).
-fn halves(words: &mut [u32]) -> &mut [u16] {
-    bytemuck::try_cast_slice_mut(words).unwrap_or_default()
-}
-
-impl<'a> Scratch<'a> {
-    /// Bytes of scratch per window cell.
-    pub const BYTES_PER_CELL: usize = 12;
-
-    /// Words each of the two slices needs for a window of `side x side` cells (saturating).
-    pub const fn words(side: usize) -> usize {
-        let cells = side.saturating_mul(side);
-        cells.saturating_add(cells.div_ceil(2))
-    }
-
-    /// Scratch over two word slices: the window holds the largest `cells` with
-    /// `cells + ceil(cells / 2)` words in the shorter one. Their contents do not matter.
-    pub fn new(a: &'a mut [u32], b: &'a mut [u32]) -> Self {
-        let words = a.len().min(b.len());
-        // cells + ceil(cells / 2) <= words  <=>  cells <= floor(2 words / 3).
-        let mut cells = words.saturating_mul(2) / 3;
-        if cells.saturating_add(cells.div_ceil(2)) > words {
-            cells = cells.saturating_sub(1);
-        }
-        let (g, a) = a.split_at_mut(cells.min(a.len()));
-        let (f, b) = b.split_at_mut(cells.min(b.len()));
-        let half = cells.div_ceil(2);
-        Scratch {
-            g,
-            f,
-            heap: halves(a.split_at_mut(half.min(a.len())).0),
-            pos: halves(b.split_at_mut(half.min(b.len())).0),
-            memo: None,
-        }
-    }
-
-    /// The same scratch with a memo of the windows searched ([`Memo`]): a window whose ends and
-    /// box a record holds, and that would not improve its piece, is not searched again. The
-    /// refined path is the same with or without it.
-    pub fn with_memo(self, memo: Memo<'a>) -> Self {
-        Scratch {
-            memo: Some(memo),
-            ..self
-        }
-    }
-
-    /// Box cells this scratch can hold.
-    pub fn cells(&self) -> usize {
-        self.g
-            .len()
-            .min(self.f.len())
-            .min(self.heap.len())
-            .min(self.pos.len())
-    }
-
-    /// The window side: the largest `s <= MAX_SIDE` with `s * s <= self.cells()`.
-    pub fn side(&self) -> usize {
-        let cells = self.cells();
-        let mut s = 0usize;
-        // s <= MAX_SIDE = 255: no overflow.
-        while s < MAX_SIDE && s.wrapping_add(1).wrapping_mul(s.wrapping_add(1)) <= cells {
-            s = s.wrapping_add(1);
-        }
-        s
-    }
-}
-
-/// Statically sized scratch: two slices of `WORDS` words each, for a window of the largest side
-/// with [`Scratch::words`]`(side) <= WORDS` (a firmware puts this in a `static`).
-///
-/// ```
-/// use ohaca::refine::{RefineStorage, Scratch};
-/// let mut s = RefineStorage::<{ Scratch::words(48) }>::new();
-/// assert_eq!(s.scratch().side(), 48);
-/// ```
-#[derive(Debug)]
-pub struct RefineStorage<const WORDS: usize> {
-    a: [u32; WORDS],
-    b: [u32; WORDS],
-}
-
-impl<const WORDS: usize> Default for RefineStorage<WORDS> {
-    fn default() -> Self {
-        Self::new()
-    }
-}
-
-impl<const WORDS: usize> RefineStorage<WORDS> {
-    /// Zeroed storage.
-    pub const fn new() -> Self {
-        RefineStorage {
-            a: [0; WORDS],
-            b: [0; WORDS],
-        }
-    }
-
-    /// Lend it as scratch.
-    pub fn scratch(&mut self) -> Scratch<'_> {
-        Scratch::new(&mut self.a, &mut self.b)
-    }
-}
 
 /// Work counter and limit. The limit is checked before each window, so a run stops at most one
 /// window (`side * side` expansions) past it.
@@ -218,6 +96,8 @@ pub struct Budget {
     pub improved: u32,
     /// Windows not searched because the memo knew they would not improve ([`Memo`]).
     pub remembered: u32,
+    /// Windows replaced by the straight line between their ends, without a search (`line`).
+    pub lines: u32,
 }
 
 impl Budget {
@@ -229,6 +109,7 @@ impl Budget {
             windows: 0,
             improved: 0,
             remembered: 0,
+            lines: 0,
         }
     }
 
@@ -527,7 +408,12 @@ impl Refiner {
         };
         // Search unless the piece is already as short as it can be.
         let mut replaced = false;
-        if old > octile(ps, pt) {
+        if old > octile(ps, pt) && line::free(grid, ps, pt) {
+            // The straight line is a shortest path between the ends (`line`'s proof): the
+            // window's search would find its cost; write the line instead of searching.
+            budget.lines = budget.lines.saturating_add(1);
+            replaced = self.replace_line(out, s, t, ps, pt);
+        } else if old > octile(ps, pt) {
             let ex = usize::from(x1.wrapping_sub(x0)).saturating_add(1);
             let ey = usize::from(y1.wrapping_sub(y0)).saturating_add(1);
             let (bw, bh) = shape.dims(ex, ey);
@@ -639,9 +525,46 @@ impl Refiner {
             i = qi;
             k = k.wrapping_sub(1); // k > s >= 0
         }
-        // Commit the new path up to its middle (but not less than was committed before) and hand
-        // the rest back to the pending part, so the next window overlaps this one by half: move
-        // out[mid + 1..=end] to just before the first pending cell (back to front: it moves up).
+        self.settle(out, s, steps, t_out);
+        true
+    }
+
+    /// Write the line from `P[s]` = `from` to `P[t]` = `to` over the piece (it always fits: the
+    /// line has `max(dx, dy)` steps, no more than any path between the ends); false if not.
+    fn replace_line(
+        &mut self,
+        out: &mut [Point],
+        s: usize,
+        t: usize,
+        from: Point,
+        to: Point,
+    ) -> bool {
+        let line = line::Line::new(from, to);
+        let steps = line.len() as usize;
+        let Some(t_out) = self.r.checked_add(t.saturating_sub(self.w)) else {
+            return false;
+        };
+        let Some(end) = s.checked_add(steps) else {
+            return false;
+        };
+        if end > t_out || end >= out.len() {
+            return false;
+        }
+        let slots = out.get_mut(s.saturating_add(1)..=end).unwrap_or_default();
+        for (slot, p) in slots.iter_mut().zip(line) {
+            *slot = p;
+        }
+        self.settle(out, s, steps, t_out);
+        true
+    }
+
+    /// After a replacement written to `out[s + 1..=s + steps]` (the piece's last cell, virtual
+    /// index `t`, was at `out[t_out]`): commit the new path up to its middle (but not less than
+    /// was committed before) and hand the rest back to the pending part, so the next window
+    /// overlaps this one by half: move `out[mid + 1..=end]` to just before the first pending cell
+    /// (back to front: it moves up).
+    fn settle(&mut self, out: &mut [Point], s: usize, steps: usize, t_out: usize) {
+        let end = s.saturating_add(steps);
         let mid = s.saturating_add(steps / 2).max(self.w).min(end);
         let keep = end.wrapping_sub(mid); // mid <= end
         let r = t_out.saturating_add(1).saturating_sub(keep);
@@ -654,7 +577,6 @@ impl Refiner {
         }
         self.w = mid.saturating_add(1);
         self.r = r;
-        true
     }
 }
 

@@ -209,7 +209,13 @@ fn bad_inputs_are_errors() {
 
 #[test]
 fn a_budget_stops_and_resumes_to_the_same_result() {
-    let (b, w, h) = open(200, 30);
+    // A zigzag through scattered obstacles (on open ground the windows would take their straight
+    // lines, `line`, and expand nothing).
+    let (mut b, w, h) = open(200, 30);
+    for x in (4..200).step_by(5) {
+        let i = 6 * 200 + x;
+        b[i / 8] |= 1 << (i % 8);
+    }
     let g = Grid::new(w, h, &b).unwrap();
     let mut dirs = vec![];
     for k in 0..39 {
@@ -220,6 +226,7 @@ fn a_budget_stops_and_resumes_to_the_same_result() {
         });
     }
     let path = walk(Point::new(0, 5), &dirs);
+    assert!(cost(&g, &path) > 0);
     let (whole, total) = run(&g, &path, 24 * 24);
     let mut out = vec![Point::default(); path.len() + 16];
     let mut s = Heapless::new(24 * 24, 0);
@@ -334,4 +341,68 @@ fn a_memo_changes_no_path() {
     }
     // The memo was used, and saved searches.
     assert!(remembered > 10, "{remembered} remembered of {searched}");
+}
+
+#[test]
+fn a_line_has_the_octile_cost_and_ends_at_its_goal() {
+    // Every direction and slope: `max(dx, dy)` 8-connected moves from `a` to `b`, costing
+    // exactly `octile(a, b)` (what `line`'s proof rests on).
+    let a = Point::new(20, 20);
+    for bx in 0..41u16 {
+        for by in 0..41u16 {
+            let b = Point::new(bx, by);
+            let l = line::Line::new(a, b);
+            let n = l.len();
+            let mut cells = vec![a];
+            cells.extend(l);
+            assert_eq!(cells.len() as u32, n + 1);
+            assert_eq!(*cells.last().unwrap(), b);
+            let c: u32 = cells
+                .windows(2)
+                .map(|s| {
+                    assert!(
+                        crate::map::grid::direction(s[0], s[1]).is_some(),
+                        "{a:?}->{b:?}"
+                    );
+                    step_cost(s[0], s[1])
+                })
+                .sum();
+            assert_eq!(c, octile(a, b), "{a:?}->{b:?}");
+        }
+    }
+}
+
+#[test]
+fn a_line_is_taken_only_when_free() {
+    // A window takes the straight line between its ends instead of searching only when every
+    // move of it is allowed. The line from (0,0) to (2,1) is (1,0) then the diagonal to (2,1).
+    // - `corner`: (2,0) blocked, so the diagonal cuts a corner; the optimum (0,0) (1,1) (2,1)
+    //   has the same cost and must come from the search.
+    // - `cell`: (1,0) blocked, the line enters it.
+    // `run` panics on an illegal step: a line taken without either check fails here.
+    let cases: [(&str, [&str; 4], &[u8]); 2] = [
+        ("corner", ["..#.", "....", "....", "...."], &[2, 0, 0]),
+        ("cell", [".#..", "....", "....", "...."], &[2, 1, 7]),
+    ];
+    for (name, rows, dirs) in cases {
+        let (b, w, h) = grid(&rows);
+        let g = Grid::new(w, h, &b).unwrap();
+        let path = walk(Point::new(0, 0), dirs);
+        assert_eq!(*path.last().unwrap(), Point::new(2, 1), "{name}");
+        assert!(!line::free(&g, path[0], Point::new(2, 1)), "{name}");
+        let (out, budget) = run(&g, &path, 16 * 16);
+        assert_eq!(budget.lines, 0, "{name}");
+        assert!(budget.windows > 0 && budget.improved > 0, "{name}");
+        assert!(cost(&g, &out) < cost(&g, &path), "{name}");
+    }
+    // On open ground the same detour is answered by its line, without a search.
+    let (b, w, h) = open(4, 4);
+    let g = Grid::new(w, h, &b).unwrap();
+    let path = walk(Point::new(0, 0), &[2, 0, 0]);
+    let (out, budget) = run(&g, &path, 16 * 16);
+    assert_eq!((budget.lines, budget.windows), (1, 0));
+    assert_eq!(
+        out,
+        vec![Point::new(0, 0), Point::new(1, 0), Point::new(2, 1)]
+    );
 }
