@@ -24,7 +24,14 @@
 //! corridor, and the input is replaced only by a strictly shorter path), every segment obeys the
 //! segment rule, start and goal stay; deterministic (fixed candidate order, first minimum wins,
 //! `f32` lengths from [`crate::geometry::distance`]); no allocation, no panic: a buffer too
-//! short leaves the input as it was.
+//! short leaves the input as it was, and [`try_shortest`] says which one ([`Short`]).
+//!
+//! The per-cell scratch is typed: the lent buffer (the pheromone increments, `[f32; 4]` a cell)
+//! is borrowed as `&mut [`[`Entry`]`]` by `bytemuck`'s checked cast (same size and alignment, so
+//! it cannot fail; if it did, [`Short::Cells`]); the parent and the flags are `u32` fields, not
+//! bits read out of an `f32`.
+
+use core::fmt;
 
 use crate::geometry::{distance, drop_collinear, polyline_length, segment_clear};
 use crate::map::grid::{Grid, Point};
@@ -39,56 +46,115 @@ const MIN_GAIN: f32 = 1e-4;
 const CANDIDATE: u32 = 1;
 const CLOSED: u32 = 2;
 
-/// Per-cell scratch entry: `[g, parent index (bits), flags (bits), h = distance to the goal]`.
-type Entry = [f32; 4];
+/// A map cell's scratch entry, laid over one `[f32; 4]` of the lent buffer (16 bytes, 4-aligned).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct Entry {
+    /// The shortest length from the start found so far (`INFINITY`: not reached).
+    pub g: f32,
+    /// The map index of the cell it was reached from (meaningful once `g` is finite).
+    pub parent: u32,
+    /// [`CANDIDATE`] (in the corridor) and [`CLOSED`] (expanded) bits.
+    pub flags: u32,
+    /// The Euclidean distance to the goal (the A*'s heuristic; set for the corridor's cells).
+    pub h: f32,
+}
+
+impl Entry {
+    /// Not reached, not in the corridor.
+    const EMPTY: Self = Self {
+        g: f32::INFINITY,
+        parent: 0,
+        flags: 0,
+        h: 0.0,
+    };
+
+    fn closed(&self) -> bool {
+        self.flags & CLOSED != 0
+    }
+}
+
+// The cast from the lent `[f32; 4]` cells cannot fail: same size, same alignment.
+const _: () = assert!(
+    core::mem::size_of::<Entry>() == core::mem::size_of::<[f32; 4]>()
+        && core::mem::align_of::<Entry>() == core::mem::align_of::<[f32; 4]>()
+);
+
+/// Why [`try_shortest`] left the path as it was: a buffer too short for this map or path.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Short {
+    /// The cell scratch has fewer entries than the map has cells.
+    Cells,
+    /// The list cannot hold the corridor's cells and its open ones.
+    List,
+    /// The path buffer cannot hold the new path (or its parent chain is broken).
+    Points,
+}
+
+impl fmt::Display for Short {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Self::Cells => "corridor: cell scratch shorter than the map",
+            Self::List => "corridor: list shorter than the corridor",
+            Self::Points => "corridor: path buffer shorter than the new path",
+        })
+    }
+}
 
 /// Replace `pts[..n]` (a valid path from its first to its last point) by the shortest path through
 /// the free cell centres within `radius` of its segments, if that is shorter; returns the new
 /// point count. `pts` beyond `n` is room for a new path of more points than the input (the
 /// planner's path buffer has the raw path's length); `cell` is scratch of one entry per map cell,
 /// `list` scratch for the corridor's cells and its open ones (at most twice the corridor's cells).
-/// Any of them too short leaves the path unchanged.
+/// Any of them too short leaves the path unchanged ([`try_shortest`] says which).
 pub fn shortest(
     grid: &Grid<'_>,
     pts: &mut [Point],
     n: usize,
     radius: u16,
-    cell: &mut [Entry],
+    cell: &mut [[f32; 4]],
     list: &mut [u32],
 ) -> usize {
+    try_shortest(grid, pts, n, radius, cell, list).unwrap_or(n.min(pts.len()))
+}
+
+/// [`shortest`], saying which buffer was too short when it leaves the path as it was. `Ok` with
+/// the input's count when the input is already the shortest (or no shorter path was found).
+pub fn try_shortest(
+    grid: &Grid<'_>,
+    pts: &mut [Point],
+    n: usize,
+    radius: u16,
+    cell: &mut [[f32; 4]],
+    list: &mut [u32],
+) -> Result<usize, Short> {
     let n = n.min(pts.len());
     let cells = grid.cells();
-    let (Some(path), Some(cell)) = (pts.get(..n), cell.get_mut(..cells)) else {
-        return n;
-    };
+    let cell: &mut [Entry] = bytemuck::try_cast_slice_mut(cell).map_err(|_| Short::Cells)?;
+    let cell = cell.get_mut(..cells).ok_or(Short::Cells)?;
+    let path = pts.get(..n).unwrap_or_default();
     let (Some(&start), Some(&goal)) = (path.first(), path.last()) else {
-        return n;
+        return Ok(n);
     };
     if n < 3 {
-        return n; // one segment: already the shortest
+        return Ok(n); // one segment: already the shortest
     }
     let bound = polyline_length(path);
-    cell.fill([f32::INFINITY, 0.0, 0.0, 0.0]);
-    let Some(v) = mark(grid, path, radius, cell, list) else {
-        return n;
-    };
+    cell.fill(Entry::EMPTY);
+    let v = mark(grid, path, radius, cell, list).ok_or(Short::List)?;
     // `list[..v]`: the corridor's cells; the rest holds the open ones (those with a finite `g`
     // that are not closed yet), so picking the next one scans only them.
     let (list, open) = list.split_at_mut(v.min(list.len()));
     for &c in list.iter() {
         let q = unpack(c);
         if let Some(e) = cell.get_mut(grid.index(q)) {
-            e[3] = distance(q, goal);
+            e.h = distance(q, goal);
         }
     }
     let (s, t) = (grid.index(start), grid.index(goal));
-    let Some(e) = cell.get_mut(s) else {
-        return n;
-    };
-    e[0] = 0.0;
-    let Some(slot) = open.first_mut() else {
-        return n;
-    };
+    cell.get_mut(s).ok_or(Short::Cells)?.g = 0.0;
+    let slot = open.first_mut().ok_or(Short::List)?;
     *slot = s as u32;
     let mut open_len = 1usize;
     // `list[..live]` holds the corridor's cells not closed yet, plus `closed` cells closed since
@@ -101,7 +167,7 @@ pub fn shortest(
     while open_len > 0 {
         let mut best: Option<(usize, f32)> = None;
         for (k, &c) in open.iter().enumerate().take(open_len) {
-            let f = cell.get(c as usize).map_or(f32::INFINITY, |e| e[0] + e[3]);
+            let f = cell.get(c as usize).map_or(f32::INFINITY, |e| e.g + e.h);
             if best.is_none_or(|(_, bf)| f < bf) {
                 best = Some((k, f));
             }
@@ -116,8 +182,8 @@ pub fn shortest(
             }
         }
         let Some(e) = cell.get_mut(i) else { break };
-        e[2] = f32::from_bits(e[2].to_bits() | CLOSED);
-        let gi = e[0];
+        e.flags |= CLOSED;
+        let gi = e.g;
         if i == t {
             break;
         }
@@ -126,9 +192,7 @@ pub fn shortest(
             let mut k = 0usize;
             for r in 0..live {
                 let Some(&c) = list.get(r) else { break };
-                let shut = cell
-                    .get(grid.index(unpack(c)))
-                    .is_none_or(|e| e[2].to_bits() & CLOSED != 0);
+                let shut = cell.get(grid.index(unpack(c))).is_none_or(Entry::closed);
                 if !shut {
                     if let Some(slot) = list.get_mut(k) {
                         *slot = c;
@@ -139,12 +203,12 @@ pub fn shortest(
             (live, closed) = (k, 0);
         }
         let p = grid.point(i);
-        let limit = cell.get(t).map_or(bound, |e| e[0].min(bound));
+        let limit = cell.get(t).map_or(bound, |e| e.g.min(bound));
         for &c in list.iter().take(live) {
             let q = unpack(c);
             let j = grid.index(q);
             let Some(e) = cell.get(j) else { continue };
-            if e[2].to_bits() & CLOSED != 0 {
+            if e.closed() {
                 continue;
             }
             // Lower bounds of the Euclidean distance (Chebyshev, and the octile diagonal's): most
@@ -154,44 +218,39 @@ pub fn shortest(
             let diag = (f32::from(dx) + f32::from(dy)) * core::f32::consts::FRAC_1_SQRT_2;
             // (Not `f32::max`: on the Cortex-M4F that is a call to `fmaxf`.)
             let low = gi + if cheb > diag { cheb } else { diag };
-            if low >= e[0] || low + e[3] >= limit {
+            if low >= e.g || low + e.h >= limit {
                 continue;
             }
             let nd = gi + distance(p, q);
-            if nd < e[0] && nd + e[3] < limit && segment_clear(grid, p, q) {
-                let first = e[0] == f32::INFINITY;
+            if nd < e.g && nd + e.h < limit && segment_clear(grid, p, q) {
+                let first = e.g == f32::INFINITY;
                 if let Some(e) = cell.get_mut(j) {
-                    e[0] = nd;
-                    e[1] = f32::from_bits(i as u32);
+                    e.g = nd;
+                    e.parent = i as u32;
                 }
                 if first {
                     // A cell opens once (closed cells are never relaxed), so the open list never
                     // holds more than the corridor's cells; no room left: stop improving.
-                    let Some(slot) = open.get_mut(open_len) else {
-                        return n;
-                    };
+                    let slot = open.get_mut(open_len).ok_or(Short::List)?;
                     *slot = j as u32;
                     open_len = open_len.wrapping_add(1);
                 }
             }
         }
     }
-    let Some(&[g, ..]) = cell.get(t) else {
-        return n;
-    };
+    let g = cell.get(t).ok_or(Short::Cells)?.g;
     let improves = g < bound - MIN_GAIN;
     if !improves {
-        return n;
+        return Ok(n);
     }
     // Count the new path's points, then write them back to front.
     let mut m = 1usize;
     let mut c = t;
     while c != s {
-        let Some(e) = cell.get(c) else { return n };
-        c = e[1].to_bits() as usize;
+        c = cell.get(c).ok_or(Short::Points)?.parent as usize;
         m = m.saturating_add(1);
         if m > pts.len() || m > cells {
-            return n; // longer than the buffer (or a broken chain): keep the input
+            return Err(Short::Points); // longer than the buffer (or a broken chain)
         }
     }
     let mut c = t;
@@ -199,9 +258,9 @@ pub fn shortest(
         if let Some(slot) = pts.get_mut(k) {
             *slot = grid.point(c);
         }
-        c = cell.get(c).map_or(s, |e| e[1].to_bits() as usize);
+        c = cell.get(c).map_or(s, |e| e.parent as usize);
     }
-    drop_collinear(pts, m)
+    Ok(drop_collinear(pts, m))
 }
 
 /// A cell as one word in the corridor's list (`x` high, `y` low): no division to get it back.
@@ -254,10 +313,10 @@ fn mark(
                     }
                     let c = grid.index(q);
                     let Some(e) = cell.get_mut(c) else { continue };
-                    if e[2].to_bits() & CANDIDATE != 0 {
+                    if e.flags & CANDIDATE != 0 {
                         continue;
                     }
-                    e[2] = f32::from_bits(CANDIDATE);
+                    e.flags = CANDIDATE;
                     *list.get_mut(v)? = pack(q);
                     v = v.wrapping_add(1); // < list.len(): the slot existed
                 }
@@ -343,11 +402,17 @@ mod tests {
         let (b, w, h) = bits(&rows);
         let g = Grid::new(w, h, &b).unwrap();
         let input = [Point::new(0, 0), Point::new(2, 2), Point::new(4, 0)];
-        for (cells, list) in [(g.cells() - 1, g.cells()), (g.cells(), 3)] {
+        for (cells, list, why) in [
+            (g.cells() - 1, g.cells(), Short::Cells),
+            (g.cells(), 3, Short::List),
+        ] {
             let mut pts = input.to_vec();
             let mut cell = vec![[0.0f32; 4]; cells];
             let mut l = vec![0u32; list];
             assert_eq!(shortest(&g, &mut pts, 3, RADIUS, &mut cell, &mut l), 3);
+            assert_eq!(pts, input);
+            let r = try_shortest(&g, &mut pts, 3, RADIUS, &mut cell, &mut l);
+            assert_eq!(r, Err(why), "{why}");
             assert_eq!(pts, input);
         }
     }
