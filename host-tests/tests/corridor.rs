@@ -114,7 +114,8 @@ fn plain(grid: &Grid<'_>, input: &[Point], radius: u16) -> Vec<Point> {
             }
         }
     }
-    if !(g[t] < bound - 1e-4) {
+    let improves = g[t] < bound - 1e-4;
+    if !improves {
         return input.to_vec();
     }
     let mut out = vec![grid.point(t)];
