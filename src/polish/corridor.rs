@@ -227,12 +227,16 @@ pub fn try_shortest(
             if low >= e.g || low + e.h >= limit {
                 continue;
             }
+            // Hidden by its own shade (below): no update whatever the length, so no square root.
+            if shadows.shaded(grid, p, q, e.shade) {
+                continue;
+            }
             let nd = gi + distance(p, q);
             if nd >= e.g || nd + e.h >= limit {
                 continue;
             }
             // An improving edge: is it clear? If not, `q` remembers what hid it.
-            if let Err(shade) = shadows.clear(grid, p, q, e.shade) {
+            if let Err(shade) = shadows.clear(grid, p, q) {
                 if let (Some(shade), Some(e)) = (shade, cell.get_mut(j)) {
                     e.shade = shade;
                 }
@@ -298,32 +302,30 @@ impl Shadows {
         }
     }
 
-    /// [`segment_clear`]`(grid, a, b)` as `Ok(())` (clear) or `Err` (blocked), with `b`'s
-    /// `shade` and the remembered blocked cells tried first. A segment found blocked by a walk
+    /// Whether `b`'s `shade` (its blocked cell last found, see [`Entry::shade`]) touches the
+    /// segment from `a`: then it is blocked.
+    fn shaded(&self, grid: &Grid<'_>, a: Point, b: Point, shade: [i8; 2]) -> bool {
+        if shade == [0, 0] || grid.width() > SHADOW_SIDE || grid.height() > SHADOW_SIDE {
+            return false;
+        }
+        let c = Point::new(
+            b.x.wrapping_add_signed(i16::from(shade[0])),
+            b.y.wrapping_add_signed(i16::from(shade[1])),
+        );
+        touches(a, b, c)
+    }
+
+    /// [`segment_clear`]`(grid, a, b)` as `Ok(())` (clear) or `Err` (blocked), with the
+    /// remembered blocked cells tried first. A segment found blocked by a walk
     /// leaves its blocked cell nearest `a` remembered here, and returns `b`'s new shade (the
     /// blocked cell nearest `b`, when within an `i8` offset).
-    fn clear(
-        &mut self,
-        grid: &Grid<'_>,
-        a: Point,
-        b: Point,
-        shade: [i8; 2],
-    ) -> Result<(), Option<[i8; 2]>> {
+    fn clear(&mut self, grid: &Grid<'_>, a: Point, b: Point) -> Result<(), Option<[i8; 2]>> {
         if grid.width() > SHADOW_SIDE || grid.height() > SHADOW_SIDE {
             return if segment_clear(grid, a, b) {
                 Ok(())
             } else {
                 Err(None)
             };
-        }
-        if shade != [0, 0] {
-            let c = Point::new(
-                b.x.wrapping_add_signed(i16::from(shade[0])),
-                b.y.wrapping_add_signed(i16::from(shade[1])),
-            );
-            if touches(a, b, c) {
-                return Err(None);
-            }
         }
         let live = self.cells.get_mut(..self.len).unwrap_or_default();
         for k in 0..live.len() {
