@@ -16,9 +16,14 @@
 //! What it cannot fix is a corridor on the other side of an obstacle: the any-angle optimum may go
 //! around an obstacle the 8-connected optimum passes on the other side.
 //!
-//! Cost: `O(V^2)` distance computations for `V` corridor cells (at most the map's cells), plus the
-//! segment tests of improving edges. It runs on maps of at most [`crate::colony::pheromone::BLOCKS`] cells,
-//! whose per-cell pheromone increments lend the per-cell scratch (`g`, parent, flags).
+//! Cost: for `V` corridor cells (at most the map's cells) and `E` expanded ones, `O(E V)` cheap
+//! steps (each expansion scans the open list and the live corridor cells with square-root-free
+//! lower bounds) and a segment test per improving edge. The segment tests were the cost
+//! (10,058 walks on complex-26, 2.7 M of 4.4 M host instructions): `Shadows` remembers blocked
+//! cells, per corridor cell ([`Entry::shade`]) and the last few found, and an edge whose segment
+//! touches one is blocked without a walk (640 walks left; `docs/ALGORITHM.md`, "Its cost, and the
+//! shadows"). It runs on maps of at most [`crate::colony::pheromone::BLOCKS`] cells, whose per-cell
+//! pheromone increments lend the per-cell scratch (`g`, parent, flags, shade).
 //!
 //! Guarantees: the result is never longer than the input (the input's vertices lie in the
 //! corridor, and the input is replaced only by a strictly shorter path), every segment obeys the
@@ -28,8 +33,8 @@
 //!
 //! The per-cell scratch is typed: the lent buffer (the pheromone increments, `[f32; 4]` a cell)
 //! is borrowed as `&mut [`[`Entry`]`]` by `bytemuck`'s checked cast (same size and alignment, so
-//! it cannot fail; if it did, [`Short::Cells`]); the parent and the flags are `u32` fields, not
-//! bits read out of an `f32`.
+//! it cannot fail; if it did, [`Short::Cells`]); the parent and the flags are integer fields,
+//! not bits read out of an `f32`.
 
 use core::fmt;
 
@@ -56,7 +61,7 @@ pub struct Entry {
     pub parent: u32,
     /// The Euclidean distance to the goal (the A*'s heuristic; set for the corridor's cells).
     pub h: f32,
-    /// [`CANDIDATE`] (in the corridor) and [`CLOSED`] (expanded) bits.
+    /// `CANDIDATE` (in the corridor) and `CLOSED` (expanded) bits.
     pub flags: u16,
     /// The blocked cell last found between this cell and an expanded one, as an offset from
     /// this cell (`[0, 0]`, the cell itself, which is free: none). A blocked cell beside a cell
