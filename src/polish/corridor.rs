@@ -16,15 +16,27 @@
 //! What it cannot fix is a corridor on the other side of an obstacle: the any-angle optimum may go
 //! around an obstacle the 8-connected optimum passes on the other side.
 //!
-//! Cost: `O(V^2)` distance computations for `V` corridor cells (at most the map's cells), plus the
-//! segment tests of improving edges. It runs on maps of at most [`crate::colony::pheromone::BLOCKS`] cells,
-//! whose per-cell pheromone increments lend the per-cell scratch (`g`, parent, flags).
+//! Cost: for `V` corridor cells (at most the map's cells) and `E` expanded ones, `O(E V)` cheap
+//! steps (each expansion scans the open list and the live corridor cells with square-root-free
+//! lower bounds) and a segment test per improving edge. The segment tests were the cost
+//! (10,058 walks on complex-26, 2.7 M of 4.4 M host instructions): `Shadows` remembers blocked
+//! cells, per corridor cell ([`Entry::shade`]) and the last few found, and an edge whose segment
+//! touches one is blocked without a walk (756 walks left; `docs/ALGORITHM.md`, "Its cost, and the
+//! shadows"). It runs on maps of at most [`crate::colony::pheromone::BLOCKS`] cells, whose per-cell
+//! pheromone increments lend the per-cell scratch (`g`, parent, flags, shade).
 //!
 //! Guarantees: the result is never longer than the input (the input's vertices lie in the
 //! corridor, and the input is replaced only by a strictly shorter path), every segment obeys the
 //! segment rule, start and goal stay; deterministic (fixed candidate order, first minimum wins,
 //! `f32` lengths from [`crate::geometry::distance`]); no allocation, no panic: a buffer too
-//! short leaves the input as it was.
+//! short leaves the input as it was, and [`try_shortest`] says which one ([`Short`]).
+//!
+//! The per-cell scratch is typed: the lent buffer (the pheromone increments, `[f32; 4]` a cell)
+//! is borrowed as `&mut [`[`Entry`]`]` by `bytemuck`'s checked cast (same size and alignment, so
+//! it cannot fail; if it did, [`Short::Cells`]); the parent and the flags are integer fields,
+//! not bits read out of an `f32`.
+
+use core::fmt;
 
 use crate::geometry::{distance, drop_collinear, polyline_length, segment_clear};
 use crate::map::grid::{Grid, Point};
@@ -36,59 +48,123 @@ pub const RADIUS: u16 = 3;
 const MIN_GAIN: f32 = 1e-4;
 
 /// Flag bits in a cell's scratch entry.
-const CANDIDATE: u32 = 1;
-const CLOSED: u32 = 2;
+const CANDIDATE: u16 = 1;
+const CLOSED: u16 = 2;
 
-/// Per-cell scratch entry: `[g, parent index (bits), flags (bits), h = distance to the goal]`.
-type Entry = [f32; 4];
+/// A map cell's scratch entry, laid over one `[f32; 4]` of the lent buffer (16 bytes, 4-aligned).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct Entry {
+    /// The shortest length from the start found so far (`INFINITY`: not reached).
+    pub g: f32,
+    /// The map index of the cell it was reached from (meaningful once `g` is finite).
+    pub parent: u32,
+    /// The Euclidean distance to the goal (the A*'s heuristic; set for the corridor's cells).
+    pub h: f32,
+    /// `CANDIDATE` (in the corridor) and `CLOSED` (expanded) bits.
+    pub flags: u16,
+    /// The blocked cell last found between this cell and an expanded one, as an offset from
+    /// this cell (`[0, 0]`, the cell itself, which is free: none). A blocked cell beside a cell
+    /// hides it from a wide angle: the next expanded cell's segment usually touches it too.
+    pub shade: [i8; 2],
+}
+
+impl Entry {
+    /// Not reached, not in the corridor.
+    const EMPTY: Self = Self {
+        g: f32::INFINITY,
+        parent: 0,
+        h: 0.0,
+        flags: 0,
+        shade: [0, 0],
+    };
+
+    fn closed(&self) -> bool {
+        self.flags & CLOSED != 0
+    }
+}
+
+// The cast from the lent `[f32; 4]` cells cannot fail: same size, same alignment.
+const _: () = assert!(
+    core::mem::size_of::<Entry>() == core::mem::size_of::<[f32; 4]>()
+        && core::mem::align_of::<Entry>() == core::mem::align_of::<[f32; 4]>()
+);
+
+/// Why [`try_shortest`] left the path as it was: a buffer too short for this map or path.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Short {
+    /// The cell scratch has fewer entries than the map has cells.
+    Cells,
+    /// The list cannot hold the corridor's cells and its open ones.
+    List,
+    /// The path buffer cannot hold the new path (or its parent chain is broken).
+    Points,
+}
+
+impl fmt::Display for Short {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Self::Cells => "corridor: cell scratch shorter than the map",
+            Self::List => "corridor: list shorter than the corridor",
+            Self::Points => "corridor: path buffer shorter than the new path",
+        })
+    }
+}
 
 /// Replace `pts[..n]` (a valid path from its first to its last point) by the shortest path through
 /// the free cell centres within `radius` of its segments, if that is shorter; returns the new
 /// point count. `pts` beyond `n` is room for a new path of more points than the input (the
 /// planner's path buffer has the raw path's length); `cell` is scratch of one entry per map cell,
 /// `list` scratch for the corridor's cells and its open ones (at most twice the corridor's cells).
-/// Any of them too short leaves the path unchanged.
+/// Any of them too short leaves the path unchanged ([`try_shortest`] says which).
 pub fn shortest(
     grid: &Grid<'_>,
     pts: &mut [Point],
     n: usize,
     radius: u16,
-    cell: &mut [Entry],
+    cell: &mut [[f32; 4]],
     list: &mut [u32],
 ) -> usize {
+    try_shortest(grid, pts, n, radius, cell, list).unwrap_or(n.min(pts.len()))
+}
+
+/// [`shortest`], saying which buffer was too short when it leaves the path as it was. `Ok` with
+/// the input's count when the input is already the shortest (or no shorter path was found).
+pub fn try_shortest(
+    grid: &Grid<'_>,
+    pts: &mut [Point],
+    n: usize,
+    radius: u16,
+    cell: &mut [[f32; 4]],
+    list: &mut [u32],
+) -> Result<usize, Short> {
     let n = n.min(pts.len());
     let cells = grid.cells();
-    let (Some(path), Some(cell)) = (pts.get(..n), cell.get_mut(..cells)) else {
-        return n;
-    };
+    let cell: &mut [Entry] = bytemuck::try_cast_slice_mut(cell).map_err(|_| Short::Cells)?;
+    let cell = cell.get_mut(..cells).ok_or(Short::Cells)?;
+    let path = pts.get(..n).unwrap_or_default();
     let (Some(&start), Some(&goal)) = (path.first(), path.last()) else {
-        return n;
+        return Ok(n);
     };
     if n < 3 {
-        return n; // one segment: already the shortest
+        return Ok(n); // one segment: already the shortest
     }
     let bound = polyline_length(path);
-    cell.fill([f32::INFINITY, 0.0, 0.0, 0.0]);
-    let Some(v) = mark(grid, path, radius, cell, list) else {
-        return n;
-    };
+    cell.fill(Entry::EMPTY);
+    let v = mark(grid, path, radius, cell, list).ok_or(Short::List)?;
     // `list[..v]`: the corridor's cells; the rest holds the open ones (those with a finite `g`
     // that are not closed yet), so picking the next one scans only them.
     let (list, open) = list.split_at_mut(v.min(list.len()));
     for &c in list.iter() {
         let q = unpack(c);
         if let Some(e) = cell.get_mut(grid.index(q)) {
-            e[3] = distance(q, goal);
+            e.h = distance(q, goal);
         }
     }
     let (s, t) = (grid.index(start), grid.index(goal));
-    let Some(e) = cell.get_mut(s) else {
-        return n;
-    };
-    e[0] = 0.0;
-    let Some(slot) = open.first_mut() else {
-        return n;
-    };
+    cell.get_mut(s).ok_or(Short::Cells)?.g = 0.0;
+    let slot = open.first_mut().ok_or(Short::List)?;
     *slot = s as u32;
     let mut open_len = 1usize;
     // `list[..live]` holds the corridor's cells not closed yet, plus `closed` cells closed since
@@ -97,11 +173,12 @@ pub fn shortest(
     // of the entries are closed: each cell is moved O(1) times on average.
     let mut live = list.len();
     let mut closed = 0usize;
+    let mut shadows = Shadows::new();
     // A*: expand the open cell of least g + h (the first one on ties) until the goal closes.
     while open_len > 0 {
         let mut best: Option<(usize, f32)> = None;
         for (k, &c) in open.iter().enumerate().take(open_len) {
-            let f = cell.get(c as usize).map_or(f32::INFINITY, |e| e[0] + e[3]);
+            let f = cell.get(c as usize).map_or(f32::INFINITY, |e| e.g + e.h);
             if best.is_none_or(|(_, bf)| f < bf) {
                 best = Some((k, f));
             }
@@ -116,8 +193,8 @@ pub fn shortest(
             }
         }
         let Some(e) = cell.get_mut(i) else { break };
-        e[2] = f32::from_bits(e[2].to_bits() | CLOSED);
-        let gi = e[0];
+        e.flags |= CLOSED;
+        let gi = e.g;
         if i == t {
             break;
         }
@@ -126,9 +203,7 @@ pub fn shortest(
             let mut k = 0usize;
             for r in 0..live {
                 let Some(&c) = list.get(r) else { break };
-                let shut = cell
-                    .get(grid.index(unpack(c)))
-                    .is_none_or(|e| e[2].to_bits() & CLOSED != 0);
+                let shut = cell.get(grid.index(unpack(c))).is_none_or(Entry::closed);
                 if !shut {
                     if let Some(slot) = list.get_mut(k) {
                         *slot = c;
@@ -139,12 +214,12 @@ pub fn shortest(
             (live, closed) = (k, 0);
         }
         let p = grid.point(i);
-        let limit = cell.get(t).map_or(bound, |e| e[0].min(bound));
+        let limit = cell.get(t).map_or(bound, |e| e.g.min(bound));
         for &c in list.iter().take(live) {
             let q = unpack(c);
             let j = grid.index(q);
             let Some(e) = cell.get(j) else { continue };
-            if e[2].to_bits() & CLOSED != 0 {
+            if e.closed() {
                 continue;
             }
             // Lower bounds of the Euclidean distance (Chebyshev, and the octile diagonal's): most
@@ -154,44 +229,51 @@ pub fn shortest(
             let diag = (f32::from(dx) + f32::from(dy)) * core::f32::consts::FRAC_1_SQRT_2;
             // (Not `f32::max`: on the Cortex-M4F that is a call to `fmaxf`.)
             let low = gi + if cheb > diag { cheb } else { diag };
-            if low >= e[0] || low + e[3] >= limit {
+            if low >= e.g || low + e.h >= limit {
+                continue;
+            }
+            // Hidden by its own shade (below): no update whatever the length, so no square root.
+            if shadows.shaded(grid, p, q, e.shade) {
                 continue;
             }
             let nd = gi + distance(p, q);
-            if nd < e[0] && nd + e[3] < limit && segment_clear(grid, p, q) {
-                let first = e[0] == f32::INFINITY;
-                if let Some(e) = cell.get_mut(j) {
-                    e[0] = nd;
-                    e[1] = f32::from_bits(i as u32);
+            if nd >= e.g || nd + e.h >= limit {
+                continue;
+            }
+            // An improving edge: is it clear? If not, `q` remembers what hid it.
+            if let Err(shade) = shadows.clear(grid, p, q) {
+                if let (Some(shade), Some(e)) = (shade, cell.get_mut(j)) {
+                    e.shade = shade;
                 }
-                if first {
-                    // A cell opens once (closed cells are never relaxed), so the open list never
-                    // holds more than the corridor's cells; no room left: stop improving.
-                    let Some(slot) = open.get_mut(open_len) else {
-                        return n;
-                    };
-                    *slot = j as u32;
-                    open_len = open_len.wrapping_add(1);
-                }
+                continue;
+            }
+            let first = e.g == f32::INFINITY;
+            if let Some(e) = cell.get_mut(j) {
+                e.g = nd;
+                e.parent = i as u32;
+            }
+            if first {
+                // A cell opens once (closed cells are never relaxed), so the open list never
+                // holds more than the corridor's cells; no room left: stop improving.
+                let slot = open.get_mut(open_len).ok_or(Short::List)?;
+                *slot = j as u32;
+                open_len = open_len.wrapping_add(1);
             }
         }
     }
-    let Some(&[g, ..]) = cell.get(t) else {
-        return n;
-    };
+    let g = cell.get(t).ok_or(Short::Cells)?.g;
     let improves = g < bound - MIN_GAIN;
     if !improves {
-        return n;
+        return Ok(n);
     }
     // Count the new path's points, then write them back to front.
     let mut m = 1usize;
     let mut c = t;
     while c != s {
-        let Some(e) = cell.get(c) else { return n };
-        c = e[1].to_bits() as usize;
+        c = cell.get(c).ok_or(Short::Points)?.parent as usize;
         m = m.saturating_add(1);
         if m > pts.len() || m > cells {
-            return n; // longer than the buffer (or a broken chain): keep the input
+            return Err(Short::Points); // longer than the buffer (or a broken chain)
         }
     }
     let mut c = t;
@@ -199,9 +281,191 @@ pub fn shortest(
         if let Some(slot) = pts.get_mut(k) {
             *slot = grid.point(c);
         }
-        c = cell.get(c).map_or(s, |e| e[1].to_bits() as usize);
+        c = cell.get(c).map_or(s, |e| e.parent as usize);
     }
-    drop_collinear(pts, m)
+    Ok(drop_collinear(pts, m))
+}
+
+/// Blocked cells that recently stopped a segment: a candidate segment that touches one of their
+/// squares is blocked without walking it ([`segment_clear`] would say so too: it is false exactly
+/// when some blocked square is touched). Around an expanded cell the same few obstacle cells
+/// shadow most of the corridor's cells beyond them, so most failing tests stop here.
+struct Shadows {
+    /// Packed cells ([`pack`]), the most recently useful first.
+    cells: [u32; SHADOWS],
+    len: usize,
+}
+
+/// Blocked cells [`Shadows`] remembers (4, 8, 16, 32 measured on complex-26's device plan: 4.60,
+/// 4.68, 4.60, 4.58 M instructions; 4 takes the least stack).
+const SHADOWS: usize = 4;
+
+impl Shadows {
+    fn new() -> Self {
+        Self {
+            cells: [0; SHADOWS],
+            len: 0,
+        }
+    }
+
+    /// Whether `b`'s `shade` (its blocked cell last found, see [`Entry::shade`]) touches the
+    /// segment from `a`: then it is blocked.
+    fn shaded(&self, grid: &Grid<'_>, a: Point, b: Point, shade: [i8; 2]) -> bool {
+        if shade == [0, 0] || grid.width() > SHADOW_SIDE || grid.height() > SHADOW_SIDE {
+            return false;
+        }
+        let c = Point::new(
+            b.x.wrapping_add_signed(i16::from(shade[0])),
+            b.y.wrapping_add_signed(i16::from(shade[1])),
+        );
+        touches(a, b, c)
+    }
+
+    /// [`segment_clear`]`(grid, a, b)` as `Ok(())` (clear) or `Err` (blocked), with the
+    /// remembered blocked cells tried first. A segment found blocked by a walk
+    /// leaves its blocked cell nearest `a` remembered here, and returns `b`'s new shade (the
+    /// blocked cell nearest `b`, when within an `i8` offset).
+    fn clear(&mut self, grid: &Grid<'_>, a: Point, b: Point) -> Result<(), Option<[i8; 2]>> {
+        if grid.width() > SHADOW_SIDE || grid.height() > SHADOW_SIDE {
+            return if segment_clear(grid, a, b) {
+                Ok(())
+            } else {
+                Err(None)
+            };
+        }
+        let live = self.cells.get_mut(..self.len).unwrap_or_default();
+        for k in 0..live.len() {
+            let Some(&c) = live.get(k) else { break };
+            if touches(a, b, unpack(c)) {
+                // The most recent hit first: the next candidates lie beside this one.
+                move_to_front(live, k, c);
+                return Err(None);
+            }
+        }
+        if segment_clear(grid, a, b) {
+            return Ok(());
+        }
+        if let Some(c) = blocker(grid, a, b) {
+            self.len = self.len.saturating_add(1).min(SHADOWS);
+            let live = self.cells.get_mut(..self.len).unwrap_or_default();
+            move_to_front(live, live.len().saturating_sub(1), pack(c));
+        }
+        Err(blocker(grid, b, a).and_then(|c| {
+            let ox = i8::try_from(i32::from(c.x).wrapping_sub(i32::from(b.x))).ok()?;
+            let oy = i8::try_from(i32::from(c.y).wrapping_sub(i32::from(b.y))).ok()?;
+            Some([ox, oy])
+        }))
+    }
+}
+
+/// `list[k] = c`, moved to the front: `list[..k]` shifts up one.
+fn move_to_front(list: &mut [u32], k: usize, c: u32) {
+    let mut k = k;
+    while k > 0 {
+        let prev = k.wrapping_sub(1);
+        let p = list.get(prev).copied();
+        if let (Some(p), Some(slot)) = (p, list.get_mut(k)) {
+            *slot = p;
+        }
+        k = prev;
+    }
+    if let Some(first) = list.first_mut() {
+        *first = c;
+    }
+}
+
+/// Sides up to which [`touches`] and [`blocker`] compute in `i32`: doubled coordinates below
+/// 2^14, their products below 2^28 (the corridor's maps have at most
+/// [`crate::colony::pheromone::BLOCKS`] cells). On larger maps [`Shadows`] stays empty.
+const SHADOW_SIDE: u16 = 4096;
+
+/// Doubled coordinates of `p`'s centre (see [`touches`]); below 2^14 on maps of sides up to
+/// [`SHADOW_SIDE`].
+fn centre(p: Point) -> (i32, i32) {
+    (
+        i32::from(p.x).wrapping_mul(2).wrapping_add(1),
+        i32::from(p.y).wrapping_mul(2).wrapping_add(1),
+    )
+}
+
+/// Whether the segment between the centres of `a` and `b` touches the closed square of cell `c`
+/// (exact: integer arithmetic in doubled coordinates, where cell `c`'s square is
+/// `[2 c.x, 2 c.x + 2] x [2 c.y, 2 c.y + 2]` and a centre is `2 p + 1`). A segment and a square
+/// meet unless an axis separates them: x, y, or the segment's normal (all four corners strictly
+/// on one side of its line). For points on maps of sides up to [`SHADOW_SIDE`].
+fn touches(a: Point, b: Point, c: Point) -> bool {
+    let ((ax, ay), (bx, by)) = (centre(a), centre(b));
+    let (x0, y0) = (
+        i32::from(c.x).wrapping_mul(2),
+        i32::from(c.y).wrapping_mul(2),
+    );
+    let (x1, y1) = (x0.wrapping_add(2), y0.wrapping_add(2));
+    if (ax > x1 && bx > x1) || (ax < x0 && bx < x0) || (ay > y1 && by > y1) || (ay < y0 && by < y0)
+    {
+        return false;
+    }
+    let (dx, dy) = (bx.wrapping_sub(ax), by.wrapping_sub(ay));
+    // The cross product (b - a) x (corner - a) at the corner (x0, y0), then its least and
+    // greatest over the four corners (each coordinate of a corner is that one or 2 more).
+    let base = dx
+        .wrapping_mul(y0.wrapping_sub(ay))
+        .wrapping_sub(dy.wrapping_mul(x0.wrapping_sub(ax)));
+    let (ex, ey) = (dx.wrapping_mul(2), dy.wrapping_mul(-2));
+    let lo = base.wrapping_add(ex.min(0)).wrapping_add(ey.min(0));
+    let hi = base.wrapping_add(ex.max(0)).wrapping_add(ey.max(0));
+    lo <= 0 && hi >= 0
+}
+
+/// A blocked cell whose closed square the segment between the centres of `a` and `b` (both on
+/// the map) touches, the first found walking the rows from `a`'s towards `b`'s; `None` when the
+/// segment is clear (then [`segment_clear`] is true, and only then). For points on maps of sides
+/// up to [`SHADOW_SIDE`].
+fn blocker(grid: &Grid<'_>, a: Point, b: Point) -> Option<Point> {
+    // Doubled coordinates (see `touches`): the touched cells of row `r` lie in the x range the
+    // segment covers within the row's closed band `[2 r, 2 r + 2]`, as fractions over |dy|.
+    let ((ax, ay), (bx, by)) = (centre(a), centre(b));
+    let (dx, dy) = (bx.wrapping_sub(ax), by.wrapping_sub(ay));
+    let (x_lo, x_hi) = (i32::from(a.x.min(b.x)), i32::from(a.x.max(b.x)));
+    let (y_min, y_max) = (ay.min(by), ay.max(by));
+    let (den, sign) = (dy.wrapping_abs().wrapping_mul(2), dy.signum());
+    // x(y) dy = ax dy + (y - ay) dx; times sign(dy), over |dy|.
+    let num = |y: i32| {
+        ax.wrapping_mul(dy)
+            .wrapping_add(y.wrapping_sub(ay).wrapping_mul(dx))
+            .wrapping_mul(sign)
+    };
+    let mut r = i32::from(a.y);
+    loop {
+        let (lo, hi) = if dy == 0 {
+            (x_lo, x_hi)
+        } else {
+            let band = r.wrapping_mul(2);
+            let (y0, y1) = (band.max(y_min), band.wrapping_add(2).min(y_max));
+            let (n0, n1) = (num(y0), num(y1));
+            // Cells cx with 2 cx <= x_max and 2 cx + 2 >= x_min: from ceil(x_min / 2) - 1 to
+            // floor(x_max / 2) (den = 2 |dy| > 0).
+            let lo = n0
+                .min(n1)
+                .wrapping_neg()
+                .checked_div_euclid(den)
+                .unwrap_or(0)
+                .wrapping_neg()
+                .wrapping_sub(1);
+            let hi = n0.max(n1).checked_div_euclid(den).unwrap_or(0);
+            (lo.max(x_lo), hi.min(x_hi))
+        };
+        for x in lo..=hi {
+            // Within a's and b's box: on the map, below 2^16.
+            let q = Point::new(x as u16, r as u16);
+            if !grid.is_free(q) && touches(a, b, q) {
+                return Some(q);
+            }
+        }
+        if r == i32::from(b.y) {
+            return None;
+        }
+        r = r.wrapping_add(if dy > 0 { 1 } else { -1 });
+    }
 }
 
 /// A cell as one word in the corridor's list (`x` high, `y` low): no division to get it back.
@@ -254,10 +518,10 @@ fn mark(
                     }
                     let c = grid.index(q);
                     let Some(e) = cell.get_mut(c) else { continue };
-                    if e[2].to_bits() & CANDIDATE != 0 {
+                    if e.flags & CANDIDATE != 0 {
                         continue;
                     }
-                    e[2] = f32::from_bits(CANDIDATE);
+                    e.flags = CANDIDATE;
                     *list.get_mut(v)? = pack(q);
                     v = v.wrapping_add(1); // < list.len(): the slot existed
                 }
@@ -326,6 +590,49 @@ mod tests {
         assert!((after - (5.0 + 17f32.sqrt())).abs() < 1e-5);
     }
 
+    /// The shadows' geometry is [`segment_clear`]'s rule exactly, on every pair of cells of
+    /// random maps (corners grazed, segments along a row or a column, both directions): a
+    /// blocked cell whose square [`touches`] a segment makes it blocked, and [`blocker`] finds
+    /// one (touching, blocked) exactly when the segment is not clear. A remembered cell that
+    /// hid a clear segment would change paths: this test fails first.
+    #[test]
+    fn shadows_agree_with_segment_clear_on_every_pair() {
+        let mut rng = crate::rng::Xoshiro128pp::from_u64(7);
+        let mut blocked_pairs = 0usize;
+        for (w, h, density) in [
+            (9u16, 7u16, 0.2f32),
+            (12, 10, 0.3),
+            (6, 11, 0.15),
+            (10, 10, 0.4),
+        ] {
+            let b = crate::testutil::random_bits(&mut rng, w, h, density);
+            let g = Grid::new(w, h, &b).unwrap();
+            let all: Vec<Point> = (0..g.cells()).map(|i| g.point(i)).collect();
+            let walls: Vec<Point> = all.iter().copied().filter(|&c| !g.is_free(c)).collect();
+            for &a in &all {
+                for &z in &all {
+                    let clear = segment_clear(&g, a, z);
+                    if !g.is_free(a) || !g.is_free(z) {
+                        continue;
+                    }
+                    let touched = walls.iter().any(|&c| touches(a, z, c));
+                    assert_eq!(touched, !clear, "{a:?} -> {z:?}");
+                    match blocker(&g, a, z) {
+                        Some(c) => {
+                            assert!(
+                                !clear && !g.is_free(c) && touches(a, z, c),
+                                "{a:?} -> {z:?}"
+                            );
+                            blocked_pairs += 1;
+                        }
+                        None => assert!(clear, "{a:?} -> {z:?}: no blocker found"),
+                    }
+                }
+            }
+        }
+        assert!(blocked_pairs > 1000, "{blocked_pairs}");
+    }
+
     #[test]
     fn a_straight_path_and_a_single_segment_stay_as_they_are() {
         let rows = [".....", ".....", "....."];
@@ -343,11 +650,17 @@ mod tests {
         let (b, w, h) = bits(&rows);
         let g = Grid::new(w, h, &b).unwrap();
         let input = [Point::new(0, 0), Point::new(2, 2), Point::new(4, 0)];
-        for (cells, list) in [(g.cells() - 1, g.cells()), (g.cells(), 3)] {
+        for (cells, list, why) in [
+            (g.cells() - 1, g.cells(), Short::Cells),
+            (g.cells(), 3, Short::List),
+        ] {
             let mut pts = input.to_vec();
             let mut cell = vec![[0.0f32; 4]; cells];
             let mut l = vec![0u32; list];
             assert_eq!(shortest(&g, &mut pts, 3, RADIUS, &mut cell, &mut l), 3);
+            assert_eq!(pts, input);
+            let r = try_shortest(&g, &mut pts, 3, RADIUS, &mut cell, &mut l);
+            assert_eq!(r, Err(why), "{why}");
             assert_eq!(pts, input);
         }
     }
