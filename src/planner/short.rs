@@ -26,12 +26,15 @@ impl Shortfalls {
     pub const REFINE: Self = Self(1 << 2);
     /// Too few links for the shortest-path smoothing: the greedy rule smoothed the path.
     pub const SMOOTHING: Self = Self(1 << 3);
+    /// Too little scratch for the small maps' exact corridor search: the smoothed path stands.
+    pub const CORRIDOR: Self = Self(1 << 4);
 
-    const NAMES: [(Self, &'static str); 4] = [
+    const NAMES: [(Self, &'static str); 5] = [
         (Self::ROUTE, "route"),
         (Self::STASH, "stash"),
         (Self::REFINE, "refine"),
         (Self::SMOOTHING, "smoothing"),
+        (Self::CORRIDOR, "corridor"),
     ];
 
     /// Whether no step ran short.
@@ -49,7 +52,8 @@ impl Shortfalls {
         self.0 |= other.0;
     }
 
-    /// The set as a byte (bit 0 the route, 1 the stash, 2 the local search, 3 the smoothing).
+    /// The set as a byte (bit 0 the route, 1 the stash, 2 the local search, 3 the smoothing, 4
+    /// the corridor search).
     pub const fn bits(self) -> u8 {
         self.0
     }

@@ -1042,6 +1042,12 @@ fn a_short_workspace_says_which_steps_ran_short() {
         "{}",
         a.shortfalls
     );
+    // Its corridor search (a small map) has no room for its lists either.
+    assert!(
+        a.shortfalls.contains(Shortfalls::CORRIDOR),
+        "{}",
+        a.shortfalls
+    );
     let mut full: Storage<5, 160, 160, 0> = Storage::new();
     let b2 = plan(&g, start, goal, &p, full.workspace()).unwrap();
     assert!(b2.shortfalls.is_empty(), "{}", b2.shortfalls);

@@ -220,7 +220,7 @@ impl Run<'_, '_> {
                     None => Phase::Polish(Polish::Tail(sm)),
                     Some(k) => {
                         let waypoints = if corridor {
-                            crate::polish::corridor::shortest(
+                            crate::polish::corridor::try_shortest(
                                 grid,
                                 ws.points,
                                 k,
@@ -228,6 +228,11 @@ impl Run<'_, '_> {
                                 ws.delta,
                                 ws.idle.links(),
                             )
+                            .unwrap_or_else(|_| {
+                                // The smoothed path stays as it is.
+                                self.short.insert(Shortfalls::CORRIDOR);
+                                k.min(ws.points.len())
+                            })
                         } else {
                             k
                         };
