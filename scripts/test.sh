@@ -10,8 +10,8 @@ source scripts/setup.sh
 # Cargo builds one thing at a time in a target directory, so the two builds that have their own
 # run in the background while the rest builds in target/ (on a fresh clone that saves a minute or
 # two of the first run): the STM32H743's QEMU capacity twin (the H743's capacity and RAM regions
-# on the same QEMU board) that host/tests/qemu_twin.rs boots, and defmt-print, if missing, which
-# golden-boot.sh decodes the boot log with and host/tests/qemu_responsive.rs the firmware's
+# on the same QEMU board) that host/tests/qemu/twin_maps.rs boots, and defmt-print, if missing, which
+# golden-boot.sh decodes the boot log with and host/tests/qemu/responsive.rs the firmware's
 # latency log (scripts/install-defmt-print.sh). Their output goes to
 # a log that is shown if they fail.
 logs=$(mktemp -d)
@@ -47,8 +47,8 @@ cargo test -p ohaca --target host-tuple
 cargo build --release
 join twin-h743 "$twin_pid"
 twin_pid=""
-# defmt-print decodes the firmware's log for host/tests/qemu_responsive.rs (request and reply
-# ticks) and qemu_pieces.rs (the largest piece of a plan, counted under -icount), and for
+# defmt-print decodes the firmware's log for host/tests/qemu/responsive.rs (request and reply
+# ticks) and qemu/pieces.rs (the largest piece of a plan, counted under -icount), and for
 # golden-boot.sh below.
 if [ -n "$defmt_pid" ]; then
   join defmt-print "$defmt_pid"
