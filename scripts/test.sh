@@ -57,8 +57,11 @@ fi
 # Host tool (incl. QEMU end-to-end tests, the twin's on 1024 x 1024 and 2048 x 1024 maps),
 # references, properties, shared maps. Profile `host` (Cargo.toml): optimised, since the
 # shared-map checks plan thousands of times, without the firmware's fat LTO. It also builds the
-# `ohaca` tool the tests run, target/<host>/host/ohaca, which ros-test.sh below reuses.
-cargo test --profile host -p ohaca-host -p ohaca-host-tests --target host-tuple
+# `ohaca` tool the tests run, target/<host>/host/ohaca, which ros-test.sh below reuses. The
+# libraries, the tool and the three test binaries (host/tests/qemu/, host/tests/tool/,
+# host-tests/tests/it/) only: not the 12 examples, which plain `cargo test` would also build and
+# link, optimised (CI's `cargo clippy --all-targets` compiles them; the crates have no doc tests).
+cargo test --profile host -p ohaca-host -p ohaca-host-tests --target host-tuple --lib --bins --tests
 # The firmware's boot log against tests/golden/boot.txt, and the protocol selftest over QEMU.
 scripts/golden-boot.sh --no-build
 scripts/qemu-selftest.sh --no-build
