@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Long soak of the firmware's link under QEMU, in two phases:
-#  1. the QEMU firmware (F411 capacity): build it, then run host/tests/qemu_soak.rs's
+#  1. the QEMU firmware (F411 capacity): build it, then run host/tests/qemu/soak.rs's
 #     soak_thousands_of_valid_and_broken_frames with FRAMES frames (default 100000; the test's own
 #     default is 10000) and print its summary (frames sent per kind, replies, errors, the device's
 #     counters, wall time, then the burst beyond the window). The soak keeps within the device's
@@ -10,7 +10,7 @@
 #     the pacing relay (ohaca_host::link::relay: a real 8N1 line at BAUD) and also prints the
 #     relay's counters; see BENCHMARKS.md section 8 for wall times.
 #  2. faults at scale, on the STM32H743's capacity twin (`--features twin-h743`) and on the F411
-#     build (which holds these maps in its arena): host/tests/qemu_soak_twin.rs with ROUNDS rounds (default 10; the
+#     build (which holds these maps in its arena): host/tests/qemu/soak_twin.rs with ROUNDS rounds (default 10; the
 #     test's own default is 1), each uploading a 512 x 512 and a 604 x 307 map raw and run-length
 #     coded with injected byte drops and corruption, broken uploads redone, plans checked against
 #     the host core. About 25 s a round on each firmware, the two in parallel. ROUNDS = 0 skips it.
@@ -35,11 +35,11 @@ target="$(realpath -m "${CARGO_TARGET_DIR:-target}")"  # absolute: the tests run
 cargo build --release
 if [ -n "$baud" ]; then export OHACA_SOAK_BAUD="$baud"; else unset OHACA_SOAK_BAUD; fi
 OHACA_FIRMWARE="$target/thumbv7em-none-eabihf/release/ohaca" OHACA_SOAK_FRAMES="$frames" \
-  cargo test --profile host -p ohaca-host --target x86_64-unknown-linux-gnu --test qemu_soak \
-  -- --nocapture --exact soak_thousands_of_valid_and_broken_frames
+  cargo test --profile host -p ohaca-host --target x86_64-unknown-linux-gnu --test qemu \
+  -- --nocapture --exact soak::soak_thousands_of_valid_and_broken_frames
 if [ "$rounds" -gt 0 ]; then
   cargo build --release --features twin-h743 --target-dir "$target/twin-h743"
   OHACA_TWIN_FIRMWARE="$target/twin-h743/thumbv7em-none-eabihf/release/ohaca" \
     OHACA_SOAK_SCALE_ROUNDS="$rounds" \
-    cargo test --profile host -p ohaca-host --target x86_64-unknown-linux-gnu --test qemu_soak_twin -- --nocapture
+    cargo test --profile host -p ohaca-host --target x86_64-unknown-linux-gnu --test qemu -- soak_twin:: --nocapture
 fi

@@ -10,8 +10,8 @@ source scripts/setup.sh
 # Cargo builds one thing at a time in a target directory, so the two builds that have their own
 # run in the background while the rest builds in target/ (on a fresh clone that saves a minute or
 # two of the first run): the STM32H743's QEMU capacity twin (the H743's capacity and RAM regions
-# on the same QEMU board) that host/tests/qemu_twin.rs boots, and defmt-print, if missing, which
-# golden-boot.sh decodes the boot log with and host/tests/qemu_responsive.rs the firmware's
+# on the same QEMU board) that host/tests/qemu/twin_maps.rs boots, and defmt-print, if missing, which
+# golden-boot.sh decodes the boot log with and host/tests/qemu/responsive.rs the firmware's
 # latency log (scripts/install-defmt-print.sh). Their output goes to
 # a log that is shown if they fail.
 logs=$(mktemp -d)
@@ -47,8 +47,8 @@ cargo test -p ohaca --target host-tuple
 cargo build --release
 join twin-h743 "$twin_pid"
 twin_pid=""
-# defmt-print decodes the firmware's log for host/tests/qemu_responsive.rs (request and reply
-# ticks) and qemu_pieces.rs (the largest piece of a plan, counted under -icount), and for
+# defmt-print decodes the firmware's log for host/tests/qemu/responsive.rs (request and reply
+# ticks) and qemu/pieces.rs (the largest piece of a plan, counted under -icount), and for
 # golden-boot.sh below.
 if [ -n "$defmt_pid" ]; then
   join defmt-print "$defmt_pid"
@@ -57,8 +57,11 @@ fi
 # Host tool (incl. QEMU end-to-end tests, the twin's on 1024 x 1024 and 2048 x 1024 maps),
 # references, properties, shared maps. Profile `host` (Cargo.toml): optimised, since the
 # shared-map checks plan thousands of times, without the firmware's fat LTO. It also builds the
-# `ohaca` tool the tests run, target/<host>/host/ohaca, which ros-test.sh below reuses.
-cargo test --profile host -p ohaca-host -p ohaca-host-tests --target host-tuple
+# `ohaca` tool the tests run, target/<host>/host/ohaca, which ros-test.sh below reuses. The
+# libraries, the tool and the three test binaries (host/tests/qemu/, host/tests/tool/,
+# host-tests/tests/it/) only: not the 12 examples, which plain `cargo test` would also build and
+# link, optimised (CI's `cargo clippy --all-targets` compiles them; the crates have no doc tests).
+cargo test --profile host -p ohaca-host -p ohaca-host-tests --target host-tuple --lib --bins --tests
 # The firmware's boot log against tests/golden/boot.txt, and the protocol selftest over QEMU.
 scripts/golden-boot.sh --no-build
 scripts/qemu-selftest.sh --no-build

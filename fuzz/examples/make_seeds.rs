@@ -307,7 +307,7 @@ fn wire_frame_seeds(root: &Path) -> Result<Vec<(String, Vec<u8>)>> {
     };
     out.push(("rep-path-max".into(), rep(14, &Reply::Path(max_path))));
     // The twin's longest path as it plans it: MAX_STEPS steps through sixteen corridors, 32
-    // waypoints (`host/tests/qemu_twin.rs`, the serpentine), about 16.5 KB.
+    // waypoints (`host/tests/qemu/twin_maps.rs`, the serpentine), about 16.5 KB.
     let corners: Vec<Point> = (0..32u16)
         .map(|i| Point::new(if (i + 1) % 4 < 2 { 1 } else { 1024 }, 1 + 2 * (i / 2)))
         .collect();

@@ -12,7 +12,7 @@
 //!
 //! [`maze`] and [`far_pair`] make fresh wide-corridor mazes (Moving AI's `maze-*-*-W` style, any
 //! corridor width) and a far start/goal pair in them, deterministically from a seed: the
-//! `mazes` example and `tests/mazes.rs` plan on them.
+//! `mazes` example and `tests/it/mazes.rs` plan on them.
 
 use ohaca::Point;
 use proptest::collection::vec;

@@ -2,7 +2,7 @@
 //! result with [`crate::check`], and compare its lengths with the exact optima of
 //! [`crate::reference`] (computed once per scenario by [`prepare`]).
 //!
-//! Used by `tests/shared_maps.rs` and by the `quality` and `paper_table` examples. Runs are spread
+//! Used by `tests/it/shared_maps.rs` and by the `quality` and `paper_table` examples. Runs are spread
 //! over the machine's cores, but every aggregate is summed in a fixed order, so the numbers do not
 //! depend on scheduling. Wall-clock times are recorded for the examples only; no test looks at them.
 

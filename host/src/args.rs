@@ -34,6 +34,34 @@ pub enum PointError {
     },
 }
 
+/// A malformed flag value other than a point ([`PointError`]).
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum ValueError {
+    /// Not a name of the planner enum (serde's words: the name given and the names expected).
+    #[error("{0}")]
+    Name(String),
+    /// Not a boolean.
+    #[error("expected true or false, found `{0}`")]
+    Bool(String),
+    /// Not a preset's name.
+    #[error("unknown preset `{0}`; expected default or paper")]
+    Preset(String),
+    /// Not two comma-separated parts (`X,Y` in metres).
+    #[error("expected X,Y in metres (two numbers separated by a comma), found `{0}`")]
+    Metres(String),
+    /// A coordinate in metres is not a finite number.
+    #[error("{axis} `{value}` is not a number")]
+    NotANumber {
+        /// `x` or `y`.
+        axis: char,
+        /// The text given.
+        value: String,
+    },
+    /// Not a length: a finite number >= 0.
+    #[error("expected a length >= 0, found `{0}`")]
+    Length(String),
+}
+
 /// Parse `"X,Y"` (column, row from the top; spaces around either number are allowed).
 pub fn parse_point(s: &str) -> Result<Point, PointError> {
     let mut parts = s.split(',');
@@ -58,18 +86,19 @@ pub fn parse_point(s: &str) -> Result<Point, PointError> {
 
 /// Parse a planner enum ([`Algorithm`], [`DeadEnd`], [`SmoothingKind`]) by its lower-case name,
 /// in any case: the names of the core's serde derive, which the JSON report prints too.
-pub fn parse_name<T: serde::de::DeserializeOwned>(s: &str) -> Result<T, String> {
+pub fn parse_name<T: serde::de::DeserializeOwned>(s: &str) -> Result<T, ValueError> {
     use serde::de::value::{Error, StrDeserializer};
     let lower = s.trim().to_ascii_lowercase();
-    T::deserialize(StrDeserializer::<Error>::new(&lower)).map_err(|e| e.to_string())
+    T::deserialize(StrDeserializer::<Error>::new(&lower))
+        .map_err(|e| ValueError::Name(e.to_string()))
 }
 
 /// Parse a boolean flag value (`true`/`false`, `on`/`off`, `yes`/`no`, `1`/`0`).
-pub fn parse_bool(s: &str) -> Result<bool, String> {
+pub fn parse_bool(s: &str) -> Result<bool, ValueError> {
     match s.trim().to_ascii_lowercase().as_str() {
         "true" | "on" | "yes" | "1" => Ok(true),
         "false" | "off" | "no" | "0" => Ok(false),
-        _ => Err(format!("expected true or false, found `{s}`")),
+        _ => Err(ValueError::Bool(s.to_string())),
     }
 }
 
@@ -118,11 +147,11 @@ fn preset_help(what: &str, value: impl Fn(&Params) -> String) -> String {
 }
 
 /// Parse a preset name (`default` or `paper`; any case).
-pub fn parse_preset(s: &str) -> Result<Preset, String> {
+pub fn parse_preset(s: &str) -> Result<Preset, ValueError> {
     Preset::ALL
         .into_iter()
         .find(|p| p.name().eq_ignore_ascii_case(s.trim()))
-        .ok_or_else(|| format!("unknown preset `{s}`; expected default or paper"))
+        .ok_or_else(|| ValueError::Preset(s.to_string()))
 }
 
 /// Every planner parameter as a command-line flag. Flatten it into a subcommand's arguments
@@ -441,6 +470,7 @@ mod tests {
         }
         assert!(parse_name::<Algorithm>("bee")
             .unwrap_err()
+            .to_string()
             .contains("`ohaca`"));
     }
 

@@ -17,7 +17,7 @@
 //! narrower in order, so shared segments show every colour. Start: green disc `S`; goal: black
 //! disc `G`. A legend on the right gives each algorithm's numbers.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::Once;
 
 use ohaca::{Algorithm, Point};
@@ -103,17 +103,17 @@ pub trait Picture {
     /// Width and height in pixels.
     fn size(&self) -> (u32, u32);
     /// Draw on `area` (of [`Picture::size`]).
-    fn draw<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>) -> Result<(), String>;
+    fn draw<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>) -> Result<(), DrawError>;
 }
 
 /// The picture as an SVG document, with the font embedded (see [`embed_font`]).
-pub fn to_svg<P: Picture>(p: &P) -> Result<String, String> {
+pub fn to_svg<P: Picture>(p: &P) -> Result<String, DrawError> {
     register_font();
     let mut s = String::new();
     {
         let root = SVGBackend::with_string(&mut s, p.size()).into_drawing_area();
         p.draw(&root)?;
-        root.present().map_err(|e| e.to_string())?;
+        root.present().map_err(err)?;
     }
     Ok(embed_font(&s))
 }
@@ -164,36 +164,38 @@ pub fn text_width(text: &str, size: f64) -> u32 {
 }
 
 /// The picture as RGB pixels, row-major, 3 bytes a pixel.
-pub fn to_rgb<P: Picture>(p: &P) -> Result<Vec<u8>, String> {
+pub fn to_rgb<P: Picture>(p: &P) -> Result<Vec<u8>, DrawError> {
     register_font();
     let (w, h) = p.size();
     let bytes = u64::from(w) * u64::from(h) * 3;
     // 1 GiB of pixels (a 18000 x 18000 picture) is plenty; beyond that, say so instead of
     // exhausting the memory. SVG has no such limit.
+    let too_large = DrawError::TooLarge {
+        width: w,
+        height: h,
+    };
     if bytes > 1 << 30 {
-        return Err(format!(
-            "{w}x{h} pixels is too large for a PNG; write an SVG"
-        ));
+        return Err(too_large);
     }
-    let len = usize::try_from(bytes).map_err(|e| e.to_string())?;
+    let len = usize::try_from(bytes).map_err(|_| too_large)?;
     let mut buf = vec![255u8; len];
     {
         let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
         p.draw(&root)?;
-        root.present().map_err(|e| e.to_string())?;
+        root.present().map_err(err)?;
     }
     Ok(buf)
 }
 
 /// The picture as a PNG file's bytes.
-pub fn to_png<P: Picture>(p: &P) -> Result<Vec<u8>, String> {
+pub fn to_png<P: Picture>(p: &P) -> Result<Vec<u8>, DrawError> {
     use image::ImageEncoder;
     let (w, h) = p.size();
     let rgb = to_rgb(p)?;
     let mut out = Vec::new();
     image::codecs::png::PngEncoder::new(&mut out)
         .write_image(&rgb, w, h, image::ExtendedColorType::Rgb8)
-        .map_err(|e| format!("cannot encode the PNG: {e}"))?;
+        .map_err(DrawError::Png)?;
     Ok(out)
 }
 
@@ -219,23 +221,63 @@ impl Format {
 }
 
 /// Draw `p` into `path` (`.svg` or `.png`). The error is one line naming the file.
-pub fn save<P: Picture>(p: &P, path: &Path) -> Result<(), String> {
-    let name = path.display();
+pub fn save<P: Picture>(p: &P, path: &Path) -> Result<(), DrawError> {
     let bytes = match Format::of(path) {
         Some(Format::Svg) => to_svg(p).map(String::into_bytes),
         Some(Format::Png) => to_png(p),
-        None => {
-            return Err(format!(
-                "{name}: the picture's name must end in .svg or .png"
-            ))
-        }
+        None => return Err(DrawError::Extension(path.to_path_buf())),
     }
-    .map_err(|e| format!("{name}: cannot draw the picture: {e}"))?;
-    std::fs::write(path, bytes).map_err(|e| format!("{name}: cannot write the file: {e}"))
+    .map_err(|e| DrawError::Draw {
+        path: path.to_path_buf(),
+        error: Box::new(e),
+    })?;
+    std::fs::write(path, bytes).map_err(|error| DrawError::Write {
+        path: path.to_path_buf(),
+        error,
+    })
 }
 
-fn err<E: std::fmt::Display>(e: E) -> String {
-    e.to_string()
+/// Why a picture cannot be drawn or saved.
+#[derive(Debug, thiserror::Error)]
+pub enum DrawError {
+    /// The plotting library failed (its own words: its error type depends on the backend).
+    #[error("{0}")]
+    Plot(String),
+    /// Too many pixels for a PNG.
+    #[error("{width}x{height} pixels is too large for a PNG; write an SVG")]
+    TooLarge {
+        /// Pixels across.
+        width: u32,
+        /// Pixels down.
+        height: u32,
+    },
+    /// The PNG encoder failed.
+    #[error("cannot encode the PNG: {0}")]
+    Png(image::ImageError),
+    /// The file name asks for no format.
+    #[error("{}: the picture's name must end in .svg or .png", .0.display())]
+    Extension(PathBuf),
+    /// Drawing the picture for a file failed.
+    #[error("{}: cannot draw the picture: {error}", .path.display())]
+    Draw {
+        /// The file.
+        path: PathBuf,
+        /// What failed.
+        error: Box<DrawError>,
+    },
+    /// The file cannot be written.
+    #[error("{}: cannot write the file: {error}", .path.display())]
+    Write {
+        /// The file.
+        path: PathBuf,
+        /// The system's error.
+        error: std::io::Error,
+    },
+}
+
+/// A plotters error (whatever its backend) as a [`DrawError`].
+fn err<E: std::fmt::Display>(e: E) -> DrawError {
+    DrawError::Plot(e.to_string())
 }
 
 fn font(size: f64, colour: RGBColor) -> TextStyle<'static> {
@@ -456,7 +498,7 @@ impl Scene {
         &self,
         a: &DrawingArea<DB, Shift>,
         l: &Layout,
-    ) -> Result<(), String> {
+    ) -> Result<(), DrawError> {
         let (w, h) = (self.map.width, self.map.height);
         let c = l.cell as i32;
         let (x0, y0) = l.corner(0, 0);
@@ -567,7 +609,7 @@ impl Scene {
         &self,
         a: &DrawingArea<DB, Shift>,
         l: &Layout,
-    ) -> Result<(), String> {
+    ) -> Result<(), DrawError> {
         let n = self.layers.len();
         let centres = |pts: &[[u16; 2]]| -> Vec<(i32, i32)> {
             pts.iter().map(|&[x, y]| l.centre(x, y)).collect()
@@ -619,7 +661,7 @@ impl Scene {
         &self,
         a: &DrawingArea<DB, Shift>,
         l: &Layout,
-    ) -> Result<(), String> {
+    ) -> Result<(), DrawError> {
         let x = l.legend_x as i32;
         let mut y = (l.map_y + LEGEND_LINE / 2) as i32;
         let line = LEGEND_LINE as i32;
@@ -742,7 +784,7 @@ impl Picture for Scene {
         (l.width, l.height)
     }
 
-    fn draw<DB: DrawingBackend>(&self, a: &DrawingArea<DB, Shift>) -> Result<(), String> {
+    fn draw<DB: DrawingBackend>(&self, a: &DrawingArea<DB, Shift>) -> Result<(), DrawError> {
         let l = self.layout();
         a.fill(&FREE).map_err(err)?;
         a.draw(&Text::new(
@@ -789,7 +831,7 @@ impl Picture for Convergence {
         (960.max(text_width(&self.title, 20.0) + 2 * 18 + 8), 600)
     }
 
-    fn draw<DB: DrawingBackend>(&self, a: &DrawingArea<DB, Shift>) -> Result<(), String> {
+    fn draw<DB: DrawingBackend>(&self, a: &DrawingArea<DB, Shift>) -> Result<(), DrawError> {
         a.fill(&FREE).map_err(err)?;
         let finite = || {
             self.series

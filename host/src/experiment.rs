@@ -25,7 +25,7 @@
 //!   curve never rises.
 
 use std::fmt::Write as _;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use ohaca::{Algorithm, Params};
 use rayon::prelude::*;
@@ -469,13 +469,14 @@ impl Outcome {
     /// Write every output file into `dir` (created if missing): `results.csv`, `summary.md`,
     /// `convergence.csv`, `convergence.svg`, `convergence.png`, and `path-<algorithm>.svg` /
     /// `.png` for each algorithm. The error is one line naming the file.
-    pub fn write(&self, dir: &Path) -> Result<(), String> {
-        std::fs::create_dir_all(dir)
-            .map_err(|e| format!("{}: cannot create the folder: {e}", dir.display()))?;
-        let text = |name: &str, body: String| -> Result<(), String> {
-            let p = dir.join(name);
-            std::fs::write(&p, body)
-                .map_err(|e| format!("{}: cannot write the file: {e}", p.display()))
+    pub fn write(&self, dir: &Path) -> Result<(), WriteError> {
+        std::fs::create_dir_all(dir).map_err(|error| WriteError::Folder {
+            path: dir.to_path_buf(),
+            error,
+        })?;
+        let text = |name: &str, body: String| -> Result<(), WriteError> {
+            let path = dir.join(name);
+            std::fs::write(&path, body).map_err(|error| WriteError::File { path, error })
         };
         text("results.csv", self.results_csv())?;
         text("summary.md", self.summary_md())?;
@@ -490,6 +491,30 @@ impl Outcome {
         }
         Ok(())
     }
+}
+
+/// Why [`Experiment::write`] failed: one line naming the file.
+#[derive(Debug, thiserror::Error)]
+pub enum WriteError {
+    /// The output folder cannot be created.
+    #[error("{}: cannot create the folder: {error}", .path.display())]
+    Folder {
+        /// The folder.
+        path: PathBuf,
+        /// The system's error.
+        error: std::io::Error,
+    },
+    /// A text file cannot be written.
+    #[error("{}: cannot write the file: {error}", .path.display())]
+    File {
+        /// The file.
+        path: PathBuf,
+        /// The system's error.
+        error: std::io::Error,
+    },
+    /// A picture cannot be drawn or written.
+    #[error(transparent)]
+    Picture(#[from] draw::DrawError),
 }
 
 /// The parameters that matter most, as a short line for picture subtitles.

@@ -10,34 +10,35 @@ use clap::parser::ValueSource;
 use clap::{ArgAction, ArgMatches, Args, Command, FromArgMatches};
 use ohaca::{Algorithm, Point};
 
-use crate::args::{parse_point, ParamArgs};
+use crate::args::{parse_point, ParamArgs, ValueError};
 use crate::map::{prepare, Map, MapError, MapFrame, Unknown};
 
 /// Parse `"X,Y"` in metres (any finite numbers, e.g. `-1.5,2`).
-pub fn parse_metres(s: &str) -> Result<[f64; 2], String> {
+pub fn parse_metres(s: &str) -> Result<[f64; 2], ValueError> {
     let mut parts = s.split(',');
     let (Some(x), Some(y), None) = (parts.next(), parts.next(), parts.next()) else {
-        return Err(format!(
-            "expected X,Y in metres (two numbers separated by a comma), found `{s}`"
-        ));
+        return Err(ValueError::Metres(s.to_string()));
     };
-    let num = |axis: char, v: &str| -> Result<f64, String> {
+    let num = |axis: char, v: &str| -> Result<f64, ValueError> {
         v.trim()
             .parse::<f64>()
             .ok()
             .filter(|v| v.is_finite())
-            .ok_or_else(|| format!("{axis} `{}` is not a number", v.trim()))
+            .ok_or_else(|| ValueError::NotANumber {
+                axis,
+                value: v.trim().to_string(),
+            })
     };
     Ok([num('x', x)?, num('y', y)?])
 }
 
 /// Parse a length in metres: a finite number >= 0.
-pub fn parse_length(s: &str) -> Result<f64, String> {
+pub fn parse_length(s: &str) -> Result<f64, ValueError> {
     s.trim()
         .parse::<f64>()
         .ok()
         .filter(|v| v.is_finite() && *v >= 0.0)
-        .ok_or_else(|| format!("expected a length >= 0, found `{s}`"))
+        .ok_or_else(|| ValueError::Length(s.to_string()))
 }
 
 /// The map and the start and goal, as command-line flags. Flatten it into a subcommand

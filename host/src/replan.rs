@@ -35,7 +35,7 @@ use ohaca::planner::session;
 use ohaca::planner::{Fallback, Memory, Origin, Poll};
 use ohaca::{Grid, Params, Point};
 
-use crate::board::BoardStorage;
+use crate::board::{BoardError, BoardStorage};
 use crate::link::{DevicePath, Link, LinkError, Transport};
 use crate::map::Map;
 
@@ -111,13 +111,131 @@ pub struct BoxAway {
     pub distance: u16,
 }
 
+/// Why a scenario cannot be read or driven.
+#[derive(Debug, thiserror::Error)]
+pub enum ReplanError {
+    /// The scenario file is not the JSON described above.
+    #[error("{0}")]
+    Json(#[from] serde_json::Error),
+    /// An event's `at` is not a fraction.
+    #[error("event {event}: `at` must be in 0..=1, not {at}")]
+    At {
+        /// The event's index.
+        event: usize,
+        /// Its `at`.
+        at: f64,
+    },
+    /// A change names none or several of its kinds.
+    #[error("each change needs exactly one of rect, cells, wall_ahead, box_away, undo")]
+    OneKind,
+    /// A cell of a change is outside the map.
+    #[error("cell ({x}, {y}) is outside the map")]
+    Outside {
+        /// Column.
+        x: i64,
+        /// Row.
+        y: i64,
+    },
+    /// A cell of a `rect` change is outside the map.
+    #[error("rect cell ({x}, {y}) is outside the map")]
+    RectOutside {
+        /// Column.
+        x: i64,
+        /// Row.
+        y: i64,
+    },
+    /// `wall_ahead` on a path of fewer than 3 cells.
+    #[error("wall_ahead: the robot's path is too short")]
+    PathTooShort,
+    /// `wall_ahead` found no path cell at its centre.
+    #[error("wall_ahead: no path cell there")]
+    NoPathCell,
+    /// `box_away` before the first plan.
+    #[error("box_away: no path yet")]
+    NoPathYet,
+    /// `box_away` found no square far enough from the path.
+    #[error("box_away: no free {size} x {size} square {distance} cells from the path")]
+    NoBox {
+        /// Cells a side.
+        size: u16,
+        /// Cells from the path.
+        distance: u16,
+    },
+    /// A plan's raw path does not run from the start to the goal.
+    #[error("the path does not join start and goal")]
+    NotJoined,
+    /// A plan's raw path makes a move the map does not allow.
+    #[error("step ({}, {}) -> ({}, {}) is not an allowed move", .from.x, .from.y, .to.x, .to.y)]
+    BadStep {
+        /// The cell it leaves.
+        from: Point,
+        /// The cell it reaches.
+        to: Point,
+    },
+    /// The host planner was asked to plan before it had a map.
+    #[error("no map yet")]
+    NoMap,
+    /// The board's buffers cannot take the map.
+    #[error(transparent)]
+    Board(#[from] BoardError),
+    /// The core refused the map, the endpoints or the parameters.
+    #[error("{0}")]
+    Core(ohaca::Error),
+    /// The device's link failed or the device refused.
+    #[error(transparent)]
+    Link(#[from] LinkError),
+    /// What went wrong at an event of the scenario.
+    #[error("event {event}: {error}")]
+    Event {
+        /// The event's index.
+        event: usize,
+        /// What went wrong.
+        error: Box<ReplanError>,
+    },
+    /// A costmap stream's rates are out of range ([`crate::stream::Stream`]).
+    #[error("stream: hz and speed must be positive, near in 0..=1")]
+    BadStream,
+    /// What went wrong at an update of a costmap stream.
+    #[error("update {update}: {error}")]
+    Update {
+        /// The update's index.
+        update: usize,
+        /// What went wrong.
+        error: Box<ReplanError>,
+    },
+}
+
+impl From<ohaca::Error> for ReplanError {
+    fn from(e: ohaca::Error) -> Self {
+        ReplanError::Core(e)
+    }
+}
+
+impl ReplanError {
+    /// `self` at event `event` of the scenario.
+    fn at_event(self, event: usize) -> Self {
+        ReplanError::Event {
+            event,
+            error: Box::new(self),
+        }
+    }
+
+    /// `self` at update `update` of a costmap stream.
+    pub(crate) fn at_update(self, update: usize) -> Self {
+        ReplanError::Update {
+            update,
+            error: Box::new(self),
+        }
+    }
+}
+
 impl Scenario {
     /// Parse a scenario file's text.
-    pub fn parse(text: &str) -> Result<Scenario, String> {
-        let s: Scenario = serde_json::from_str(text).map_err(|e| e.to_string())?;
+    pub fn parse(text: &str) -> Result<Scenario, ReplanError> {
+        let s: Scenario = serde_json::from_str(text)?;
         for (i, e) in s.events.iter().enumerate() {
             if !(0.0..=1.0).contains(&e.at) {
-                return Err(format!("event {i}: `at` must be in 0..=1, not {}", e.at));
+                return Err(ReplanError::At { event: i, at: e.at });
             }
         }
         for c in s.initial.iter().chain(s.events.iter().map(|e| &e.change)) {
@@ -132,10 +250,7 @@ impl Scenario {
             .filter(|&&b| b)
             .count();
             if n != 1 {
-                return Err(
-                    "each change needs exactly one of rect, cells, wall_ahead, box_away, undo"
-                        .into(),
-                );
+                return Err(ReplanError::OneKind);
             }
         }
         Ok(s)
@@ -187,11 +302,11 @@ impl Planned {
 /// Something that plans: the host core or a device.
 pub trait Planner {
     /// Make the map the active map.
-    fn set_map(&mut self, map: &Map) -> Result<(), String>;
+    fn set_map(&mut self, map: &Map) -> Result<(), ReplanError>;
     /// Block or clear `cells` (every one on the map).
-    fn change(&mut self, cells: &[Point], blocked: bool) -> Result<(), String>;
+    fn change(&mut self, cells: &[Point], blocked: bool) -> Result<(), ReplanError>;
     /// Plan from `start` to `goal`, warm or cold.
-    fn plan(&mut self, start: Point, goal: Point, warm: bool) -> Result<Planned, String>;
+    fn plan(&mut self, start: Point, goal: Point, warm: bool) -> Result<Planned, ReplanError>;
 }
 
 /// The host core, planning as a board's firmware does ([`crate::board::BoardStorage`]), so its
@@ -246,20 +361,20 @@ impl HostPlanner {
 }
 
 impl Planner for HostPlanner {
-    fn set_map(&mut self, map: &Map) -> Result<(), String> {
+    fn set_map(&mut self, map: &Map) -> Result<(), ReplanError> {
         let iterations = usize::from(self.params.iterations);
         let storage = if self.strict {
             BoardStorage::new(self.board, map.cells(), iterations)
         } else {
             BoardStorage::lenient(self.board, map.cells(), iterations)
         };
-        self.storage = Some(storage.map_err(|e| e.to_string())?);
+        self.storage = Some(storage?);
         self.map = map.clone();
         self.memory.forget();
         Ok(())
     }
 
-    fn change(&mut self, cells: &[Point], blocked: bool) -> Result<(), String> {
+    fn change(&mut self, cells: &[Point], blocked: bool) -> Result<(), ReplanError> {
         for &p in cells {
             // As the firmware does: a cleared cell counts as freed if it was blocked.
             let was_blocked = self.map.is_blocked(p);
@@ -269,14 +384,13 @@ impl Planner for HostPlanner {
         Ok(())
     }
 
-    fn plan(&mut self, start: Point, goal: Point, warm: bool) -> Result<Planned, String> {
-        let grid = self.map.grid().map_err(|e| e.to_string())?;
+    fn plan(&mut self, start: Point, goal: Point, warm: bool) -> Result<Planned, ReplanError> {
+        let grid = self.map.grid()?;
         let mut ws = self
             .storage
             .as_mut()
-            .ok_or("no map yet")?
-            .workspace()
-            .map_err(|e| e.to_string())?;
+            .ok_or(ReplanError::NoMap)?
+            .workspace()?;
         // The firmware's dispatch (`ohaca::planner::session`): a warm replan that no change since
         // can shorten or block is the rest of the last answer (or its local repair); else the
         // reason, kept for the table, and a run.
@@ -288,12 +402,11 @@ impl Planner for HostPlanner {
             }
             Err(why) => why,
         };
-        let mut run = session::start(&grid, ends, &self.params, ws, memory, warm)
-            .map_err(|e| e.to_string())?;
+        let mut run = session::start(&grid, ends, &self.params, ws, memory, warm)?;
         // The one loop (the firmware's, without its yields), then what the run leaves for the
         // next warm start.
         while let Poll::Working(_) = run.poll() {}
-        let plan = session::end(run, &mut self.memory).map_err(|e| e.to_string())?;
+        let plan = session::end(run, &mut self.memory)?;
         Ok(Planned {
             fallback,
             ..Planned::of(&plan, None)
@@ -308,25 +421,23 @@ pub struct DevicePlanner<T: Transport> {
 }
 
 impl<T: Transport> Planner for DevicePlanner<T> {
-    fn set_map(&mut self, map: &Map) -> Result<(), String> {
-        self.link.set_map(map).map_err(|e| e.to_string())
+    fn set_map(&mut self, map: &Map) -> Result<(), ReplanError> {
+        Ok(self.link.set_map(map)?)
     }
 
-    fn change(&mut self, cells: &[Point], blocked: bool) -> Result<(), String> {
-        self.link
-            .set_cells(cells, blocked)
-            .map_err(|e| e.to_string())
+    fn change(&mut self, cells: &[Point], blocked: bool) -> Result<(), ReplanError> {
+        Ok(self.link.set_cells(cells, blocked)?)
     }
 
-    fn plan(&mut self, start: Point, goal: Point, warm: bool) -> Result<Planned, String> {
+    fn plan(&mut self, start: Point, goal: Point, warm: bool) -> Result<Planned, ReplanError> {
         let r: Result<DevicePath, LinkError> = if warm {
             self.link.plan_warm(start, goal, None)
         } else {
             self.link.plan(start, goal, None)
         };
-        let p = r.map_err(|e| e.to_string())?;
+        let p = r?;
         Ok(Planned {
-            raw: p.raw(start).map_err(|e| e.to_string())?,
+            raw: p.raw(start)?,
             waypoints: p.waypoints.clone(),
             raw_length: p.raw_length,
             length: p.length,
@@ -339,9 +450,11 @@ impl<T: Transport> Planner for DevicePlanner<T> {
     }
 }
 
-fn set_cell(map: &mut Map, p: Point, blocked: bool) -> Result<(), String> {
-    map.set(p, blocked)
-        .map_err(|_| format!("cell ({}, {}) is outside the map", p.x, p.y))
+pub(crate) fn set_cell(map: &mut Map, p: Point, blocked: bool) -> Result<(), ReplanError> {
+    map.set(p, blocked).map_err(|_| ReplanError::Outside {
+        x: i64::from(p.x),
+        y: i64::from(p.y),
+    })
 }
 
 /// One plan of a scenario run.
@@ -380,7 +493,7 @@ pub fn drive(
     (start, goal): (Point, Point),
     planner: &mut dyn Planner,
     warm: bool,
-) -> Result<Drive, String> {
+) -> Result<Drive, ReplanError> {
     let mut map = map.clone();
     let mut changed = Vec::new();
     let mut blocked = true;
@@ -420,7 +533,7 @@ pub fn drive(
         }
         planner
             .change(&cells, e.change.blocked)
-            .map_err(|m| format!("event {i}: {m}"))?;
+            .map_err(|e| e.at_event(i))?;
         let at = trail.len() - 1;
         let step = plan_step(
             planner,
@@ -431,7 +544,7 @@ pub fn drive(
             e.change.blocked,
             warm,
         )
-        .map_err(|m| format!("event {i}: {m}"))?;
+        .map_err(|e| e.at_event(i))?;
         steps.push(step);
     }
     if let Some(last) = steps.last() {
@@ -449,7 +562,7 @@ pub(crate) fn plan_step(
     changed: Vec<Point>,
     blocked: bool,
     warm: bool,
-) -> Result<Step, String> {
+) -> Result<Step, ReplanError> {
     let plan = planner.plan(robot, goal, warm)?;
     check(map, robot, goal, &plan.raw)?;
     Ok(Step {
@@ -471,7 +584,7 @@ fn resolve(
     at: usize,
     goal: Point,
     prev: &[Point],
-) -> Result<Vec<Point>, String> {
+) -> Result<Vec<Point>, ReplanError> {
     if c.undo {
         return Ok(prev.to_vec());
     }
@@ -487,8 +600,10 @@ fn resolve(
         for yy in u32::from(y)..u32::from(y) + u32::from(h) {
             for xx in u32::from(x)..u32::from(x) + u32::from(w) {
                 out.push(
-                    on_map(i64::from(xx), i64::from(yy))
-                        .ok_or_else(|| format!("rect cell ({xx}, {yy}) is outside the map"))?,
+                    on_map(i64::from(xx), i64::from(yy)).ok_or(ReplanError::RectOutside {
+                        x: i64::from(xx),
+                        y: i64::from(yy),
+                    })?,
                 );
             }
         }
@@ -498,8 +613,10 @@ fn resolve(
         return cells
             .iter()
             .map(|&[x, y]| {
-                on_map(i64::from(x), i64::from(y))
-                    .ok_or_else(|| format!("cell ({x}, {y}) is outside the map"))
+                on_map(i64::from(x), i64::from(y)).ok_or(ReplanError::Outside {
+                    x: i64::from(x),
+                    y: i64::from(y),
+                })
             })
             .collect();
     }
@@ -507,12 +624,12 @@ fn resolve(
         return Ok(Vec::new());
     };
     if path.len() < 3 {
-        return Err("wall_ahead: the robot's path is too short".into());
+        return Err(ReplanError::PathTooShort);
     }
     // The wall's centre stays off the goal (the path's last cell) and has a next cell.
     let centre = (at + usize::from(w.ahead)).min(path.len() - 2).max(at + 1);
     let (Some(&c0), Some(&c1)) = (path.get(centre), path.get(centre + 1)) else {
-        return Err("wall_ahead: no path cell there".into());
+        return Err(ReplanError::NoPathCell);
     };
     let (dx, dy) = (
         i64::from(c1.x) - i64::from(c0.x),
@@ -534,10 +651,10 @@ fn resolve(
 
 /// The first `size x size` square of free cells at least `distance` cells from every cell of
 /// `path` (row-major order of its top-left corner).
-fn box_away(map: &Map, path: &[Point], b: BoxAway) -> Result<Vec<Point>, String> {
+fn box_away(map: &Map, path: &[Point], b: BoxAway) -> Result<Vec<Point>, ReplanError> {
     let (size, d) = (b.size.max(1), b.distance);
     if path.is_empty() {
-        return Err("box_away: no path yet".into());
+        return Err(ReplanError::NoPathYet);
     }
     let far = |x: u16, y: u16| {
         path.iter().all(|p| {
@@ -564,24 +681,19 @@ fn box_away(map: &Map, path: &[Point], b: BoxAway) -> Result<Vec<Point>, String>
             }
         }
     }
-    Err(format!(
-        "box_away: no free {size} x {size} square {d} cells from the path"
-    ))
+    Err(ReplanError::NoBox { size, distance: d })
 }
 
 /// Check that `raw` goes from `start` to `goal` by allowed moves on `map`.
-pub fn check(map: &Map, start: Point, goal: Point, raw: &[Point]) -> Result<(), String> {
-    let grid = map.grid().map_err(|e| e.to_string())?;
+pub fn check(map: &Map, start: Point, goal: Point, raw: &[Point]) -> Result<(), ReplanError> {
+    let grid = map.grid()?;
     if raw.first() != Some(&start) || raw.last() != Some(&goal) {
-        return Err("the path does not join start and goal".into());
+        return Err(ReplanError::NotJoined);
     }
     for (&a, &b) in raw.iter().zip(raw.iter().skip(1)) {
         let ok = (0..8u8).any(|d| grid.step(a, d) == Some(b));
         if !ok {
-            return Err(format!(
-                "step ({}, {}) -> ({}, {}) is not an allowed move",
-                a.x, a.y, b.x, b.y
-            ));
+            return Err(ReplanError::BadStep { from: a, to: b });
         }
     }
     Ok(())
@@ -688,13 +800,24 @@ mod tests {
 
     #[test]
     fn bad_scenarios_are_refused() {
-        assert!(Scenario::parse(r#"{"events":[{"at":2,"rect":[0,0,1,1]}]}"#).is_err());
-        assert!(Scenario::parse(r#"{"events":[{"at":0.5}]}"#).is_err());
-        assert!(Scenario::parse(r#"{"oops":1}"#).is_err());
+        assert!(matches!(
+            Scenario::parse(r#"{"events":[{"at":2,"rect":[0,0,1,1]}]}"#),
+            Err(ReplanError::At { event: 0, .. })
+        ));
+        assert!(matches!(
+            Scenario::parse(r#"{"events":[{"at":0.5}]}"#),
+            Err(ReplanError::OneKind)
+        ));
+        assert!(matches!(
+            Scenario::parse(r#"{"oops":1}"#),
+            Err(ReplanError::Json(_))
+        ));
         let sc = Scenario::parse(r#"{"initial":[{"rect":[2,0,9,1]}]}"#).unwrap();
         let ends = (Point::new(0, 0), Point::new(3, 0));
         let mut host = HostPlanner::new(Params::default());
-        assert!(drive(&sc, &open(4, 1), ends, &mut host, true).is_err());
+        let e = drive(&sc, &open(4, 1), ends, &mut host, true).unwrap_err();
+        assert!(matches!(e, ReplanError::RectOutside { x: 4, y: 0 }), "{e}");
+        assert_eq!(e.to_string(), "rect cell (4, 0) is outside the map");
     }
 
     #[test]

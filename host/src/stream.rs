@@ -20,7 +20,7 @@
 use ohaca::Point;
 
 use crate::map::Map;
-use crate::replan::{plan_step, Drive, Planner, Step};
+use crate::replan::{plan_step, set_cell, Drive, Planner, ReplanError, Step};
 use crate::rng::Rng;
 
 /// How the stream runs. See the module docs.
@@ -60,9 +60,9 @@ pub fn stream(
     (start, goal): (Point, Point),
     planner: &mut dyn Planner,
     warm: bool,
-) -> Result<Drive, String> {
+) -> Result<Drive, ReplanError> {
     if !(s.hz > 0.0 && s.speed > 0.0 && (0.0..=1.0).contains(&s.near)) {
-        return Err("stream: hz and speed must be positive, near in 0..=1".into());
+        return Err(ReplanError::BadStream);
     }
     let mut map = map.clone();
     let mut rng = Rng(s.seed);
@@ -106,15 +106,14 @@ pub fn stream(
         };
         let cells: Vec<Point> = cells.into_iter().filter(|&p| p != robot).collect();
         for &p in &cells {
-            map.set(p, blocked)
-                .map_err(|_| format!("cell ({}, {}) is outside the map", p.x, p.y))?;
+            set_cell(&mut map, p, blocked)?;
         }
         planner
             .change(&cells, blocked)
-            .map_err(|m| format!("update {k}: {m}"))?;
+            .map_err(|e| e.at_update(k))?;
         let at = trail.len() - 1;
         let step = plan_step(planner, (robot, at), goal, &map, cells, blocked, warm)
-            .map_err(|m| format!("update {k}: {m}"))?;
+            .map_err(|e| e.at_update(k))?;
         steps.push(step);
     }
     if let Some(last) = steps.last() {

@@ -8,7 +8,7 @@
 //! warm run (the colony kept), teal the rest of the last answer (reused, no run),
 //! purple the rest with a local detour (repaired, no run).
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use image::codecs::gif::{GifEncoder, Repeat};
 use image::{Delay, Frame, Rgb, RgbImage, RgbaImage};
@@ -172,8 +172,8 @@ fn scene(c: &mut Canvas, drive: &Drive, at: &[usize], k: usize, t: usize, goal: 
 }
 
 /// A strip of panels, one per plan, at the moment the robot planned it.
-pub fn strip(drive: &Drive, goal: Point) -> Result<RgbImage, String> {
-    let first = drive.steps.first().ok_or("no plans to draw")?;
+pub fn strip(drive: &Drive, goal: Point) -> Result<RgbImage, StripError> {
+    let first = drive.steps.first().ok_or(StripError::NoPlans)?;
     let s = scale(&first.map);
     let (pw, ph) = (
         u32::from(first.map.width) * s,
@@ -194,15 +194,42 @@ pub fn strip(drive: &Drive, goal: Point) -> Result<RgbImage, String> {
 }
 
 /// Save [`strip`] as a PNG.
-pub fn save_strip(drive: &Drive, goal: Point, path: &Path) -> Result<(), String> {
+pub fn save_strip(drive: &Drive, goal: Point, path: &Path) -> Result<(), StripError> {
     strip(drive, goal)?
         .save(path)
-        .map_err(|e| format!("{}: {e}", path.display()))
+        .map_err(|error| StripError::Image {
+            path: path.to_path_buf(),
+            error,
+        })
+}
+
+/// Why a picture of a drive cannot be made.
+#[derive(Debug, thiserror::Error)]
+pub enum StripError {
+    /// The drive has no plan.
+    #[error("no plans to draw")]
+    NoPlans,
+    /// The file cannot be created.
+    #[error("{}: {error}", .path.display())]
+    Create {
+        /// The file.
+        path: PathBuf,
+        /// The system's error.
+        error: std::io::Error,
+    },
+    /// The image cannot be encoded or written.
+    #[error("{}: {error}", .path.display())]
+    Image {
+        /// The file.
+        path: PathBuf,
+        /// The encoder's error.
+        error: image::ImageError,
+    },
 }
 
 /// An animated GIF of the robot driving: about 60 frames, a pause at every replan.
-pub fn save_gif(drive: &Drive, goal: Point, path: &Path) -> Result<(), String> {
-    let first = drive.steps.first().ok_or("no plans to draw")?;
+pub fn save_gif(drive: &Drive, goal: Point, path: &Path) -> Result<(), StripError> {
+    let first = drive.steps.first().ok_or(StripError::NoPlans)?;
     let s = scale(&first.map).min(4);
     let (pw, ph) = (
         u32::from(first.map.width) * s,
@@ -215,10 +242,16 @@ pub fn save_gif(drive: &Drive, goal: Point, path: &Path) -> Result<(), String> {
     times.push(drive.trail.len().saturating_sub(1));
     times.sort_unstable();
     times.dedup();
-    let file = std::fs::File::create(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let file = std::fs::File::create(path).map_err(|error| StripError::Create {
+        path: path.to_path_buf(),
+        error,
+    })?;
+    let image = |error| StripError::Image {
+        path: path.to_path_buf(),
+        error,
+    };
     let mut enc = GifEncoder::new_with_speed(std::io::BufWriter::new(file), 20);
-    enc.set_repeat(Repeat::Infinite)
-        .map_err(|e| e.to_string())?;
+    enc.set_repeat(Repeat::Infinite).map_err(image)?;
     for &t in &times {
         let k = at.iter().rposition(|&a| a <= t).unwrap_or(0);
         let mut c = Canvas {
@@ -239,7 +272,7 @@ pub fn save_gif(drive: &Drive, goal: Point, path: &Path) -> Result<(), String> {
             0,
             Delay::from_numer_denom_ms(pause, 1),
         ))
-        .map_err(|e| e.to_string())?;
+        .map_err(image)?;
     }
     Ok(())
 }

@@ -34,7 +34,7 @@
 //! the coarse route moved from the DTCM to the ITCM (the CPU reads and writes it as data). Only
 //! a best path of exactly 16,384 steps (16,385 cells, one more than the links) is smoothed
 //! greedily instead of by the shortest-path smoothing; the host plans it alike
-//! (`host/tests/common/qemu.rs`, `core_plan_steps`).
+//! (`host/tests/qemu/qemu.rs`, `core_plan_steps`).
 //!
 //! The NOLOAD sections are not touched by the startup code (cortex-m-rt zeroes `.bss` only), so
 //! their statics are `Region`s, `MaybeUninit` memory that [`take`] fills with zeros element by

@@ -127,7 +127,7 @@ pub const fn path_payload(waypoints: usize, directions: usize) -> usize {
 /// [`encode_reply`].
 pub const MAX_REPLY: usize = path_payload(MAX_WAYPOINTS, MAX_DIRECTIONS);
 
-// The figure docs/PROTOCOL.md gives (`host-tests/tests/documents.rs` reads it there and encodes
+// The figure docs/PROTOCOL.md gives (`host-tests/tests/it/documents.rs` reads it there and encodes
 // the widest path reply): a change to `MAX_STEPS` or to `PathReply` is a new protocol version.
 // Each board checks its `max_steps` against `MAX_STEPS` (`firmware::board`).
 const _: () = assert!(MAX_REPLY == 81_985);

@@ -14,6 +14,7 @@
 use std::path::PathBuf;
 
 use ohaca::geometry::segment_clear;
+use ohaca::Point;
 use ohaca_host::exit;
 use ohaca_host::input::{parse_length, parse_metres};
 use ohaca_host::map::{prepare, Unknown};
@@ -85,44 +86,42 @@ pub fn run(args: &Args) -> u8 {
     let near = |a: Option<&[f64; 2]>, b: [f64; 2]| {
         a.is_some_and(|a| (a[0] - b[0]).hypot(a[1] - b[1]) <= args.tolerance)
     };
-    let verdict = (|| -> Result<(), String> {
+    let verdict = (|| -> Result<(), Invalid> {
         if points.len() < 2 {
-            return Err(format!("{} points: a path needs at least 2", points.len()));
+            return Err(Invalid::TooShort(points.len()));
         }
         if !near(points.first(), args.start_m) {
-            return Err(format!(
-                "the path starts at {:?}, not at the start {:?}",
-                points.first(),
-                args.start_m
-            ));
+            return Err(Invalid::Start {
+                at: points.first().copied(),
+                start: args.start_m,
+            });
         }
         if !near(points.last(), args.goal_m) {
-            return Err(format!(
-                "the path ends at {:?}, not at the goal {:?}",
-                points.last(),
-                args.goal_m
-            ));
+            return Err(Invalid::Goal {
+                at: points.last().copied(),
+                goal: args.goal_m,
+            });
         }
         let mut cells = Vec::with_capacity(points.len());
         for (i, p) in points.iter().enumerate() {
-            let c = frame
-                .cell(*p)
-                .ok_or_else(|| format!("point {i} ({:.3}, {:.3}) is off the map", p[0], p[1]))?;
+            let c = frame.cell(*p).ok_or(Invalid::OffMap { index: i, at: *p })?;
             if map.is_blocked(c) {
-                return Err(format!(
-                    "point {i} ({:.3}, {:.3}) is on an obstacle (cell {},{})",
-                    p[0], p[1], c.x, c.y
-                ));
+                return Err(Invalid::OnObstacle {
+                    index: i,
+                    at: *p,
+                    cell: c,
+                });
             }
             cells.push(c);
         }
         for (i, w) in cells.windows(2).enumerate() {
             if let [a, b] = w {
                 if !segment_clear(&grid, *a, *b) {
-                    return Err(format!(
-                        "segment {i} from cell {},{} to {},{} touches an obstacle",
-                        a.x, a.y, b.x, b.y
-                    ));
+                    return Err(Invalid::Segment {
+                        index: i,
+                        from: *a,
+                        to: *b,
+                    });
                 }
             }
         }
@@ -132,7 +131,7 @@ pub fn run(args: &Args) -> u8 {
         "valid": verdict.is_ok(),
         "points": points.len(),
         "length_m": length_m,
-        "error": verdict.as_ref().err(),
+        "error": verdict.as_ref().err().map(ToString::to_string),
     });
     print(&format!("{out}\n"));
     match verdict {
@@ -142,4 +141,56 @@ pub fn run(args: &Args) -> u8 {
             exit::NO_PATH
         }
     }
+}
+
+/// Why a path is not valid on the map (`error` in the JSON line, and `invalid path: ...`).
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+enum Invalid {
+    /// Fewer than two points.
+    #[error("{0} points: a path needs at least 2")]
+    TooShort(usize),
+    /// The first point is not the start.
+    #[error("the path starts at {at:?}, not at the start {start:?}")]
+    Start {
+        /// The first point.
+        at: Option<[f64; 2]>,
+        /// `--start-m`.
+        start: [f64; 2],
+    },
+    /// The last point is not the goal.
+    #[error("the path ends at {at:?}, not at the goal {goal:?}")]
+    Goal {
+        /// The last point.
+        at: Option<[f64; 2]>,
+        /// `--goal-m`.
+        goal: [f64; 2],
+    },
+    /// A point is off the map.
+    #[error("point {index} ({:.3}, {:.3}) is off the map", .at[0], .at[1])]
+    OffMap {
+        /// The point's index.
+        index: usize,
+        /// The point in metres.
+        at: [f64; 2],
+    },
+    /// A point is on an obstacle.
+    #[error("point {index} ({:.3}, {:.3}) is on an obstacle (cell {},{})", .at[0], .at[1], .cell.x, .cell.y)]
+    OnObstacle {
+        /// The point's index.
+        index: usize,
+        /// The point in metres.
+        at: [f64; 2],
+        /// Its cell.
+        cell: Point,
+    },
+    /// A segment between two points touches an obstacle.
+    #[error("segment {index} from cell {},{} to {},{} touches an obstacle", .from.x, .from.y, .to.x, .to.y)]
+    Segment {
+        /// The segment's index.
+        index: usize,
+        /// Its first cell.
+        from: Point,
+        /// Its last cell.
+        to: Point,
+    },
 }

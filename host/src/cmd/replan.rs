@@ -9,15 +9,17 @@
 //! invalid path); 2 bad input.
 
 use std::path::PathBuf;
-use std::time::Duration;
+use std::time::{Duration, TryFromFloatSecsError};
 
 use ohaca::Params;
 use ohaca::Point;
 use ohaca_host::board::BoardArg;
-use ohaca_host::dstar::{self, AstarCost, Stats};
+use ohaca_host::dstar::{self, AstarCost, DStarError, Stats};
 use ohaca_host::input::MapArgs;
-use ohaca_host::link::{Link, Transport, DEFAULT_BAUD};
-use ohaca_host::replan::{drive, DevicePlanner, Drive, HostPlanner, Planner, Scenario};
+use ohaca_host::link::{Link, LinkError, Transport, DEFAULT_BAUD};
+use ohaca_host::replan::{
+    drive, DevicePlanner, Drive, HostPlanner, Planner, ReplanError, Scenario,
+};
 use ohaca_host::stream::{stream, summary as summary_of, Stream, Summary};
 use ohaca_host::{exit, strip, ParamArgs};
 use serde::Serialize;
@@ -150,8 +152,8 @@ fn rows(mode: &'static str, d: &Drive) -> Vec<Row> {
 }
 
 /// Replay `d` into D* Lite and attach its columns to `rows` (the drive's rows, in order).
-fn add_dstar(rows: &mut [Row], d: &Drive, goal: Point) -> Result<(), String> {
-    let replayed = dstar::replay(d, goal).map_err(|e| format!("D* Lite: {e}"))?;
+fn add_dstar(rows: &mut [Row], d: &Drive, goal: Point) -> Result<(), CmdError> {
+    let replayed = dstar::replay(d, goal)?;
     for (row, r) in rows.iter_mut().zip(replayed) {
         row.dstar = Some(DstarCols {
             stats: r.dstar,
@@ -165,23 +167,20 @@ fn add_dstar(rows: &mut [Row], d: &Drive, goal: Point) -> Result<(), String> {
 fn device<T: Transport + 'static>(
     mut link: Link<T>,
     params: &Params,
-) -> Result<Box<dyn Planner>, String> {
-    link.hello().map_err(|e| e.to_string())?;
-    link.set_params(params).map_err(|e| e.to_string())?;
+) -> Result<Box<dyn Planner>, CmdError> {
+    link.hello()?;
+    link.set_params(params)?;
     Ok(Box::new(DevicePlanner { link }))
 }
 
-fn planner(args: &Args) -> Result<Box<dyn Planner>, String> {
+fn planner(args: &Args) -> Result<Box<dyn Planner>, CmdError> {
     let params = args.params.params();
-    let timeout = Duration::try_from_secs_f64(args.timeout).map_err(|e| e.to_string())?;
+    let timeout = Duration::try_from_secs_f64(args.timeout)?;
     if let Some(addr) = &args.tcp {
-        return device(
-            Link::tcp(addr, timeout).map_err(|e| e.to_string())?,
-            &params,
-        );
+        return device(Link::tcp(addr, timeout)?, &params);
     }
     if let Some(port) = &args.serial {
-        let link = Link::serial(port, args.baud, timeout).map_err(|e| e.to_string())?;
+        let link = Link::serial(port, args.baud, timeout)?;
         return device(link, &params);
     }
     Ok(match args.board {
@@ -246,6 +245,26 @@ fn table(rows: &[Row]) -> String {
     out
 }
 
+/// Why `ohaca replan` cannot start or finish (printed as `error: ...`).
+#[derive(Debug, thiserror::Error)]
+enum CmdError {
+    /// The events file cannot be read.
+    #[error(transparent)]
+    Read(#[from] std::io::Error),
+    /// The events file is not a scenario.
+    #[error(transparent)]
+    Scenario(#[from] ReplanError),
+    /// `--timeout` is not a duration.
+    #[error("--timeout: {0}")]
+    Timeout(#[from] TryFromFloatSecsError),
+    /// The device cannot be reached or refused `Hello` or the parameters.
+    #[error(transparent)]
+    Link(#[from] LinkError),
+    /// D* Lite's replay failed.
+    #[error("D* Lite: {0}")]
+    DStar(#[from] DStarError),
+}
+
 /// Run `ohaca replan`; returns the exit code.
 pub fn run(args: &Args) -> u8 {
     let sc = match args.input.load() {
@@ -254,8 +273,8 @@ pub fn run(args: &Args) -> u8 {
     };
     let events = match &args.events {
         Some(path) => match std::fs::read_to_string(path)
-            .map_err(|e| e.to_string())
-            .and_then(|t| Scenario::parse(&t))
+            .map_err(CmdError::from)
+            .and_then(|t| Ok(Scenario::parse(&t)?))
         {
             Ok(e) => Some(e),
             Err(e) => return bad_input(format_args!("{}: {e}", path.display())),

@@ -158,18 +158,39 @@ pub struct Args {
     pub params: ParamArgs,
 }
 
-fn seconds(v: f64, what: &str) -> Result<Duration, String> {
-    if !(v > 0.0 && v <= 86_400.0 * 365.0) {
-        return Err(format!(
-            "{what} must be a positive number of seconds, not {v}"
-        ));
-    }
-    Duration::try_from_secs_f64(v).map_err(|e| format!("{what}: {e}"))
+/// Why `ohaca ros` cannot start (printed as `error: ...`, exit code 2).
+#[derive(Debug, thiserror::Error)]
+enum RosError {
+    /// A duration flag is not a positive number of seconds (up to a year).
+    #[error("{flag} must be a positive number of seconds, not {value}")]
+    Seconds {
+        /// The flag.
+        flag: &'static str,
+        /// Its value.
+        value: f64,
+    },
+    /// The parameters are out of range (the core's words).
+    #[error("{0}")]
+    Params(ohaca::Error),
+    /// `ROS_DOMAIN_ID` is not a number.
+    #[error("ROS_DOMAIN_ID `{0}` is not a domain number")]
+    DomainVar(String),
+    /// The domain is out of DDS's range.
+    #[error("DDS domain {0} is not in 0..=232")]
+    Domain(u16),
 }
 
-fn backend(args: &Args) -> Result<Box<dyn Backend>, String> {
+fn seconds(value: f64, flag: &'static str) -> Result<Duration, RosError> {
+    let bad = RosError::Seconds { flag, value };
+    if !(value > 0.0 && value <= 86_400.0 * 365.0) {
+        return Err(bad);
+    }
+    Duration::try_from_secs_f64(value).map_err(|_| bad)
+}
+
+fn backend(args: &Args) -> Result<Box<dyn Backend>, RosError> {
     let params = args.params.params();
-    params.validate().map_err(|e| e.to_string())?;
+    params.validate().map_err(RosError::Params)?;
     let timeout = seconds(args.timeout, "--timeout")?;
     if let Some(addr) = &args.tcp {
         let a = addr.clone();
@@ -187,19 +208,19 @@ fn backend(args: &Args) -> Result<Box<dyn Backend>, String> {
     }))
 }
 
-fn config(args: &Args) -> Result<NodeConfig, String> {
+fn config(args: &Args) -> Result<NodeConfig, RosError> {
     let domain = match args.domain {
         Some(d) => d,
         None => match std::env::var("ROS_DOMAIN_ID") {
             Ok(v) if !v.trim().is_empty() => v
                 .trim()
                 .parse()
-                .map_err(|_| format!("ROS_DOMAIN_ID `{v}` is not a domain number"))?,
+                .map_err(|_| RosError::DomainVar(v.clone()))?,
             _ => 0,
         },
     };
     if domain > 232 {
-        return Err(format!("DDS domain {domain} is not in 0..=232"));
+        return Err(RosError::Domain(domain));
     }
     let durability = |d: DurabilityArg| match d {
         DurabilityArg::TransientLocal => Durability::TransientLocal,

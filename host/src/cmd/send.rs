@@ -33,10 +33,11 @@ use std::time::{Duration, Instant};
 use ohaca::board::Board;
 use ohaca::protocol::{ErrorCode, ErrorReply};
 use ohaca::{Error, Params, Point};
+use ohaca_host::args::PointError;
 use ohaca_host::board::differs_from_host;
 use ohaca_host::input::{resolve_point, MapArgs};
 use ohaca_host::link::{DeviceInfo, DevicePath, Link, LinkError, PlanJob, Transport, DEFAULT_BAUD};
-use ohaca_host::map::{fit, fits, prepare, Fitted, MapFrame};
+use ohaca_host::map::{fit, fits, prepare, FitError, Fitted, MapError, MapFrame};
 use ohaca_host::output::{format_us, micros, render, waypoints_csv, xy, LocatedReport, PlanReport};
 use ohaca_host::{exit, parse_point, Map, ParamArgs};
 use serde::Serialize;
@@ -80,16 +81,161 @@ pub struct Args {
     pub params: ParamArgs,
 }
 
+/// A bad `--timeout`.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+enum TimeoutError {
+    /// Not a number.
+    #[error("expected seconds, found `{0}`")]
+    NotSeconds(String),
+    /// Not in (0, 86400].
+    #[error("timeout must be in (0, 86400] seconds, found {0}")]
+    Range(String),
+}
+
+/// `TARGET: ` before a link error, or nothing.
+fn target_prefix(target: &Option<String>) -> String {
+    target
+        .as_ref()
+        .map(|t| format!("{t}: "))
+        .unwrap_or_default()
+}
+
 /// `--timeout`: positive seconds, at most a day.
-fn parse_timeout(s: &str) -> Result<Duration, String> {
+fn parse_timeout(s: &str) -> Result<Duration, TimeoutError> {
     let v: f64 = s
         .trim()
         .parse()
-        .map_err(|_| format!("expected seconds, found `{s}`"))?;
+        .map_err(|_| TimeoutError::NotSeconds(s.to_string()))?;
     if !(v > 0.0 && v <= 86_400.0) {
-        return Err(format!("timeout must be in (0, 86400] seconds, found {s}"));
+        return Err(TimeoutError::Range(s.to_string()));
     }
-    Duration::try_from_secs_f64(v).map_err(|e| e.to_string())
+    Duration::try_from_secs_f64(v).map_err(|_| TimeoutError::Range(s.to_string()))
+}
+
+/// A bad line of a goals file.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+enum GoalLineError {
+    /// A point is malformed.
+    #[error(transparent)]
+    Point(#[from] PointError),
+    /// A goal alone, and no `--start`.
+    #[error("a goal without a start: give `SX,SY GX,GY`, or --start")]
+    NoStart,
+    /// Not one or two points.
+    #[error("expected `SX,SY GX,GY`, found `{0}`")]
+    Shape(String),
+}
+
+/// Why `ohaca send` failed (printed as `error: ...`, exit code 2).
+#[derive(Debug, thiserror::Error)]
+enum SendError {
+    /// `--json` with another `--format`.
+    #[error("--json means --format json; it cannot be combined with --format {0}")]
+    JsonAndFormat(&'static str),
+    /// `--goals` with a format other than JSON.
+    #[error("--goals prints one JSON line per request: use --format json")]
+    GoalsNotJson,
+    /// Neither a start and a goal nor `--goals`.
+    #[error("give --start (or --start-m) and --goal (or --goal-m), or --goals")]
+    NoEndpoints,
+    /// Neither `--tcp` nor `--serial`.
+    #[error("give --tcp HOST:PORT or --serial DEVICE")]
+    NoDevice,
+    /// No job.
+    #[error("nothing to plan")]
+    NothingToPlan,
+    /// The map or a point in metres.
+    #[error(transparent)]
+    Map(#[from] MapError),
+    /// The parameters are out of range (the core's words).
+    #[error("{0}")]
+    Params(Error),
+    /// The goals file cannot be read.
+    #[error("{}: cannot read the file: {error}", .path.display())]
+    ReadGoals {
+        /// The file.
+        path: PathBuf,
+        /// The system's error.
+        error: std::io::Error,
+    },
+    /// A line of the goals file is bad.
+    #[error("{}, line {line}: {error}", .path.display())]
+    GoalLine {
+        /// The file.
+        path: PathBuf,
+        /// The line (from 1).
+        line: usize,
+        /// What is wrong with it.
+        error: GoalLineError,
+    },
+    /// The goals file has no pair.
+    #[error("{}: no start/goal pairs", .0.display())]
+    NoGoals(PathBuf),
+    /// The map does not fit the device (with `--cell`, or not even fitted).
+    #[error(
+        "{}: map too large for the device: {width}x{height} = {cells} cells, but {board} holds \
+         at most {capacity} cells (sides up to {max_side}); use a smaller map",
+        .path.display()
+    )]
+    TooLarge {
+        /// The map file.
+        path: PathBuf,
+        /// Its width in cells.
+        width: u16,
+        /// Its height in cells.
+        height: u16,
+        /// Its cells.
+        cells: usize,
+        /// The device's board.
+        board: String,
+        /// The device's most cells.
+        capacity: u32,
+        /// The device's longest side.
+        max_side: u16,
+    },
+    /// A start or goal is off the map (checked before fitting the map).
+    #[error("{name}: {what} {},{} is outside the map ({width}x{height})", .at.x, .at.y)]
+    Outside {
+        /// The map's name.
+        name: String,
+        /// `start` or `goal`.
+        what: &'static str,
+        /// The cell.
+        at: Point,
+        /// The map's width.
+        width: u16,
+        /// The map's height.
+        height: u16,
+    },
+    /// A start or goal is on an obstacle (checked before fitting the map).
+    #[error("{name}: {what} {},{} is on an obstacle", .at.x, .at.y)]
+    Blocked {
+        /// The map's name.
+        name: String,
+        /// `start` or `goal`.
+        what: &'static str,
+        /// The cell.
+        at: Point,
+    },
+    /// The map cannot be fitted to the device.
+    #[error("{name}: {error}")]
+    Fit {
+        /// The map's name.
+        name: String,
+        /// Why.
+        error: FitError,
+    },
+    /// The link failed, or the device refused a request.
+    #[error("{}{error}", target_prefix(.target))]
+    Link {
+        /// The device's address (`None` when the error names it: opening the link).
+        target: Option<String>,
+        /// What failed.
+        error: LinkError,
+    },
+    /// The device's answer to the plan is an error of the user's input, or a bad path.
+    #[error("{0}")]
+    Answer(String),
 }
 
 /// What `send --json` prints: the `plan` report's keys (`waypoints_m` too, for maps with a
@@ -145,18 +291,14 @@ struct Sender {
 }
 
 /// One line of a goals file.
-fn parse_goal_line(line: &str, start: Option<Point>) -> Result<Option<PlanJob>, String> {
+fn parse_goal_line(line: &str, start: Option<Point>) -> Result<Option<PlanJob>, GoalLineError> {
     let text = line.split('#').next().unwrap_or("");
     let words: Vec<&str> = text.split_whitespace().collect();
-    let point = |w: &str| parse_point(w).map_err(|e| e.to_string());
     let (s, g) = match words.as_slice() {
         [] => return Ok(None),
-        [g] => (
-            start.ok_or("a goal without a start: give `SX,SY GX,GY`, or --start")?,
-            point(g)?,
-        ),
-        [s, g] => (point(s)?, point(g)?),
-        _ => return Err(format!("expected `SX,SY GX,GY`, found `{}`", text.trim())),
+        [g] => (start.ok_or(GoalLineError::NoStart)?, parse_point(g)?),
+        [s, g] => (parse_point(s)?, parse_point(g)?),
+        _ => return Err(GoalLineError::Shape(text.trim().to_string())),
     };
     Ok(Some(PlanJob {
         start: s,
@@ -166,37 +308,43 @@ fn parse_goal_line(line: &str, start: Option<Point>) -> Result<Option<PlanJob>, 
 }
 
 /// Every request of a goals file.
-fn load_goals(path: &Path, start: Option<Point>) -> Result<Vec<PlanJob>, String> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| format!("{}: cannot read the file: {e}", path.display()))?;
+fn load_goals(path: &Path, start: Option<Point>) -> Result<Vec<PlanJob>, SendError> {
+    let text = std::fs::read_to_string(path).map_err(|error| SendError::ReadGoals {
+        path: path.to_path_buf(),
+        error,
+    })?;
     let mut jobs = Vec::new();
     for (i, line) in text.lines().enumerate() {
         match parse_goal_line(line, start) {
             Ok(Some(j)) => jobs.push(j),
             Ok(None) => {}
-            Err(e) => return Err(format!("{}, line {}: {e}", path.display(), i + 1)),
+            Err(error) => {
+                return Err(SendError::GoalLine {
+                    path: path.to_path_buf(),
+                    line: i + 1,
+                    error,
+                })
+            }
         }
     }
     if jobs.is_empty() {
-        return Err(format!("{}: no start/goal pairs", path.display()));
+        return Err(SendError::NoGoals(path.to_path_buf()));
     }
     Ok(jobs)
 }
 
-/// A map the device cannot hold, in words.
-fn too_large(map_path: &Path, map: &Map, info: &DeviceInfo) -> String {
+/// A map the device cannot hold.
+fn too_large(map_path: &Path, map: &Map, info: &DeviceInfo) -> SendError {
     let c = &info.capacity;
-    format!(
-        "{}: map too large for the device: {}x{} = {} cells, but {} holds at most {} cells \
-         (sides up to {}); use a smaller map",
-        map_path.display(),
-        map.width,
-        map.height,
-        map.cells(),
-        info.board,
-        c.cells,
-        c.max_side
-    )
+    SendError::TooLarge {
+        path: map_path.to_path_buf(),
+        width: map.width,
+        height: map.height,
+        cells: map.cells(),
+        board: info.board.clone(),
+        capacity: c.cells,
+        max_side: c.max_side,
+    }
 }
 
 /// A note when the device plans `map` in another layout than `ohaca plan` does by default (the
@@ -219,44 +367,37 @@ fn layout_note(info: &DeviceInfo, map: &Map) -> Option<String> {
 
 impl Sender {
     /// Everything that can be checked before connecting.
-    fn prepare(args: &Args) -> Result<Sender, String> {
+    fn prepare(args: &Args) -> Result<Sender, SendError> {
         let format = match (args.json, args.format, args.goals.is_some()) {
             (true, None | Some(Format::Json), _) => Format::Json,
             (true, Some(f), _) => {
-                return Err(format!(
-                    "--json means --format json; it cannot be combined with --format {}",
-                    if f == Format::Csv { "csv" } else { "text" }
-                ))
+                return Err(SendError::JsonAndFormat(if f == Format::Csv {
+                    "csv"
+                } else {
+                    "text"
+                }))
             }
             (false, None, true) | (false, Some(Format::Json), true) => Format::Json,
-            (false, Some(_), true) => {
-                return Err("--goals prints one JSON line per request: use --format json".into())
-            }
+            (false, Some(_), true) => return Err(SendError::GoalsNotJson),
             (false, f, false) => f.unwrap_or(Format::Text),
         };
         let a = &args.input;
         let name = a.map.display().to_string();
-        let (map, metric) =
-            prepare(&a.map, a.unknown, a.inflate, a.cell).map_err(|e| e.to_string())?;
+        let (map, metric) = prepare(&a.map, a.unknown, a.inflate, a.cell)?;
         let params = args.params.params();
-        params.validate().map_err(|e| e.to_string())?;
+        params.validate().map_err(SendError::Params)?;
         let start = match (a.start, a.start_m) {
             (None, None) => None,
-            (s, m) => Some(resolve_point(&name, metric, "start", s, m).map_err(|e| e.to_string())?),
+            (s, m) => Some(resolve_point(&name, metric, "start", s, m)?),
         };
         let jobs = match (&args.goals, start) {
             (Some(file), start) => load_goals(file, start)?,
             (None, Some(start)) => vec![PlanJob {
                 start,
-                goal: resolve_point(&name, metric, "goal", a.goal, a.goal_m)
-                    .map_err(|e| e.to_string())?,
+                goal: resolve_point(&name, metric, "goal", a.goal, a.goal_m)?,
                 seed: None,
             }],
-            (None, None) => {
-                return Err(
-                    "give --start (or --start-m) and --goal (or --goal-m), or --goals".into(),
-                )
-            }
+            (None, None) => return Err(SendError::NoEndpoints),
         };
         let target = args.tcp.as_deref().or(args.serial.as_deref()).unwrap_or("");
         Ok(Sender {
@@ -277,7 +418,7 @@ impl Sender {
     /// ([`ohaca_host::map::fit`]); the jobs' cells follow, and outputs go back to the original
     /// cells. With `--cell`, a map that does not fit is an error. A map that fits (cells and
     /// longest side) goes as it is.
-    fn fit(&mut self, args: &Args, info: &DeviceInfo) -> Result<(), String> {
+    fn fit(&mut self, args: &Args, info: &DeviceInfo) -> Result<(), SendError> {
         let c = &info.capacity;
         if fits(&self.map, c) {
             return Ok(());
@@ -289,22 +430,29 @@ impl Sender {
         for job in &self.jobs {
             for (what, p) in [("start", job.start), ("goal", job.goal)] {
                 if p.x >= self.map.width || p.y >= self.map.height {
-                    return Err(format!(
-                        "{}: {what} {},{} is outside the map ({}x{})",
-                        self.name, p.x, p.y, self.map.width, self.map.height
-                    ));
+                    return Err(SendError::Outside {
+                        name: self.name.clone(),
+                        what,
+                        at: p,
+                        width: self.map.width,
+                        height: self.map.height,
+                    });
                 }
                 if self.map.is_blocked(p) {
-                    return Err(format!(
-                        "{}: {what} {},{} is on an obstacle",
-                        self.name, p.x, p.y
-                    ));
+                    return Err(SendError::Blocked {
+                        name: self.name.clone(),
+                        what,
+                        at: p,
+                    });
                 }
             }
         }
         let endpoints: Vec<Point> = self.jobs.iter().flat_map(|j| [j.start, j.goal]).collect();
         let fitted = fit(&self.map, self.metric, c, &endpoints)
-            .map_err(|e| format!("{}: {e}", self.name))?
+            .map_err(|error| SendError::Fit {
+                name: self.name.clone(),
+                error,
+            })?
             .ok_or_else(|| too_large(&args.input.map, &self.map, info))?;
         eprintln!("note: {}", fitted.note(&self.name, &info.board, c));
         self.original_jobs = self.jobs.clone();
@@ -373,14 +521,15 @@ impl Sender {
     }
 
     /// `error: <target>: <what>`.
-    fn fail(&self, e: LinkError) -> String {
-        match e {
-            LinkError::Open { .. } => e.to_string(),
-            e => format!("{}: {e}", self.target),
-        }
+    fn fail(&self, error: LinkError) -> SendError {
+        let target = match error {
+            LinkError::Open { .. } => None,
+            _ => Some(self.target.clone()),
+        };
+        SendError::Link { target, error }
     }
 
-    fn run(&mut self, args: &Args) -> Result<u8, String> {
+    fn run(&mut self, args: &Args) -> Result<u8, SendError> {
         let fail = |e: LinkError| self.fail(e);
         match (&args.tcp, &args.serial) {
             (Some(addr), _) => {
@@ -391,11 +540,11 @@ impl Sender {
                 let link = Link::serial(dev, args.baud, args.timeout).map_err(fail)?;
                 self.talk(args, link)
             }
-            (None, None) => Err("give --tcp HOST:PORT or --serial DEVICE".into()),
+            (None, None) => Err(SendError::NoDevice),
         }
     }
 
-    fn talk<T: Transport>(&mut self, args: &Args, mut link: Link<T>) -> Result<u8, String> {
+    fn talk<T: Transport>(&mut self, args: &Args, mut link: Link<T>) -> Result<u8, SendError> {
         let info = link.hello().map_err(|e| self.fail(e))?;
         self.fit(args, &info)?;
         // A fitted map has its note already, and `plan --board` of the original map cannot
@@ -443,9 +592,9 @@ impl Sender {
         args: &Args,
         link: &mut Link<T>,
         info: &DeviceInfo,
-    ) -> Result<u8, String> {
+    ) -> Result<u8, SendError> {
         let Some(job) = self.jobs.first() else {
-            return Err("nothing to plan".into());
+            return Err(SendError::NothingToPlan);
         };
         let t0 = Instant::now();
         let result = match link.plan(job.start, job.goal, job.seed) {
@@ -456,7 +605,7 @@ impl Sender {
         let outcome = self.report(job, result, t0.elapsed());
         let (report, ticks) = match outcome {
             Outcome::Report(r, t) => (*r, t),
-            Outcome::BadInput(msg) => return Err(msg),
+            Outcome::BadInput(msg) => return Err(SendError::Answer(msg)),
         };
         let code = if report.found {
             exit::FOUND

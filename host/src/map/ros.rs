@@ -101,25 +101,66 @@ fn number(v: &Value) -> Option<f64> {
     v.as_f64().filter(|f| f.is_finite())
 }
 
+/// What is wrong with a `map_server` YAML file (the caller adds the file's name).
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum YamlError {
+    /// Not YAML at all (the parser's words).
+    #[error("not valid YAML: {0}")]
+    Syntax(String),
+    /// YAML, but not a mapping of fields.
+    #[error("expected a mapping of fields (image, resolution, origin, ...), found {0}")]
+    NotAMapping(String),
+    /// A required field is missing.
+    #[error("missing field `{field}` ({what})")]
+    Missing {
+        /// The field.
+        field: &'static str,
+        /// What it holds.
+        what: &'static str,
+    },
+    /// A field has a value of the wrong kind or range.
+    #[error("field `{field}` must be {want}, found {found}")]
+    Field {
+        /// The field.
+        field: String,
+        /// What it must be.
+        want: &'static str,
+        /// What it is.
+        found: String,
+    },
+    /// The thresholds are the wrong way round.
+    #[error("free_thresh {free} is greater than occupied_thresh {occupied}")]
+    Thresholds {
+        /// `free_thresh`.
+        free: f64,
+        /// `occupied_thresh`.
+        occupied: f64,
+    },
+}
+
 impl RosMeta {
     /// Parse the YAML text of a `map_server` map; `yaml` is the file's path (for the image's
     /// folder). The error is the problem only (the caller adds the file name).
-    pub fn parse(text: &str, yaml: &Path) -> Result<RosMeta, String> {
+    pub fn parse(text: &str, yaml: &Path) -> Result<RosMeta, YamlError> {
         let doc: Value =
-            serde_norway::from_str(text).map_err(|e| format!("not valid YAML: {e}"))?;
+            serde_norway::from_str(text).map_err(|e| YamlError::Syntax(e.to_string()))?;
         let Some(fields) = doc.as_mapping() else {
-            return Err(format!(
-                "expected a mapping of fields (image, resolution, origin, ...), found {}",
-                show(&doc)
-            ));
+            return Err(YamlError::NotAMapping(show(&doc)));
         };
         let field = |name: &str| fields.get(name);
-        let bad = |name: &str, want: &str, v: &Value| {
-            format!("field `{name}` must be {want}, found {}", show(v))
+        let bad = |name: &str, want: &'static str, v: &Value| YamlError::Field {
+            field: name.to_string(),
+            want,
+            found: show(v),
         };
 
         let image = match field("image") {
-            None => return Err("missing field `image` (the PGM or PNG file)".to_string()),
+            None => {
+                return Err(YamlError::Missing {
+                    field: "image",
+                    what: "the PGM or PNG file",
+                })
+            }
             Some(v) => match v.as_str() {
                 Some(s) if !s.trim().is_empty() => s.trim().to_string(),
                 _ => return Err(bad("image", "a file name", v)),
@@ -134,7 +175,12 @@ impl RosMeta {
         };
 
         let resolution = match field("resolution") {
-            None => return Err("missing field `resolution` (metres per pixel)".to_string()),
+            None => {
+                return Err(YamlError::Missing {
+                    field: "resolution",
+                    what: "metres per pixel",
+                })
+            }
             Some(v) => match number(v) {
                 Some(r) if r > 0.0 => r,
                 _ => return Err(bad("resolution", "a number greater than 0", v)),
@@ -143,9 +189,10 @@ impl RosMeta {
 
         let origin = match field("origin") {
             None => {
-                return Err(
-                    "missing field `origin` ([x, y, yaw] of the lower-left pixel)".to_string(),
-                )
+                return Err(YamlError::Missing {
+                    field: "origin",
+                    what: "[x, y, yaw] of the lower-left pixel",
+                })
             }
             Some(v) => {
                 let want = "a list [x, y, yaw] of numbers";
@@ -168,7 +215,7 @@ impl RosMeta {
             },
         };
 
-        let thresh = |name: &str, default: f64| -> Result<f64, String> {
+        let thresh = |name: &str, default: f64| -> Result<f64, YamlError> {
             match field(name) {
                 None => Ok(default),
                 Some(v) => match number(v) {
@@ -180,9 +227,10 @@ impl RosMeta {
         let occupied_thresh = thresh("occupied_thresh", 0.65)?;
         let free_thresh = thresh("free_thresh", 0.196)?;
         if free_thresh > occupied_thresh {
-            return Err(format!(
-                "free_thresh {free_thresh} is greater than occupied_thresh {occupied_thresh}"
-            ));
+            return Err(YamlError::Thresholds {
+                free: free_thresh,
+                occupied: occupied_thresh,
+            });
         }
 
         let mode = match field("mode") {
@@ -243,7 +291,7 @@ pub fn load_ros(yaml: &Path, unknown: Unknown) -> Result<(Map, MapFrame), MapErr
     };
     let text =
         std::fs::read_to_string(yaml).map_err(|e| err(format!("cannot read the file: {e}")))?;
-    let meta = RosMeta::parse(&text, yaml).map_err(err)?;
+    let meta = RosMeta::parse(&text, yaml).map_err(|e| err(e.to_string()))?;
     if !meta.image.exists() {
         return Err(err(format!(
             "image `{}` does not exist",
@@ -281,7 +329,7 @@ mod tests {
     use super::super::image::decode_image;
     use super::*;
 
-    fn meta(text: &str) -> Result<RosMeta, String> {
+    fn meta(text: &str) -> Result<RosMeta, YamlError> {
         RosMeta::parse(text, Path::new("/maps/lab.yaml"))
     }
 
@@ -364,7 +412,7 @@ mod tests {
             ("image: [\n", "not valid YAML"),
         ];
         for (text, want) in cases {
-            let e = meta(text).unwrap_err();
+            let e = meta(text).unwrap_err().to_string();
             assert!(e.starts_with(want), "{text:?}: {e}");
         }
     }

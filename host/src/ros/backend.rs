@@ -13,7 +13,7 @@ use ohaca::{Params, Point};
 
 use crate::link::{DeviceInfo, Link, LinkError, Transport};
 use crate::map::Map;
-use crate::replan::{HostPlanner, Planned, Planner};
+use crate::replan::{HostPlanner, Planned, Planner, ReplanError};
 
 /// Why a backend call failed.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -97,7 +97,9 @@ impl Backend for HostBackend {
         Ok(self.board.as_ref().map(crate::board::capacity))
     }
     fn upload(&mut self, map: &Map) -> Result<(), BackendError> {
-        self.planner.set_map(map).map_err(BackendError::Refused)
+        self.planner
+            .set_map(map)
+            .map_err(|e| BackendError::Refused(e.to_string()))
     }
     fn set_rect(&mut self, rect: (u16, u16, u16, u16), blocked: bool) -> Result<(), BackendError> {
         self.set_cells(&rect_cells(rect), blocked)
@@ -105,12 +107,16 @@ impl Backend for HostBackend {
     fn set_cells(&mut self, cells: &[Point], blocked: bool) -> Result<(), BackendError> {
         self.planner
             .change(cells, blocked)
-            .map_err(BackendError::Refused)
+            .map_err(|e| BackendError::Refused(e.to_string()))
     }
     fn plan(&mut self, start: Point, goal: Point, warm: bool) -> Result<Planned, BackendError> {
-        self.planner
-            .plan(start, goal, warm)
-            .map_err(BackendError::NoPath)
+        self.planner.plan(start, goal, warm).map_err(|e| match e {
+            // The core's own words start with "no path: " (not "no path: no path: ...").
+            ReplanError::Core(ohaca::Error::NoPath) => {
+                BackendError::NoPath("the goal is not reachable from the start".into())
+            }
+            e => BackendError::NoPath(e.to_string()),
+        })
     }
 }
 
@@ -296,7 +302,11 @@ mod tests {
         assert!(second.origin.is_warm());
         assert!(second.raw.iter().all(|p| p.x != 5 || p.y == 9));
         b.set_rect((5, 0, 1, 10), true).unwrap();
-        assert!(matches!(b.plan(s, g, true), Err(BackendError::NoPath(_))));
+        let no = b.plan(s, g, true);
+        assert!(matches!(no, Err(BackendError::NoPath(_))));
+        // Said once: "no path: the goal is ...", not "no path: no path: ...".
+        let text = no.unwrap_err().to_string();
+        assert_eq!(text.matches("no path").count(), 1, "{text}");
     }
 
     #[test]

@@ -65,35 +65,89 @@ impl Occupancy01 {
     }
 }
 
+/// Why an `OccupancyGrid` or an update cannot be applied.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum ConvertError {
+    /// A side of the grid is 0 or over [`MAX_SIDE`].
+    #[error("map {what} {value} is not in 1..={MAX_SIDE}")]
+    Side {
+        /// `width` or `height`.
+        what: &'static str,
+        /// The side given.
+        value: u32,
+    },
+    /// The grid's or the update's data is not width x height cells.
+    #[error("{what} data has {len} cells, but {width}x{height} = {cells}")]
+    Data {
+        /// `map` or `update`.
+        what: &'static str,
+        /// Cells of data.
+        len: usize,
+        /// The width given.
+        width: u32,
+        /// The height given.
+        height: u32,
+        /// Their product.
+        cells: usize,
+    },
+    /// The resolution is not a positive number.
+    #[error("map resolution {0} is not a positive number")]
+    Resolution(f32),
+    /// The origin is not finite.
+    #[error("map origin is not finite")]
+    Origin,
+    /// The update's window misses the map.
+    #[error(
+        "update window {width}x{height} at ({x}, {y}) is off the {map_width}x{map_height} map"
+    )]
+    OffMap {
+        /// The window's width.
+        width: u32,
+        /// The window's height.
+        height: u32,
+        /// Its first column.
+        x: i32,
+        /// Its first row.
+        y: i32,
+        /// The map's width.
+        map_width: u16,
+        /// The map's height.
+        map_height: u16,
+    },
+    /// A cell of the window is off the map.
+    #[error("cell ({}, {}) is off the map", .0.x, .0.y)]
+    Cell(Point),
+}
+
 /// The planner's map and the metric frame of an `OccupancyGrid`, or why it cannot be one.
-pub fn grid_map(g: &OccupancyGrid, rule: &Occupancy01) -> Result<(Map, MapFrame), String> {
+pub fn grid_map(g: &OccupancyGrid, rule: &Occupancy01) -> Result<(Map, MapFrame), ConvertError> {
     let (w, h) = (g.info.width, g.info.height);
-    let side = |v: u32, what: &str| -> Result<u16, String> {
-        u16::try_from(v)
+    let side = |value: u32, what: &'static str| -> Result<u16, ConvertError> {
+        u16::try_from(value)
             .ok()
             .filter(|&s| s > 0 && usize::from(s) <= MAX_SIDE)
-            .ok_or_else(|| format!("map {what} {v} is not in 1..={MAX_SIDE}"))
+            .ok_or(ConvertError::Side { what, value })
     };
     let (w16, h16) = (side(w, "width")?, side(h, "height")?);
     let cells = usize::from(w16) * usize::from(h16);
     if g.data.len() != cells {
-        return Err(format!(
-            "map data has {} cells, but {w}x{h} = {cells}",
-            g.data.len()
-        ));
+        return Err(ConvertError::Data {
+            what: "map",
+            len: g.data.len(),
+            width: w,
+            height: h,
+            cells,
+        });
     }
     // The decimal the publisher meant: map_server's 0.05 arrives as the float32 nearest to it,
     // 0.0500000007 in f64, and an inflation of 0.1 m must stay 2 cells, not 1.99999997.
     let res = decimal_f64(g.info.resolution);
     if !(res.is_finite() && res > 0.0) {
-        return Err(format!(
-            "map resolution {} is not a positive number",
-            g.info.resolution
-        ));
+        return Err(ConvertError::Resolution(g.info.resolution));
     }
     let o = &g.info.origin;
     if !(o.position.x.is_finite() && o.position.y.is_finite()) {
-        return Err("map origin is not finite".into());
+        return Err(ConvertError::Origin);
     }
     let map = Map::from_fn(w16, h16, |x, y| {
         let row = usize::from(h16 - 1 - y);
@@ -123,25 +177,30 @@ pub fn apply_update(
     map: &mut Map,
     u: &OccupancyGridUpdate,
     rule: &Occupancy01,
-) -> Result<(u16, u16, u16, u16), String> {
+) -> Result<(u16, u16, u16, u16), ConvertError> {
     let n = usize::try_from(u64::from(u.width) * u64::from(u.height)).unwrap_or(usize::MAX);
     if u.data.len() != n {
-        return Err(format!(
-            "update data has {} cells, but {}x{} = {n}",
-            u.data.len(),
-            u.width,
-            u.height
-        ));
+        return Err(ConvertError::Data {
+            what: "update",
+            len: u.data.len(),
+            width: u.width,
+            height: u.height,
+            cells: n,
+        });
     }
     let (mw, mh) = (i64::from(map.width), i64::from(map.height));
     let (x0, y0) = (i64::from(u.x), i64::from(u.y));
     let (x1, y1) = (x0 + i64::from(u.width), y0 + i64::from(u.height));
     let (cx0, cy0, cx1, cy1) = (x0.max(0), y0.max(0), x1.min(mw), y1.min(mh));
     if cx0 >= cx1 || cy0 >= cy1 {
-        return Err(format!(
-            "update window {}x{} at ({}, {}) is off the {}x{} map",
-            u.width, u.height, u.x, u.y, map.width, map.height
-        ));
+        return Err(ConvertError::OffMap {
+            width: u.width,
+            height: u.height,
+            x: u.x,
+            y: u.y,
+            map_width: map.width,
+            map_height: map.height,
+        });
     }
     for j in cy0..cy1 {
         for i in cx0..cx1 {
@@ -152,7 +211,7 @@ pub fn apply_update(
                 u16::try_from(mh - 1 - j).unwrap_or(0),
             );
             map.set(p, rule.blocked(v))
-                .map_err(|_| format!("cell ({}, {}) is off the map", p.x, p.y))?;
+                .map_err(|_| ConvertError::Cell(p))?;
         }
     }
     let cell = |v: i64| u16::try_from(v).unwrap_or(0);

@@ -114,13 +114,57 @@ pub struct NodeConfig {
     pub min_replan: Duration,
 }
 
-fn name(s: &str) -> Result<Name, String> {
+/// Why the node cannot start. The ROS 2 and DDS errors are kept in their `Debug` words (they
+/// have no `Display`).
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum NodeError {
+    /// A topic or action name is not a ROS name.
+    #[error("bad ROS name `{name}`: {why}")]
+    Name {
+        /// The name given.
+        name: String,
+        /// ros2-client's reason.
+        why: String,
+    },
+    /// The node's name is not a ROS node name.
+    #[error("bad node name `{name}`: {why}")]
+    NodeName {
+        /// The name given.
+        name: String,
+        /// ros2-client's reason.
+        why: String,
+    },
+    /// DDS did not start on the domain.
+    #[error("cannot start DDS (domain {domain}): {why}")]
+    Dds {
+        /// The DDS domain.
+        domain: u16,
+        /// RustDDS's reason.
+        why: String,
+    },
+    /// The ROS 2 context or the node could not be created.
+    #[error("cannot start ROS 2: {0}")]
+    Ros(String),
+    /// A topic, subscription, publisher or the action server could not be created.
+    #[error("cannot create {what}: {why}")]
+    Create {
+        /// The topic or action name.
+        what: String,
+        /// ros2-client's reason.
+        why: String,
+    },
+}
+
+fn name(s: &str) -> Result<Name, NodeError> {
     let full = if s.starts_with('/') {
         s.to_string()
     } else {
         format!("/{s}")
     };
-    Name::parse(&full).map_err(|e| format!("bad ROS name `{s}`: {e:?}"))
+    Name::parse(&full).map_err(|e| NodeError::Name {
+        name: s.to_string(),
+        why: format!("{e:?}"),
+    })
 }
 
 /// The node's endpoints.
@@ -133,10 +177,13 @@ struct Endpoints {
     info: Publisher<StringMsg>,
 }
 
-fn endpoints(node: &mut Node, cfg: &NodeConfig) -> Result<(Endpoints, PathAction), String> {
+fn endpoints(node: &mut Node, cfg: &NodeConfig) -> Result<(Endpoints, PathAction), NodeError> {
     let t = &cfg.topics;
     let q = &cfg.qos;
-    let e = |what: &str, e: ros2_client::CreateError| format!("cannot create {what}: {e:?}");
+    let e = |what: &str, e: ros2_client::CreateError| NodeError::Create {
+        what: what.to_string(),
+        why: format!("{e:?}"),
+    };
     let topic = |n: &str, pkg: &str, ty: &str, qos: &QosProfile| {
         node.create_topic(&name(n)?, MessageTypeName::new(pkg, ty), qos)
             .map_err(|x| e(n, x))
@@ -312,11 +359,11 @@ impl State {
             "upload_bytes": self.planning.last_upload().map(|u| u.1),
         });
         log::info!(
-            "plan {} ({trigger}): {} poses, {:.2} m, {} iterations, {}, in {:.3} s on {}",
+            "plan {} ({trigger}): {} poses, {:.2} m, {}, {}, in {:.3} s on {}",
             self.seq,
             path.poses.len(),
             length_m,
-            out.planned.iterations,
+            crate::output::count(u64::from(out.planned.iterations), "iteration"),
             out.origin,
             out.elapsed.as_secs_f64(),
             self.planning.describe()
@@ -503,21 +550,27 @@ impl State {
 }
 
 /// Run the node until killed (or for `cfg.run_for`).
-pub fn run(cfg: NodeConfig, planning: Planning) -> Result<(), String> {
+pub fn run(cfg: NodeConfig, planning: Planning) -> Result<(), NodeError> {
     let mut builder = DomainParticipantBuilder::new(cfg.domain);
     if !cfg.only_networks.is_empty() {
         builder = builder.with_only_networks(cfg.only_networks.iter().copied());
     }
-    let participant = builder
-        .build()
-        .map_err(|e| format!("cannot start DDS (domain {}): {e:?}", cfg.domain))?;
+    let participant = builder.build().map_err(|e| NodeError::Dds {
+        domain: cfg.domain,
+        why: format!("{e:?}"),
+    })?;
     let context = Context::from_domain_participant(participant)
-        .map_err(|e| format!("cannot start ROS 2: {e:?}"))?;
-    let node_name = NodeName::new("/", &cfg.name)
-        .map_err(|e| format!("bad node name `{}`: {e:?}", cfg.name))?;
+        .map_err(|e| NodeError::Ros(format!("{e:?}")))?;
+    let node_name = NodeName::new("/", &cfg.name).map_err(|e| NodeError::NodeName {
+        name: cfg.name.clone(),
+        why: format!("{e:?}"),
+    })?;
     let mut node = context
         .new_node(node_name, NodeOptions::new().enable_rosout(false))
-        .map_err(|e| format!("cannot create the node: {e:?}"))?;
+        .map_err(|e| NodeError::Create {
+            what: "the node".into(),
+            why: format!("{e:?}"),
+        })?;
     let (ep, mut action) = endpoints(&mut node, &cfg)?;
     let t = &cfg.topics;
     log::info!(

@@ -214,8 +214,8 @@ impl Planning {
     /// A new map (`/map`): classified, inflated, fitted and sent. A map the backend could not
     /// take is kept (the error says so) and sent at the next plan.
     pub fn set_grid(&mut self, g: &OccupancyGrid) -> Result<MapNote, PlanError> {
-        let (grid, frame) =
-            grid_map(g, &self.rule).map_err(|e| PlanError::new(error_code::UNKNOWN, e))?;
+        let (grid, frame) = grid_map(g, &self.rule)
+            .map_err(|e| PlanError::new(error_code::UNKNOWN, e.to_string()))?;
         let map = self.inflated(&grid, &frame);
         self.loaded = Some(Loaded {
             grid,
@@ -282,7 +282,7 @@ impl Planning {
             ));
         };
         let window = apply_update(&mut l.grid, u, &self.rule)
-            .map_err(|e| PlanError::new(error_code::UNKNOWN, e))?;
+            .map_err(|e| PlanError::new(error_code::UNKNOWN, e.to_string()))?;
         let (grid, frame) = (l.grid.clone(), l.frame);
         let map = self.inflated(&grid, &frame);
         let Some(l) = self.loaded.as_mut() else {

@@ -11,7 +11,7 @@ use ohaca::Point;
 
 use crate::map::Map;
 use crate::replan::{Drive, Planned, Step};
-use crate::strip::{save_gif, save_strip};
+use crate::strip::{save_gif, save_strip, StripError};
 
 /// See the module docs.
 pub struct Recorder {
@@ -58,7 +58,7 @@ impl Recorder {
         map: &Map,
         (start, goal): (Point, Point),
         plan: &Planned,
-    ) -> Result<(), String> {
+    ) -> Result<(), StripError> {
         if self.goal != Some(goal)
             || self
                 .steps

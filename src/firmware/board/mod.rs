@@ -83,7 +83,7 @@ pub trait Board {
 
 /// Log when request `id`'s frame ended on the line, on a board that records it: with
 /// [`log_reply`], the device-side latency of each answer in ticks (under `qemu-system-arm -icount
-/// shift=0` one tick is 1000 instructions; `host/tests/qemu_paced.rs` reads these lines).
+/// shift=0` one tick is 1000 instructions; `host/tests/qemu/paced.rs` reads these lines).
 pub fn log_request(id: u32) {
     if let Some(t) = Active::frame_end() {
         defmt::info!("request {=u32} in at {=u64}", id, t);

@@ -17,9 +17,7 @@
 //! Each test boots its own QEMU; `OHACA_SKIP_QEMU=1` skips them when `qemu-system-arm` is
 //! missing.
 
-#[macro_use]
-#[path = "common/qemu.rs"]
-mod qemu;
+use crate::qemu;
 
 use std::time::{Duration, Instant};
 

@@ -12,9 +12,7 @@
 //! Upload and plan times are printed (`-- --nocapture`), not asserted: the whole file takes
 //! about 20 s on a 2-core machine (BENCHMARKS.md, section 5).
 
-#[macro_use]
-#[path = "common/qemu.rs"]
-mod qemu;
+use crate::qemu;
 
 use std::time::Instant;
 
@@ -126,7 +124,7 @@ fn a_1024x1024_city_plans_bit_identical_to_the_host() {
 }
 
 /// `maze-128-128-2`'s longest scenario (a maze of 2-wide corridors; the optimum has 1,379 steps,
-/// which the STM32F411 build's 2,047 also hold: `qemu_e2e`'s
+/// which the STM32F411 build's 2,047 also hold: `qemu/e2e.rs`'s
 /// `the_longest_maze_128_128_2_scenario_plans_on_the_device`): the twin plans it, bit for bit as
 /// the host core with the twin's capacity, and its raw path is the optimum.
 #[test]

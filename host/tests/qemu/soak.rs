@@ -78,9 +78,7 @@
 //! `soak_over_the_relay`'s 1 000 frames at 921 600 took 6 to 9 s (it now runs at 115 200): so the default is the full
 //! 10 000 over TCP, and 1 000 through the relay.
 
-#[macro_use]
-#[path = "common/qemu.rs"]
-mod qemu;
+use crate::qemu;
 
 use std::collections::{BTreeMap, VecDeque};
 use std::io::Write;

@@ -1,5 +1,5 @@
 //! Generated maps the end-to-end tests share: a 604 x 307 depot, the shape of Nav2's sample
-//! depot (`#[path]`-included by the tests that use it).
+//! depot (`large.rs` and `soak_twin.rs` use it).
 
 use ohaca_host::rng::Rng;
 use ohaca_host::Map;

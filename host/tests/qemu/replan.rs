@@ -2,12 +2,10 @@
 //! (`ohaca_host::replan`) gives the device exactly the host core's plans, warm and cold, and the
 //! device keeps its colony only when `docs/PROTOCOL.md` says it does.
 //!
-//! Like `qemu_e2e.rs`, each test boots its own QEMU; without `qemu-system-arm` the tests fail
+//! Like `qemu/e2e.rs`, each test boots its own QEMU; without `qemu-system-arm` the tests fail
 //! unless `OHACA_SKIP_QEMU=1`.
 
-#[macro_use]
-#[path = "common/qemu.rs"]
-mod qemu;
+use crate::qemu;
 
 use ohaca::{Params, Point};
 use ohaca_host::link::Link;

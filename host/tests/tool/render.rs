@@ -1,7 +1,7 @@
 //! `ohaca render` end to end: valid SVG and PNG files, the path drawn in its colour, overlays,
 //! the pheromone heat map, bad input.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 

@@ -1,6 +1,6 @@
 //! `ohaca plan --format json|csv|text` and the `--json` alias.
 
-mod common;
+use crate::common;
 
 use common::*;
 

@@ -1,7 +1,7 @@
 //! `ohaca experiment` end to end: every output file, determinism across thread counts with
 //! `--no-timing`, bad input.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 

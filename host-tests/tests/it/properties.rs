@@ -273,7 +273,7 @@ proptest! {
     #[test]
     fn smoothing_only_changes_the_output((m, s, g) in gen::case(16), p in small_params()) {
         // The local search changes the raw path (and the patience), so it is off here: with it
-        // OHACA's raw path is no longer HACA's (`small_maps_get_the_optimal_raw_path` and tests/refine.rs cover it).
+        // OHACA's raw path is no longer HACA's (`small_maps_get_the_optimal_raw_path` and tests/it/refine.rs cover it).
         let p = Params { refine: false, ..p };
         let mut st = heap::storage(m.cells());
         let cap = heap::DEFAULT_CURVE;

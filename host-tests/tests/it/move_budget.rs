@@ -8,7 +8,7 @@
 //!   abandons none, and the raw path is still the 8-connected optimum;
 //! - the run makes far fewer moves than the same run without the budget would (the paper preset's
 //!   colony, which has none, abandons nothing);
-//! - host and device run the same code: `host/tests/qemu_e2e.rs` compares their paths bit for bit.
+//! - host and device run the same code: `host/tests/qemu/e2e.rs` compares their paths bit for bit.
 
 use ohaca::{Params, Run};
 use ohaca_host_tests::large::load_large;

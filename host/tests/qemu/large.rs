@@ -7,11 +7,8 @@
 //! Each test boots its own QEMU; without `qemu-system-arm` the tests fail unless
 //! `OHACA_SKIP_QEMU=1`. Upload and plan times are printed (`-- --nocapture`), not asserted.
 
-#[macro_use]
-#[path = "common/qemu.rs"]
-mod qemu;
-#[path = "common/depot.rs"]
-mod depot;
+use crate::depot;
+use crate::qemu;
 
 use std::time::Instant;
 

@@ -14,9 +14,7 @@
 //!
 //! Without `qemu-system-arm` it fails unless `OHACA_SKIP_QEMU=1`.
 
-#[macro_use]
-#[path = "common/qemu.rs"]
-mod qemu;
+use crate::qemu;
 
 use std::net::TcpStream;
 use std::process::{Command, Stdio};

@@ -1,12 +1,12 @@
-//! QEMU helpers shared by the firmware's end-to-end tests (`qemu_e2e.rs`, `qemu_soak.rs`):
+//! QEMU helpers shared by the firmware's end-to-end tests (`e2e.rs`, `soak.rs`, ...):
 //! build the firmware once, boot it in `qemu-system-arm -M mps2-an386` with UART0 on a free
 //! local TCP port (or a pty; or behind the pacing relay at a real baud rate: [`boot_paced`]),
 //! connect a [`Link`], build broken frames, and compute what the
 //! device must answer with the protocol's own reader and decoder, and what its plans must be
 //! with the host's copy of the core.
 //!
-//! Include it with `#[macro_use] #[path = "common/qemu.rs"] mod qemu;` (it is not part of
-//! `common/mod.rs`, so the other tests do not compile it).
+//! `main.rs` declares it first, with `#[macro_use]`, so every module sees `need_qemu!`; the
+//! modules import it with `use crate::qemu;`.
 #![allow(dead_code)]
 
 use std::collections::HashMap;
@@ -548,7 +548,7 @@ pub struct CorePath {
 }
 
 /// The default QEMU firmware's longest ant path, the STM32F411's (`ohaca::board::F411`, Hello's
-/// `capacity.max_steps`; `qemu_e2e`'s maze test checks it against Hello).
+/// `capacity.max_steps`; `qemu/e2e.rs`'s maze test checks it against Hello).
 pub const DEVICE_STEPS: usize = ohaca::board::F411.max_steps;
 
 /// Plan as the firmware does (`ohaca::plan` on the map's grid), on the host: the path, or the

@@ -1,7 +1,7 @@
 //! Real robot maps end to end: ROS map_server YAML + PGM/PNG written by the tests, the image
 //! y-axis flip, `negate`, unknown cells, inflation, resampling, metres in and out, errors.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 

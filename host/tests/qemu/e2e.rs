@@ -6,14 +6,12 @@
 //! the workspace root (a no-op when it is up to date; set `OHACA_FIRMWARE=path/to/elf` to use
 //! another ELF and skip the build). Without `qemu-system-arm` the tests fail, unless
 //! `OHACA_SKIP_QEMU=1` is set: then each prints a `SKIPPED` line and returns. The QEMU helpers are shared with the
-//! soak test (`qemu_soak.rs`) in `common/qemu.rs`.
+//! soak tests (`soak.rs`) in `qemu.rs`.
 //!
 //! Nothing here asserts on time: every wait is bounded by generous timeouts, and latencies are
 //! only printed (`cargo test ... -- --nocapture`).
 
-#[macro_use]
-#[path = "common/qemu.rs"]
-mod qemu;
+use crate::qemu;
 
 use std::io::{Read, Write};
 use std::net::TcpListener;
@@ -1575,7 +1573,7 @@ fn cell_updates_between_plans_change_the_answer() {
     assert_core_path("through the gap", &host, &dev);
     assert!(dev.raw(s).expect("raw").contains(&Point::new(10, 3)));
     // The cold plan through the gap recorded its colony: this one keeps it (the host's warm
-    // replans are checked against the device's in `qemu_replan.rs`).
+    // replans are checked against the device's in `qemu/replan.rs`).
     let warm = link.plan_warm(s, g, None).expect("warm");
     assert!(
         warm.origin.is_warm(),

@@ -1,7 +1,7 @@
 //! Faults at scale (issue 19, item 7): map uploads of 512 x 512 and 604 x 307 cells over QEMU's
 //! UART with injected byte drops and corruption, against the STM32H743's capacity twin and
 //! against the F411-capacity firmware (the default QEMU build), which holds these maps in its
-//! arena (`ohaca::planner::arena`); `qemu_soak.rs` soaks the latter with many small frames.
+//! arena (`ohaca::planner::arena`); `qemu/soak.rs` soaks the latter with many small frames.
 //!
 //! Each round uploads `NewYork_0_512` (512 x 512, a city) and a generated 604 x 307 depot (the
 //! shape of Nav2's sample depot: walls, racks, aisles, noise), each raw and run-length coded,
@@ -32,9 +32,7 @@
 //! `scripts/soak.sh` runs more rounds as its second phase. A summary is printed
 //! (`--nocapture`).
 
-#[macro_use]
-#[path = "common/qemu.rs"]
-mod qemu;
+use crate::qemu;
 
 use std::io::Write;
 use std::net::TcpStream;
@@ -70,8 +68,7 @@ const DEVICE_WINDOW: (usize, usize) = (ohaca::board::H743.window, ohaca::board::
 /// How long one reply may take (a plan on 512 x 512 without `-icount` takes a second or two).
 const REPLY_TIMEOUT: Duration = Duration::from_secs(120);
 
-#[path = "common/depot.rs"]
-mod depot;
+use crate::depot;
 use depot::depot;
 use ohaca_host::rng::Rng;
 

@@ -7,12 +7,10 @@
 //! that passed on the line). Latencies in wall time are only printed (`-- --nocapture`; they are
 //! BENCHMARKS.md's "link" numbers).
 //!
-//! Like `qemu_e2e.rs`, each test boots its own QEMU; `OHACA_SKIP_QEMU=1` skips them when
+//! Like `qemu/e2e.rs`, each test boots its own QEMU; `OHACA_SKIP_QEMU=1` skips them when
 //! `qemu-system-arm` is missing.
 
-#[macro_use]
-#[path = "common/qemu.rs"]
-mod qemu;
+use crate::qemu;
 
 use std::time::{Duration, Instant};
 
@@ -450,7 +448,7 @@ fn stats_and_a_cell_update_pass_a_long_path() {
 }
 
 /// A Cancel sent while a long path goes out is answered within 50 ms of the line, the path stops
-/// (no part after the Cancel's answer: `qemu_responsive.rs` repeats it 200 times) and its plan
+/// (no part after the Cancel's answer: `qemu/responsive.rs` repeats it 200 times) and its plan
 /// gets `Cancelled`;
 /// the device then plans and answers as before.
 #[test]
