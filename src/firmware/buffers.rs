@@ -84,24 +84,33 @@ mod layout {
     pub const BYTES: usize = 4 * WORDS - MAP_BYTES;
 
     /// The arena: the map in its first [`MAP_BYTES`] bytes (what the receiver writes and
-    /// `Deref` shows), the planner's buffers after the map of each plan (`lend`); and what the
-    /// pheromone in it remembers of the last plan (`ohaca::planner::Memory`), under the same
-    /// lock as the map whose changes it records.
+    /// `Deref` shows), the planner's buffers after the map of each plan (`lend`), lent to the
+    /// lock once at boot by [`take`] (empty before); and what the pheromone in it remembers of
+    /// the last plan (`ohaca::planner::Memory`), under the same lock as the map whose changes it
+    /// records. The arena is a static of its own, zeroed in `.bss`: inside the lock beside the
+    /// memory's initial value it would be 101 KiB of initialised `.data` in flash.
     pub struct MapBuf {
-        words: [u32; WORDS],
+        words: Option<&'static mut [u32; WORDS]>,
         memory: Memory,
     }
 
-    /// Its value at boot (zeroed, in `.bss`; no plan remembered).
+    /// Its value at boot: no arena yet, no plan remembered.
     pub const MAP_INIT: MapBuf = MapBuf {
-        words: [0; WORDS],
+        words: None,
         memory: Memory::new(),
     };
+
+    /// The arena's words, zeroed (`.bss`), lent to `state::MAP` by [`take`].
+    static ARENA: ConstStaticCell<[u32; WORDS]> = ConstStaticCell::new([0; WORDS]);
 
     impl MapBuf {
         /// The map's bytes and the colony memory, both writable at once.
         pub fn split(&mut self) -> (&mut [u8], &mut Memory) {
-            let bytes: &mut [u8] = bytemuck::cast_slice_mut(&mut self.words[..]);
+            let words: &mut [u32] = match &mut self.words {
+                Some(w) => &mut w[..],
+                None => &mut [],
+            };
+            let bytes: &mut [u8] = bytemuck::cast_slice_mut(words);
             (
                 bytes.get_mut(..MAP_BYTES).unwrap_or(&mut []),
                 &mut self.memory,
@@ -112,7 +121,8 @@ mod layout {
     impl core::ops::Deref for MapBuf {
         type Target = [u8];
         fn deref(&self) -> &[u8] {
-            let bytes: &[u8] = bytemuck::cast_slice(&self.words[..]);
+            let words: &[u32] = self.words.as_deref().map_or(&[], |w| &w[..]);
+            let bytes: &[u8] = bytemuck::cast_slice(words);
             bytes.get(..MAP_BYTES).unwrap_or(&[])
         }
     }
@@ -133,7 +143,11 @@ mod layout {
         height: u16,
     ) -> Result<(Grid<'a>, Workspace<'a>, &'a mut Memory), ohaca::Error> {
         let cells = usize::from(width) * usize::from(height);
-        let carved = arena::carve(&mut map.words, cells, PLAN_STEPS)?;
+        let words: &'a mut [u32] = match &mut map.words {
+            Some(w) => &mut w[..],
+            None => &mut [],
+        };
+        let carved = arena::carve(words, cells, PLAN_STEPS)?;
         let bits: &'a [u8] = carved.map;
         Ok((
             Grid::new(width, height, bits)?,
@@ -144,10 +158,14 @@ mod layout {
 
     static STORAGE: ConstStaticCell<PlanStorage> = ConstStaticCell::new(PlanStorage);
 
-    /// Hand out the planner's storage (the arena is already the map buffer behind `_map`, the
-    /// lock `state::MAP`). Call once, at boot, before any task runs; a second call panics.
-    pub fn take(_map: &super::MapLock) -> &'static mut PlanStorage {
-        STORAGE.take()
+    /// Hand out the planner's storage and lend the arena to the map buffer behind `map_lock`
+    /// (the lock `state::MAP`): the one place that does. Call once, at boot, before any task
+    /// runs; a second call panics.
+    pub fn take(map_lock: &super::MapLock) -> &'static mut PlanStorage {
+        let storage = STORAGE.take();
+        let mut buf = defmt::unwrap!(map_lock.try_lock().ok(), "the map buffer is locked at boot");
+        buf.words = Some(ARENA.take());
+        storage
     }
 }
 
