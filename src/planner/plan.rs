@@ -4,6 +4,7 @@
 use crate::map::grid::{neighbour, Dir, Point};
 
 use super::params::Params;
+use super::warm::Memory;
 
 /// One point of the convergence curve.
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
@@ -63,6 +64,49 @@ impl core::fmt::Display for Origin {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         f.write_str(self.name())
     }
+}
+
+/// A replan answered from the last answer (`reuse::answer`, or its repair): its lengths and
+/// origin; where it lies
+/// in the workspace is the memory's answer now. It borrows nothing, so a caller that owns the
+/// workspace can still hand it to a run when there is no such answer
+/// ([`super::session::answer`]).
+#[derive(Clone, Copy, Debug)]
+pub struct Reused {
+    pub(super) raw_length: f32,
+    pub(super) length: f32,
+    pub(super) origin: Origin,
+}
+
+impl Reused {
+    /// The plan: the memory's answer's raw path in `best` and waypoints in `points` (ranges
+    /// the answer checked before it recorded them).
+    pub(super) fn plan<'a>(
+        self,
+        best: &'a [Dir],
+        points: &'a [Point],
+        memory: &Memory,
+        params: &Params,
+    ) -> Plan<'a> {
+        let (start, tour, waypoints) = match memory.answer {
+            Some(a) => (
+                a.start,
+                best.get(index(a.from)..index(a.steps)).unwrap_or_default(),
+                points.get(index(a.first)..index(a.end)).unwrap_or_default(),
+            ),
+            None => (Point::new(0, 0), &[][..], &[][..]),
+        };
+        Plan::without_run(
+            (start, tour, waypoints),
+            (self.raw_length, self.length),
+            self.origin,
+            *params,
+        )
+    }
+}
+
+fn index(v: u32) -> usize {
+    usize::try_from(v).unwrap_or(usize::MAX)
 }
 
 /// The result of a run. Borrows the workspace it was computed in.

@@ -48,6 +48,7 @@ use crate::map::grid::{is_diagonal, neighbour, Dir, Grid, Point};
 use crate::polish::smoothing::SmoothingKind;
 
 use super::params::{Algorithm, Params};
+use super::plan::Reused;
 use super::plan::{Origin, Plan};
 use super::repair::GiveUp;
 use super::warm::{Answer, Memory};
@@ -100,44 +101,6 @@ pub fn reuse<'a>(
     let reused = answer(grid, start, goal, params, ws, memory)?;
     let Workspace { best, points, .. } = ws;
     Ok(reused.plan(best, points, memory, params))
-}
-
-/// A replan answered from the last answer ([`answer`]): its lengths and origin; where it lies
-/// in the workspace is the memory's answer now. It borrows nothing, so a caller that owns the
-/// workspace can still hand it to a run when there is no such answer
-/// ([`super::session::answer`]).
-#[derive(Clone, Copy, Debug)]
-pub struct Reused {
-    pub(super) raw_length: f32,
-    pub(super) length: f32,
-    pub(super) origin: Origin,
-}
-
-impl Reused {
-    /// The plan: the memory's answer's raw path in `best` and waypoints in `points` (ranges
-    /// [`answer`] checked before it recorded them).
-    pub(super) fn plan<'a>(
-        self,
-        best: &'a [Dir],
-        points: &'a [Point],
-        memory: &Memory,
-        params: &Params,
-    ) -> Plan<'a> {
-        let (start, tour, waypoints) = match memory.answer {
-            Some(a) => (
-                a.start,
-                best.get(idx(a.from)..idx(a.steps)).unwrap_or_default(),
-                points.get(idx(a.first)..idx(a.end)).unwrap_or_default(),
-            ),
-            None => (Point::new(0, 0), &[][..], &[][..]),
-        };
-        Plan::without_run(
-            (start, tour, waypoints),
-            (self.raw_length, self.length),
-            self.origin,
-            *params,
-        )
-    }
 }
 
 /// [`reuse`]'s answer without its plan: the memory's answer is the new one on success.

@@ -16,7 +16,7 @@
 use crate::error::Error;
 use crate::map::grid::{Grid, Point};
 
-pub use super::reuse::Reused;
+pub use super::plan::Reused;
 
 use super::params::Params;
 use super::plan::Plan;

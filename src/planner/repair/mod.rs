@@ -68,7 +68,7 @@ use crate::polish::smoothing::{Smoother, SmoothingKind};
 use super::lend::Polishing;
 use super::params::{Algorithm, Params};
 use super::plan::Origin;
-use super::reuse::Reused;
+use super::plan::Reused;
 use super::warm::{Answer, Memory};
 use super::workspace::Workspace;
 
