@@ -2,8 +2,8 @@
 //! that hands them out at boot: [`take`].
 //!
 //! - **STM32F411 and the default QEMU board** (maps of up to 262,144 cells, paths of up to
-//!   4,095 steps, 2,047 in the full layout): one arena of 103,424 bytes in `.bss`, inside
-//!   `state::MAP`'s lock: the map in its first bytes, the planner's buffers after it, laid out per map by
+//!   4,095 steps, 2,047 in the full layout): one arena of 103,424 bytes, a zeroed static in
+//!   `.bss` lent to `state::MAP`'s lock at boot ([`take`]): the map in its first bytes, the planner's buffers after it, laid out per map by
 //!   `ohaca::planner::arena::carve` when a plan starts ([`lend`]). A 256 x 256 map leaves the
 //!   planner every buffer a fixed 95,232-byte `Storage` would have; a 512 x 512 one takes 32 KiB and
 //!   leaves the compact layout (4,095-step paths, `ohaca::planner::arena`'s docs).
