@@ -372,43 +372,55 @@ impl Tightening {
 /// smallest power of two of at least `2n` (load factor at most 1/2) when it fits, else half of
 /// that if it still has at least `ceil(3n / 2)` slots (load factor at most 2/3), else `None` (the
 /// path is left untightened). Two 16-bit slots a word for paths of fewer than 65,535 cells.
-fn hash_slots(n: usize, words: usize) -> Option<usize> {
-    let want = n.checked_mul(2)?.checked_next_power_of_two()?;
-    let half = n < u16::MAX as usize;
-    let fits = |slots: usize| words >= if half { slots.div_ceil(2) } else { slots };
-    if fits(want) {
+const fn hash_slots(n: usize, words: usize) -> Option<usize> {
+    let Some(want) = table_slots(n) else {
+        return None;
+    };
+    if words >= slot_words(want, n) {
         return Some(want);
     }
     // At least 3n/2 slots, rounded up (`n + ceil(n / 2) <= 2n`, which did not overflow).
     let fewer = want >> 1;
-    if fewer >= n.wrapping_add(n.div_ceil(2)) && fits(fewer) {
+    if fewer >= n.wrapping_add(n.div_ceil(2)) && words >= slot_words(fewer, n) {
         Some(fewer)
     } else {
         None
     }
 }
 
-/// The fewest words of `pos` with which [`tighten`] tightens every path of up to `n` cells
-/// (rather than leaving it unchanged) on a map of more cells: its hash table's, at a load factor
-/// of up to 2/3 (`hash_slots`). `usize::MAX` if no table holds `n` cells.
-pub const fn hash_words(n: usize) -> usize {
-    // Either the smallest table of a load factor <= 1/2, or the one half its size.
-    let Some(twice) = n.checked_mul(2) else {
-        return usize::MAX;
-    };
-    let Some(want) = twice.checked_next_power_of_two() else {
-        return usize::MAX;
-    };
-    let half = n < u16::MAX as usize;
-    let slots = if (want >> 1) >= n.wrapping_add(n.div_ceil(2)) {
-        want >> 1
-    } else {
-        want
-    };
-    if half {
+/// The slots of the smallest table of a load factor of at most 1/2 for `n` cells (a power of
+/// two); `None` on overflow.
+const fn table_slots(n: usize) -> Option<usize> {
+    match n.checked_mul(2) {
+        Some(twice) => twice.checked_next_power_of_two(),
+        None => None,
+    }
+}
+
+/// Words of a table of `slots` slots for paths of `n` cells: two 16-bit slots a word while the
+/// positions fit 16 bits, else a word a slot.
+const fn slot_words(slots: usize, n: usize) -> usize {
+    if n < u16::MAX as usize {
         slots.div_ceil(2)
     } else {
         slots
+    }
+}
+
+/// The fewest words of `pos` with which [`tighten`] tightens every path of up to `n` cells
+/// (rather than leaving it unchanged) on a map of more cells: the fewest words `hash_slots`
+/// accepts (the table half the smallest of load 1/2 when it stays at a load of at most 2/3,
+/// else that one), derived from it rather than written again. `usize::MAX` if no table holds
+/// `n` cells.
+pub const fn hash_words(n: usize) -> usize {
+    let Some(want) = table_slots(n) else {
+        return usize::MAX;
+    };
+    let fewer = slot_words(want >> 1, n);
+    if hash_slots(n, fewer).is_some() {
+        fewer
+    } else {
+        slot_words(want, n)
     }
 }
 
@@ -1052,5 +1064,17 @@ mod tests {
             shortened += usize::from(direct.0.steps < wd.walk.steps);
         });
         assert!(shortened >= 6, "{shortened}");
+    }
+
+    #[test]
+    fn hash_words_is_the_fewest_words_hash_slots_takes() {
+        // The sizing and the table agree: with `hash_words(n)` words the table is built, with
+        // one word fewer it is not (and more words never hurt), across the 16-bit boundary.
+        for n in (1..5_000).chain(65_000..65_600) {
+            let w = hash_words(n);
+            assert!(hash_slots(n, w).is_some(), "{n}");
+            assert!(hash_slots(n, w - 1).is_none(), "{n}");
+            assert!(hash_slots(n, w + 1).is_some(), "{n}");
+        }
     }
 }
