@@ -89,11 +89,14 @@ impl Reused {
         params: &Params,
     ) -> Plan<'a> {
         let (start, tour, waypoints) = match memory.answer {
-            Some(a) => (
-                a.start,
-                best.get(index(a.from)..index(a.steps)).unwrap_or_default(),
-                points.get(index(a.first)..index(a.end)).unwrap_or_default(),
-            ),
+            Some(a) => {
+                let (tour, waypoints) = a.ranges();
+                (
+                    a.start,
+                    best.get(tour).unwrap_or_default(),
+                    points.get(waypoints).unwrap_or_default(),
+                )
+            }
             None => (Point::new(0, 0), &[][..], &[][..]),
         };
         Plan::without_run(
@@ -103,10 +106,6 @@ impl Reused {
             *params,
         )
     }
-}
-
-fn index(v: u32) -> usize {
-    usize::try_from(v).unwrap_or(usize::MAX)
 }
 
 /// The result of a run. Borrows the workspace it was computed in.

@@ -120,8 +120,13 @@ pub(super) fn answer(
     if answer.params != (Params { seed: 0, ..*params }) {
         return Err(NoAnswer);
     }
-    let (from, steps) = (idx(answer.from), idx(answer.steps));
-    let (first, end) = (idx(answer.first), idx(answer.end));
+    let (
+        core::ops::Range {
+            start: from,
+            end: steps,
+        },
+        core::ops::Range { start: first, end },
+    ) = answer.ranges();
     // 1. The robot's cell on the raw path.
     let tour: &[Dir] = ws.best.get(from..steps).ok_or(NoAnswer)?;
     let mut p = answer.start;
@@ -204,10 +209,6 @@ pub(super) fn answer(
         length,
         origin: Origin::Reused,
     })
-}
-
-fn idx(v: u32) -> usize {
-    usize::try_from(v).unwrap_or(usize::MAX)
 }
 
 /// The index `e >= 1` of the waypoint that ends the segment `wps[e - 1]..wps[e]` nearest to `p`

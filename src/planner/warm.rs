@@ -246,6 +246,16 @@ pub(super) struct Answer {
     pub(super) params: super::Params,
 }
 
+impl Answer {
+    /// Where it lies: its raw path's directions in the best tour (`from..steps`) and its
+    /// waypoints in `points` (`first..end`), as indices (saturating: a range past a buffer reads
+    /// as absent).
+    pub(super) fn ranges(&self) -> (core::ops::Range<usize>, core::ops::Range<usize>) {
+        let at = |v: u32| usize::try_from(v).unwrap_or(usize::MAX);
+        (at(self.from)..at(self.steps), at(self.first)..at(self.end))
+    }
+}
+
 /// What a run left in the workspace besides its pheromone and its answer ([`super::Run::keep`]):
 /// its pruning marks, and maybe its coarse route's links.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -168,9 +168,13 @@ pub(super) fn repair(
     entry: usize,
 ) -> Result<Reused, GiveUp> {
     use GiveUp::{NoRoom, StillBlocked, Unplaced};
-    let idx = |v: u32| usize::try_from(v).unwrap_or(usize::MAX);
-    let (from, steps) = (idx(answer.from), idx(answer.steps));
-    let (first, end) = (idx(answer.first), idx(answer.end));
+    let (
+        core::ops::Range {
+            start: from,
+            end: steps,
+        },
+        core::ops::Range { start: first, end },
+    ) = answer.ranges();
     // The robot's direction in `best`.
     let base = from.checked_add(at).ok_or(Unplaced)?;
     // The answer, the increments and the buffers idle between plans (`lend::Polishing`).
