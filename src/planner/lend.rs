@@ -104,11 +104,9 @@ impl Idle<'_> {
         let Guide::Words(words) = guide else {
             return None;
         };
-        let heap = if self.links.len() >= count {
-            &mut *self.links
-        } else {
-            &mut *self.tabu
-        };
+        let lent = Lent::new(self.links, self.tabu, &mut [], &mut []);
+        let take = heap_take(lent.lengths(), count);
+        let (heap, _) = lent.take(take)?;
         Some((words, heap))
     }
 
@@ -465,6 +463,16 @@ pub(super) const fn route_take(l: Lengths, count: usize) -> Option<Take> {
         (false, false) => Take::Halves(Buf::Links, count),
     };
     take.within(l)
+}
+
+/// The heap of a word-a-block route of `count` blocks (the full layout): the links when they hold
+/// `count` words, else the tabu set.
+pub(super) const fn heap_take(l: Lengths, count: usize) -> Take {
+    if l.links >= count {
+        Take::Whole(Buf::Links)
+    } else {
+        Take::Whole(Buf::Tabu)
+    }
 }
 
 /// The smoothing's links for a raw path of `n` cells: the links when they hold `n`, else the
