@@ -258,6 +258,9 @@ fn wire_frame_seeds(root: &Path) -> Result<Vec<(String, Vec<u8>)>> {
             max_request: MAX_REQUEST as u16,
             plan_queue: 4,
             tick_hz: 1_000_000,
+            // The QEMU board's, from its description.
+            window: ohaca::board::F411.window as u8,
+            window_bytes: ohaca::board::F411.rx_ring as u16,
         },
         defaults: Params::default(),
     };
@@ -290,7 +293,7 @@ fn wire_frame_seeds(root: &Path) -> Result<Vec<(String, Vec<u8>)>> {
         moves: 4200,
         ticks: 1689,
         raw_cells: 41,
-        warm: true,
+        origin: ohaca::planner::Origin::Warm,
         waypoints: Waypoints::Points(&points),
         directions: &directions,
     };
