@@ -173,6 +173,15 @@ pub fn try_shortest(
     // of the entries are closed: each cell is moved O(1) times on average.
     let mut live = list.len();
     let mut closed = 0usize;
+    // The live cells in runs of `RUN` (see [`Run`]), in `open`'s tail when it has room (beyond
+    // the `v` entries the open list can ever hold); without room, one run of every live cell
+    // and no bulk skips.
+    let (open, runs) = if open.len() >= v.saturating_add(runs_words(v)) {
+        open.split_at_mut(v)
+    } else {
+        (open, &mut [][..])
+    };
+    let mut nruns = build_runs(grid, list, live, cell, runs);
     let mut shadows = Shadows::new();
     // A*: expand the open cell of least g + h (the first one on ties) until the goal closes.
     while open_len > 0 {
@@ -212,52 +221,73 @@ pub fn try_shortest(
                 }
             }
             (live, closed) = (k, 0);
+            nruns = build_runs(grid, list, live, cell, runs);
         }
         let p = grid.point(i);
         let limit = cell.get(t).map_or(bound, |e| e.g.min(bound));
-        for &c in list.iter().take(live) {
-            let q = unpack(c);
-            let j = grid.index(q);
-            let Some(e) = cell.get(j) else { continue };
-            if e.closed() {
+        for r in 0..nruns {
+            let (from, to) = if runs.is_empty() {
+                (0, live)
+            } else {
+                let from = r.wrapping_mul(RUN);
+                (from, from.saturating_add(RUN).min(live))
+            };
+            let run = runs
+                .get(r.wrapping_mul(RUN_WORDS)..r.wrapping_add(1).wrapping_mul(RUN_WORDS))
+                .and_then(Run::read);
+            if run.is_some_and(|run| run.skips(p, gi, limit)) {
                 continue;
             }
-            // Lower bounds of the Euclidean distance (Chebyshev, and the octile diagonal's): most
-            // candidates fail one of the two tests without a square root.
-            let (dx, dy) = (p.x.abs_diff(q.x), p.y.abs_diff(q.y));
-            let cheb = f32::from(dx.max(dy));
-            let diag = (f32::from(dx) + f32::from(dy)) * core::f32::consts::FRAC_1_SQRT_2;
-            // (Not `f32::max`: on the Cortex-M4F that is a call to `fmaxf`.)
-            let low = gi + if cheb > diag { cheb } else { diag };
-            if low >= e.g || low + e.h >= limit {
-                continue;
-            }
-            // Hidden by its own shade (below): no update whatever the length, so no square root.
-            if shadows.shaded(grid, p, q, e.shade) {
-                continue;
-            }
-            let nd = gi + distance(p, q);
-            if nd >= e.g || nd + e.h >= limit {
-                continue;
-            }
-            // An improving edge: is it clear? If not, `q` remembers what hid it.
-            if let Err(shade) = shadows.clear(grid, p, q) {
-                if let (Some(shade), Some(e)) = (shade, cell.get_mut(j)) {
-                    e.shade = shade;
+            // The greatest `g` of the run's cells not closed, before this scan's updates (they
+            // only lower it): the run's bound for the next scans.
+            let mut gmax = f32::NEG_INFINITY;
+            for &c in list.get(from..to).unwrap_or_default() {
+                let q = unpack(c);
+                let j = grid.index(q);
+                let Some(e) = cell.get(j) else { continue };
+                if e.closed() {
+                    continue;
                 }
-                continue;
+                if e.g > gmax {
+                    gmax = e.g;
+                }
+                let low = gi + octile_low(p.x.abs_diff(q.x), p.y.abs_diff(q.y));
+                if low >= e.g || low + e.h >= limit {
+                    continue;
+                }
+                // Hidden by its own shade (below): no update whatever the length, so no square
+                // root.
+                if shadows.shaded(grid, p, q, e.shade) {
+                    continue;
+                }
+                let nd = gi + distance(p, q);
+                if nd >= e.g || nd + e.h >= limit {
+                    continue;
+                }
+                // An improving edge: is it clear? If not, `q` remembers what hid it.
+                if let Err(shade) = shadows.clear(grid, p, q) {
+                    if let (Some(shade), Some(e)) = (shade, cell.get_mut(j)) {
+                        e.shade = shade;
+                    }
+                    continue;
+                }
+                let first = e.g == f32::INFINITY;
+                if let Some(e) = cell.get_mut(j) {
+                    e.g = nd;
+                    e.parent = i as u32;
+                }
+                if first {
+                    // A cell opens once (closed cells are never relaxed), so the open list
+                    // never holds more than the corridor's cells; no room left: stop.
+                    let slot = open.get_mut(open_len).ok_or(Short::List)?;
+                    *slot = j as u32;
+                    open_len = open_len.wrapping_add(1);
+                }
             }
-            let first = e.g == f32::INFINITY;
-            if let Some(e) = cell.get_mut(j) {
-                e.g = nd;
-                e.parent = i as u32;
-            }
-            if first {
-                // A cell opens once (closed cells are never relaxed), so the open list never
-                // holds more than the corridor's cells; no room left: stop improving.
-                let slot = open.get_mut(open_len).ok_or(Short::List)?;
-                *slot = j as u32;
-                open_len = open_len.wrapping_add(1);
+            if let Some(words) = runs.get_mut(r.wrapping_mul(RUN_WORDS)..) {
+                if let Some(slot) = words.get_mut(3) {
+                    *slot = gmax.to_bits();
+                }
             }
         }
     }
@@ -284,6 +314,130 @@ pub fn try_shortest(
         c = cell.get(c).map_or(s, |e| e.parent as usize);
     }
     Ok(drop_collinear(pts, m))
+}
+
+/// The larger of the two square-root-free lower bounds of the length of a vector `(dx, dy)`:
+/// Chebyshev's `max(dx, dy)` and the octile diagonal's `(dx + dy) / sqrt 2`. Monotone in `dx`
+/// and in `dy` (every step rounds monotonically), so the bound of a box's nearest offset is
+/// at most the bound of any cell in it ([`Run::skips`]).
+#[inline(always)]
+fn octile_low(dx: u16, dy: u16) -> f32 {
+    let cheb = f32::from(dx.max(dy));
+    let diag = (f32::from(dx) + f32::from(dy)) * core::f32::consts::FRAC_1_SQRT_2;
+    // (Not `f32::max`: on the Cortex-M4F that is a call to `fmaxf`.)
+    if cheb > diag {
+        cheb
+    } else {
+        diag
+    }
+}
+
+/// Live corridor cells a [`Run`] holds: consecutive entries of the live list.
+const RUN: usize = 16;
+/// Words a [`Run`] takes in the list's scratch.
+const RUN_WORDS: usize = 4;
+
+/// Words the runs of `v` live cells take.
+fn runs_words(v: usize) -> usize {
+    v.div_ceil(RUN).saturating_mul(RUN_WORDS)
+}
+
+/// `RUN` consecutive live cells of the corridor's list, with what lets an expansion skip them
+/// all at once ([`Run::skips`]): their bounding box, their least distance to the goal, the
+/// greatest `g` of those not closed, and a blocked cell that hid one of them lately. A skipped
+/// run is one whose every cell the per-cell tests would reject, so the search relaxes the same
+/// edges in the same order whether runs are skipped or not.
+#[derive(Clone, Copy)]
+struct Run {
+    lo: Point,
+    hi: Point,
+    /// The least `h` of its cells.
+    hmin: f32,
+    /// At least the `g` of each of its cells not closed (`g` only decreases, and only while
+    /// the run is scanned, where it is recomputed).
+    gmax: f32,
+}
+
+impl Run {
+    fn read(w: &[u32]) -> Option<Self> {
+        let [lo, hi, hmin, gmax] = *w else {
+            return None;
+        };
+        Some(Self {
+            lo: unpack(lo),
+            hi: unpack(hi),
+            hmin: f32::from_bits(hmin),
+            gmax: f32::from_bits(gmax),
+        })
+    }
+
+    fn write(&self, w: &mut [u32]) {
+        if let [lo, hi, hmin, gmax] = w {
+            *lo = pack(self.lo);
+            *hi = pack(self.hi);
+            *hmin = self.hmin.to_bits();
+            *gmax = self.gmax.to_bits();
+        }
+    }
+
+    /// Whether no edge from `p` (at `gi`) improves any of its cells, for one of two reasons
+    /// that hold for each cell: the lower bound from `p` to the box already reaches the greatest
+    /// `g`; or, plus the least `h`, the best length known.
+    fn skips(&self, p: Point, gi: f32, limit: f32) -> bool {
+        let off = |v: u16, lo: u16, hi: u16| {
+            if v < lo {
+                lo.wrapping_sub(v)
+            } else {
+                v.saturating_sub(hi)
+            }
+        };
+        let low = gi + octile_low(
+            off(p.x, self.lo.x, self.hi.x),
+            off(p.y, self.lo.y, self.hi.y),
+        );
+        low >= self.gmax || low + self.hmin >= limit
+    }
+}
+
+/// Cut `list[..live]` into runs of [`RUN`] cells and write each one's [`Run`] to `runs`; returns
+/// how many runs the scan walks (one run of all `live` cells, with no record, when `runs` is
+/// too short).
+fn build_runs(
+    grid: &Grid<'_>,
+    list: &[u32],
+    live: usize,
+    cell: &[Entry],
+    runs: &mut [u32],
+) -> usize {
+    let n = live.div_ceil(RUN);
+    if runs.len() < n.saturating_mul(RUN_WORDS) {
+        return 1;
+    }
+    let cells = list.get(..live).unwrap_or_default();
+    for (chunk, words) in cells.chunks(RUN).zip(runs.chunks_exact_mut(RUN_WORDS)) {
+        let first = chunk.first().map_or(Point::new(0, 0), |&c| unpack(c));
+        let mut run = Run {
+            lo: first,
+            hi: first,
+            hmin: f32::INFINITY,
+            gmax: f32::NEG_INFINITY,
+        };
+        for &c in chunk {
+            let q = unpack(c);
+            run.lo = Point::new(run.lo.x.min(q.x), run.lo.y.min(q.y));
+            run.hi = Point::new(run.hi.x.max(q.x), run.hi.y.max(q.y));
+            if let Some(e) = cell.get(grid.index(q)) {
+                if e.h < run.hmin {
+                    run.hmin = e.h;
+                }
+                if e.g > run.gmax {
+                    run.gmax = e.g;
+                }
+            }
+        }
+        run.write(words);
+    }
+    n
 }
 
 /// Blocked cells that recently stopped a segment: a candidate segment that touches one of their
