@@ -9,8 +9,9 @@
 //!   (`reference::any_angle`, a different search over all free cells);
 //! - it returns bit for bit the path of the plain search it replaced ([`plain`] below: every
 //!   improving edge walked by `segment_clear`, the open list scanned for its least `g + h`):
-//!   the remembered blocked cells (shadows) only skip walks whose answer is known, so a shadow
-//!   that hid a clear edge, or any change of order or ties, fails here.
+//!   the remembered blocked cells (shadows) only skip walks whose answer is known, and a run of
+//!   live cells is skipped only when no cell of it can improve, so a shadow that hid a clear
+//!   edge, a run skipped wrongly, or any change of order or ties, fails here.
 
 use ohaca::corridor::{shortest, RADIUS};
 use ohaca::geometry::{distance, drop_collinear, polyline_length, segment_clear};
@@ -132,11 +133,17 @@ fn plain(grid: &Grid<'_>, input: &[Point], radius: u16) -> Vec<Point> {
 }
 
 fn corridor(m: &Map, input: &[Point], radius: u16) -> Vec<Point> {
+    corridor_in(m, input, radius, 3 * m.cells())
+}
+
+/// [`corridor`] with a list of `words` words: from `2 V + 3 V / 16` (for `V` corridor cells, at
+/// most the map's cells) the search skips runs of live cells, below it scans them all.
+fn corridor_in(m: &Map, input: &[Point], radius: u16, words: usize) -> Vec<Point> {
     // Room for a path of more points than the input, as the planner's `points` has.
     let mut pts = input.to_vec();
     pts.resize(m.cells(), Point::new(0, 0));
     let mut cell = vec![[0.0f32; 4]; m.cells()];
-    let mut list = vec![0u32; 2 * m.cells()];
+    let mut list = vec![0u32; words];
     let n = shortest(
         &m.grid(),
         &mut pts,
@@ -186,9 +193,12 @@ proptest! {
     ) {
         let Some(input) = greedy_waypoints(&m, s, g, seed) else { return Ok(()) };
         for radius in [RADIUS, 8] {
-            let out = corridor(&m, &input, radius);
             let want = plain(&m.grid(), &input, radius);
-            prop_assert_eq!(out, want, "radius {}", radius);
+            // With runs skipped (3 words a cell) and, mostly, without (2 words a cell).
+            for words in [3 * m.cells(), 2 * m.cells()] {
+                let out = corridor_in(&m, &input, radius, words);
+                prop_assert_eq!(&out, &want, "radius {}, {} words", radius, words);
+            }
         }
     }
 }
