@@ -185,7 +185,7 @@ pub fn try_shortest(
         (open, &mut [][..])
     };
     let mut nruns = build_runs(grid, list, live, cell, runs);
-    let mut shadows = Shadows::new();
+    let mut shadows = Shadows::new(grid);
     let exact = grid.width() <= EXACT_SIDE && grid.height() <= EXACT_SIDE;
     // A*: expand the open cell of least g + h (the first one on ties) until the goal closes.
     while open_len > 0 {
@@ -264,7 +264,7 @@ pub fn try_shortest(
                     continue;
                 }
                 // Hidden by its own shade (below).
-                if shadows.shaded(grid, p, q, e.shade) {
+                if shadows.shaded(p, q, e.shade) {
                     continue;
                 }
                 // An improving edge: is it clear? If not, `q` remembers what hid it.
@@ -340,10 +340,10 @@ fn octile_low(dx: u16, dy: u16) -> f32 {
 /// never above [`distance`].
 const EXACT_SIDE: u16 = 2048;
 
-/// Live corridor cells a [`Run`] holds: consecutive entries of the live list (4, 8, 16 and 32
-/// measured on complex-26's device plan: 4.96, 4.67, 4.51 and 4.51 M instructions, with a bound
-/// on `g` as well, which saved nothing and is gone).
-const RUN: usize = 16;
+/// Live corridor cells a [`Run`] holds: consecutive entries of the live list (measured on
+/// complex-26's device plan, once the length came before the bound: 8, 16, 32, 64 and a single
+/// run give 4.16, 4.06, 4.03, 4.06 and 4.21 M instructions).
+const RUN: usize = 32;
 /// Words a [`Run`] takes in the list's scratch.
 const RUN_WORDS: usize = 3;
 
@@ -451,6 +451,8 @@ struct Shadows {
     /// Packed cells ([`pack`]), the most recently useful first.
     cells: [u32; SHADOWS],
     len: usize,
+    /// The map's sides are at most [`SHADOW_SIDE`] (else no shadows: every test walks).
+    on: bool,
 }
 
 /// Blocked cells [`Shadows`] remembers (4, 8, 16, 32 measured on complex-26's device plan: 4.60,
@@ -458,17 +460,18 @@ struct Shadows {
 const SHADOWS: usize = 4;
 
 impl Shadows {
-    fn new() -> Self {
+    fn new(grid: &Grid<'_>) -> Self {
         Self {
             cells: [0; SHADOWS],
             len: 0,
+            on: grid.width() <= SHADOW_SIDE && grid.height() <= SHADOW_SIDE,
         }
     }
 
     /// Whether `b`'s `shade` (its blocked cell last found, see [`Entry::shade`]) touches the
     /// segment from `a`: then it is blocked.
-    fn shaded(&self, grid: &Grid<'_>, a: Point, b: Point, shade: [i8; 2]) -> bool {
-        if shade == [0, 0] || grid.width() > SHADOW_SIDE || grid.height() > SHADOW_SIDE {
+    fn shaded(&self, a: Point, b: Point, shade: [i8; 2]) -> bool {
+        if shade == [0, 0] || !self.on {
             return false;
         }
         let c = Point::new(
@@ -483,7 +486,7 @@ impl Shadows {
     /// leaves its blocked cell nearest `a` remembered here, and returns `b`'s new shade (the
     /// blocked cell nearest `b`, when within an `i8` offset).
     fn clear(&mut self, grid: &Grid<'_>, a: Point, b: Point) -> Result<(), Option<[i8; 2]>> {
-        if grid.width() > SHADOW_SIDE || grid.height() > SHADOW_SIDE {
+        if !self.on {
             return if segment_clear(grid, a, b) {
                 Ok(())
             } else {
@@ -610,11 +613,15 @@ fn blocker(grid: &Grid<'_>, a: Point, b: Point) -> Option<Point> {
             let hi = n0.max(n1).checked_div_euclid(den).unwrap_or(0);
             (lo.max(x_lo), hi.min(x_hi))
         };
-        for x in lo..=hi {
-            // Within a's and b's box: on the map, below 2^16.
-            let q = Point::new(x as u16, r as u16);
-            if !grid.is_free(q) && touches(a, b, q) {
-                return Some(q);
+        // A row whose touched cells are all free (read a byte at a time) has no blocked cell:
+        // most rows of most walks.
+        // Within a's and b's box: on the map, below 2^16.
+        if !grid.run_free(r as u16, lo, hi) {
+            for x in lo..=hi {
+                let q = Point::new(x as u16, r as u16);
+                if !grid.is_free(q) && touches(a, b, q) {
+                    return Some(q);
+                }
             }
         }
         if r == i32::from(b.y) {
