@@ -17,8 +17,8 @@
 //! around an obstacle the 8-connected optimum passes on the other side.
 //!
 //! Cost: for `V` corridor cells (at most the map's cells) and `E` expanded ones, `O(E V)` cheap
-//! steps (each expansion scans the open list and the live corridor cells with square-root-free
-//! lower bounds) and a segment test per improving edge. The segment tests were the cost
+//! steps (each expansion scans the open list and the live corridor cells, each with its length:
+//! one `vsqrt.f32` on the device) and a segment test per improving edge. The segment tests were the cost
 //! (10,058 walks on complex-26, 2.7 M of 4.4 M host instructions): `Shadows` remembers blocked
 //! cells, per corridor cell ([`Entry::shade`]) and the last few found, and an edge whose segment
 //! touches one is blocked without a walk (756 walks left; `docs/ALGORITHM.md`, "Its cost, and the
