@@ -440,7 +440,9 @@ impl Ant<'_, '_, '_> {
     /// are kept by direction, so the roulette walks the open moves' bits again instead of a
     /// list of candidates. The same sums in the same order: the candidates are the set bits of
     /// the open mask, lowest first, as in the general loop.
-    #[inline(always)]
+    // Not inlined: the general loop's function stays as it was (its registers, its count of
+    // instructions on the device).
+    #[inline(never)]
     fn walk_cells(
         &self,
         trail: &mut Trail,
@@ -596,6 +598,7 @@ impl Ant<'_, '_, '_> {
     }
 
     /// The walk that reached the goal with `steps` steps in `tour` after `moves` moves.
+    #[inline(always)]
     fn arrived(
         &self,
         tabu: &[u32],
