@@ -214,22 +214,24 @@ impl Ant<'_, '_, '_> {
         tour: &mut [Dir],
         left: &mut u32,
     ) -> Result<Option<Walk>, Lost> {
-        // The common exponent gets its own copy of the loop, without a test per candidate;
-        // `pow_alpha(t, 1.0)` is `t`, so both give the same weights.
-        if self.alpha == 1.0 {
-            self.walk_with(cells, trail, rng, tabu, tour, left, |t| t)
-        } else {
-            let alpha = self.alpha;
-            self.walk_with(cells, trail, rng, tabu, tour, left, |t| pow_alpha(t, alpha))
+        // The common exponent gets its own copy of each loop, without a test per candidate;
+        // `pow_alpha(t, 1.0)` is `t`, so both give the same weights. Each loop is a function of
+        // its own, so this one's stack frame is small and the deeper of them is the stack's need.
+        let alpha = self.alpha;
+        match (cells, alpha == 1.0) {
+            (true, true) => self.walk_cells(trail, rng, tabu, tour, left, |t| t),
+            (true, false) => self.walk_cells(trail, rng, tabu, tour, left, |t| pow_alpha(t, alpha)),
+            (false, true) => self.walk_general(trail, rng, tabu, tour, left, |t| t),
+            (false, false) => {
+                self.walk_general(trail, rng, tabu, tour, left, |t| pow_alpha(t, alpha))
+            }
         }
     }
 
-    /// [`Ant::resume`] with `tau^alpha` computed by `pow`.
-    #[inline(always)]
-    #[allow(clippy::too_many_arguments)]
-    fn walk_with(
+    /// [`Ant::resume`] by the general loop, with `tau^alpha` computed by `pow`.
+    #[inline(never)]
+    fn walk_general(
         &self,
-        cells: bool,
         trail: &mut Trail,
         rng: &mut Xoshiro128pp,
         tabu: &mut [u32],
@@ -237,14 +239,6 @@ impl Ant<'_, '_, '_> {
         limit: &mut u32,
         pow: impl Fn(f32) -> f32,
     ) -> Result<Option<Walk>, Lost> {
-        if cells {
-            // The generator as a local: the loop keeps its state in registers (through `rng`
-            // it would store it at every draw, since the tour and tabu writes might alias it).
-            let mut gen = rng.clone();
-            let r = self.walk_cells(trail, &mut gen, tabu, tour, limit, pow);
-            *rng = gen;
-            return r;
-        }
         let grid = self.moves.grid();
         let offsets = grid.offsets();
         let blocks = self.tau.blocks();
@@ -433,7 +427,7 @@ impl Ant<'_, '_, '_> {
         self.arrived(tabu, tour, steps, moves, may_tighten)
     }
 
-    /// [`Ant::walk_with`] where the pheromone has an entry per cell (a map of at most
+    /// [`Ant::walk_general`] where the pheromone has an entry per cell (a map of at most
     /// [`crate::colony::pheromone::BLOCKS`] cells) and the potential field pulls toward the goal
     /// (no route): the same moves and draws, bit for bit, at fewer instructions a move. An edge's
     /// entry is `4 * cell` plus a slot offset fixed for the map ([`slot_offsets`]); the weights
@@ -444,6 +438,25 @@ impl Ant<'_, '_, '_> {
     // instructions on the device).
     #[inline(never)]
     fn walk_cells(
+        &self,
+        trail: &mut Trail,
+        rng: &mut Xoshiro128pp,
+        tabu: &mut [u32],
+        tour: &mut [Dir],
+        limit: &mut u32,
+        pow: impl Fn(f32) -> f32,
+    ) -> Result<Option<Walk>, Lost> {
+        // The generator as a local: the loop keeps its state in registers (through `rng` it
+        // would store it at every draw, since the tour and tabu writes might alias it).
+        let mut gen = rng.clone();
+        let r = self.cells_loop(trail, &mut gen, tabu, tour, limit, pow);
+        *rng = gen;
+        r
+    }
+
+    /// The loop of [`Ant::walk_cells`].
+    #[inline(always)]
+    fn cells_loop(
         &self,
         trail: &mut Trail,
         rng: &mut Xoshiro128pp,
@@ -669,14 +682,7 @@ fn roulette(rng: &mut Xoshiro128pp, w: &[f32], total: f32) -> usize {
 #[inline]
 fn roulette_open(rng: &mut Xoshiro128pp, weight: &[f32; 8], open: u8, total: f32) -> Dir {
     if !(total > 0.0 && total <= f32::MAX) {
-        // As in `roulette`: the k-th of the n open moves.
-        let n = u64::from(open.count_ones());
-        let k = (u64::from(rng.next_word()).wrapping_mul(n) >> 32) as u32;
-        let mut m = open;
-        for _ in 0..k {
-            m &= m.wrapping_sub(1);
-        }
-        return m.trailing_zeros() as u8 & 7;
+        return uniform_open(rng, open);
     }
     let r = rng.next_unit() * total;
     let mut acc = 0.0f32;
@@ -693,6 +699,20 @@ fn roulette_open(rng: &mut Xoshiro128pp, weight: &[f32; 8], open: u8, total: f32
     }
     // Rounding can leave r just above the running sum: the last open move.
     last
+}
+
+/// [`roulette`]'s uniform choice among the open moves (every weight underflowed, or the sum
+/// overflowed: rare, so out of the loop): the k-th of the set bits of `open`.
+#[cold]
+#[inline(never)]
+fn uniform_open(rng: &mut Xoshiro128pp, open: u8) -> Dir {
+    let n = u64::from(open.count_ones());
+    let k = (u64::from(rng.next_word()).wrapping_mul(n) >> 32) as u32;
+    let mut m = open;
+    for _ in 0..k {
+        m &= m.wrapping_sub(1);
+    }
+    m.trailing_zeros() as u8 & 7
 }
 
 #[cfg(test)]
