@@ -25,7 +25,7 @@ use crate::colony::heuristic::Heuristic;
 use crate::colony::pheromone::{slot_offsets, Table};
 use crate::colony::route::Route;
 use crate::map::bitmap;
-use crate::map::grid::{is_diagonal, neighbour, opposite, Dir, Moves, Point};
+use crate::map::grid::{is_diagonal, neighbour, opposite, Dir, Moves, Point, DX, DY};
 use crate::named::named;
 use crate::rng::Xoshiro128pp;
 
@@ -466,8 +466,18 @@ impl Ant<'_, '_, '_> {
         pow: impl Fn(f32) -> f32,
     ) -> Result<Option<Walk>, Lost> {
         let grid = self.moves.grid();
-        let offsets = grid.offsets();
-        let slots = slot_offsets(&offsets);
+        // The offset of a step, computed where it is needed: a table of them would be one
+        // more array on the stack, whose depth the device's RAM budget counts.
+        let w_off = grid.width() as isize;
+        let step = |d: usize| {
+            let (dx, dy) = (
+                DX.get(d & 7).copied().unwrap_or(0),
+                DY.get(d & 7).copied().unwrap_or(0),
+            );
+            // |dy|, |dx| <= 1 and the width <= 65535: no overflow.
+            (dy as isize).wrapping_mul(w_off).wrapping_add(dx as isize)
+        };
+        let slots = slot_offsets(&grid.offsets());
         let tau = self.tau.flat();
         let goal = grid.index(self.goal);
         let Trail {
@@ -497,7 +507,7 @@ impl Ant<'_, '_, '_> {
                 while m != 0 {
                     let di = m.trailing_zeros() as usize & 7;
                     m &= m.wrapping_sub(1);
-                    let ni = ci.wrapping_add_signed(offsets.get(di).copied().unwrap_or(0));
+                    let ni = ci.wrapping_add_signed(step(di));
                     if bitmap::get(tabu, ni) {
                         t |= 1 << di;
                     }
@@ -511,7 +521,7 @@ impl Ant<'_, '_, '_> {
                 while m != 0 {
                     let di = m.trailing_zeros() as usize & 7;
                     m &= m.wrapping_sub(1);
-                    let ni = ci.wrapping_add_signed(offsets.get(di).copied().unwrap_or(0));
+                    let ni = ci.wrapping_add_signed(step(di));
                     seen = seen.wrapping_add(u32::from(!bitmap::marked(self.dead, ni)));
                 }
                 may_tighten = seen > 1;
@@ -556,9 +566,7 @@ impl Ant<'_, '_, '_> {
                         };
                         steps = s;
                         let back = opposite(tour.get(steps).copied().ok_or(Lost::Overflow)?);
-                        ci = ci.wrapping_add_signed(
-                            offsets.get(usize::from(back)).copied().unwrap_or(0),
-                        );
+                        ci = ci.wrapping_add_signed(step(usize::from(back)));
                         cur = neighbour(cur, back);
                         continue;
                     }
@@ -592,8 +600,7 @@ impl Ant<'_, '_, '_> {
                         return Err(Lost::Overflow);
                     }
                     DeadEnd::Backtrack => {
-                        let ni = ci
-                            .wrapping_add_signed(offsets.get(usize::from(d)).copied().unwrap_or(0));
+                        let ni = ci.wrapping_add_signed(step(usize::from(d)));
                         bitmap::set(tabu, ni);
                         moves = moves.wrapping_sub(1); // counted above: at least 1
                         continue;
@@ -602,7 +609,7 @@ impl Ant<'_, '_, '_> {
             };
             *slot = d;
             steps = steps.wrapping_add(1); // < tour.len() + 1: the slot existed
-            ci = ci.wrapping_add_signed(offsets.get(usize::from(d)).copied().unwrap_or(0));
+            ci = ci.wrapping_add_signed(step(usize::from(d)));
             cur = neighbour(cur, d);
             bitmap::set(tabu, ci);
         }
