@@ -130,10 +130,13 @@ fn key_between(p: Point, g: Point) -> usize {
         );
     }
     // 0, 1, 2 for p left of, level with, right of g: `signum(p.x - g.x) + 1`.
-    let sx = usize::from(p.x > g.x) + usize::from(p.x >= g.x);
-    let sy = usize::from(p.y > g.y) + usize::from(p.y >= g.y);
-    let diff = i32::from(p.x.abs_diff(g.x)) - i32::from(p.y.abs_diff(g.y));
-    // In 0..=6: the difference clamped to -3..=3, plus 3.
+    // At most 2 each; the difference of two u16 values fits an i32: nothing wraps.
+    let sx = usize::from(p.x > g.x).wrapping_add(usize::from(p.x >= g.x));
+    let sy = usize::from(p.y > g.y).wrapping_add(usize::from(p.y >= g.y));
+    let diff = i32::from(p.x.abs_diff(g.x)).wrapping_sub(i32::from(p.y.abs_diff(g.y)));
+    // In 0..=6: the difference clamped to -3..=3, plus 3 (`max`/`min`, not `clamp`, which
+    // keeps a panic path).
+    #[allow(clippy::manual_clamp)]
     let d = diff.max(-3).min(3).wrapping_add(3) as usize;
     // Below 63: sx, sy <= 2, d <= 6.
     sx.wrapping_mul(21)
