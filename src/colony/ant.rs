@@ -20,6 +20,13 @@
 //! A walk can be done a bounded number of moves at a time ([`Ant::begin`], [`Ant::resume`]: the
 //! planner's pieces, `planner::run`): its state between pieces is a [`Trail`], and the pieces
 //! make the same moves with the same draws as one [`Ant::walk`], bit for bit.
+//!
+//! Two loops make the moves: a general one, and one for maps whose pheromone has an entry a cell
+//! and no route (every map of at most [`crate::colony::pheromone::BLOCKS`] cells, the paper
+//! preset's), which finds a move's pheromone at a fixed offset from its cell's and keeps the
+//! weights by direction. Both make the same moves with the same draws, bit for bit (the same
+//! products, summed in the same order; a test compares them on random maps, pheromone, budgets
+//! and pieces).
 
 use crate::colony::heuristic::Heuristic;
 use crate::colony::pheromone::{slot_offsets, Table};
