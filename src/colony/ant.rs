@@ -20,12 +20,19 @@
 //! A walk can be done a bounded number of moves at a time ([`Ant::begin`], [`Ant::resume`]: the
 //! planner's pieces, `planner::run`): its state between pieces is a [`Trail`], and the pieces
 //! make the same moves with the same draws as one [`Ant::walk`], bit for bit.
+//!
+//! Two loops make the moves: a general one, and one for maps whose pheromone has an entry a cell
+//! and no route (every map of at most [`crate::colony::pheromone::BLOCKS`] cells, the paper
+//! preset's), which finds a move's pheromone at a fixed offset from its cell's and keeps the
+//! weights by direction. Both make the same moves with the same draws, bit for bit (the same
+//! products, summed in the same order; a test compares them on random maps, pheromone, budgets
+//! and pieces).
 
 use crate::colony::heuristic::Heuristic;
-use crate::colony::pheromone::Table;
+use crate::colony::pheromone::{slot_offsets, Table};
 use crate::colony::route::Route;
 use crate::map::bitmap;
-use crate::map::grid::{is_diagonal, neighbour, opposite, Dir, Moves, Point};
+use crate::map::grid::{is_diagonal, neighbour, opposite, Dir, Moves, Point, DX, DY};
 use crate::named::named;
 use crate::rng::Xoshiro128pp;
 
@@ -199,19 +206,38 @@ impl Ant<'_, '_, '_> {
         tour: &mut [Dir],
         left: &mut u32,
     ) -> Result<Option<Walk>, Lost> {
-        // The common exponent gets its own copy of the loop, without a test per candidate;
-        // `pow_alpha(t, 1.0)` is `t`, so both give the same weights.
-        if self.alpha == 1.0 {
-            self.walk_with(trail, rng, tabu, tour, left, |t| t)
-        } else {
-            let alpha = self.alpha;
-            self.walk_with(trail, rng, tabu, tour, left, |t| pow_alpha(t, alpha))
+        let cells = self.route.is_none() && self.tau.blocks().shift() == 0;
+        self.resume_by(cells, trail, rng, tabu, tour, left)
+    }
+
+    /// [`Ant::resume`] by the loop for an entry a cell ([`Ant::walk_cells`], `cells`: only
+    /// where the pheromone has an entry a cell and there is no route) or by the general one.
+    fn resume_by(
+        &self,
+        cells: bool,
+        trail: &mut Trail,
+        rng: &mut Xoshiro128pp,
+        tabu: &mut [u32],
+        tour: &mut [Dir],
+        left: &mut u32,
+    ) -> Result<Option<Walk>, Lost> {
+        // The common exponent gets its own copy of each loop, without a test per candidate;
+        // `pow_alpha(t, 1.0)` is `t`, so both give the same weights. Each loop is a function of
+        // its own, so this one's stack frame is small and the deeper of them is the stack's need.
+        let alpha = self.alpha;
+        match (cells, alpha == 1.0) {
+            (true, true) => self.walk_cells(trail, rng, tabu, tour, left, |t| t),
+            (true, false) => self.walk_cells(trail, rng, tabu, tour, left, |t| pow_alpha(t, alpha)),
+            (false, true) => self.walk_general(trail, rng, tabu, tour, left, |t| t),
+            (false, false) => {
+                self.walk_general(trail, rng, tabu, tour, left, |t| pow_alpha(t, alpha))
+            }
         }
     }
 
-    /// [`Ant::resume`] with `tau^alpha` computed by `pow`.
-    #[inline(always)]
-    fn walk_with(
+    /// [`Ant::resume`] by the general loop, with `tau^alpha` computed by `pow`.
+    #[inline(never)]
+    fn walk_general(
         &self,
         trail: &mut Trail,
         rng: &mut Xoshiro128pp,
@@ -405,6 +431,211 @@ impl Ant<'_, '_, '_> {
             bitmap::set(tabu, ci);
         }
         *limit = limit.saturating_sub(moves.wrapping_sub(first));
+        self.arrived(tabu, tour, steps, moves, may_tighten)
+    }
+
+    /// [`Ant::walk_general`] where the pheromone has an entry per cell (a map of at most
+    /// [`crate::colony::pheromone::BLOCKS`] cells) and the potential field pulls toward the goal
+    /// (no route): the same moves and draws, bit for bit, at fewer instructions a move. An edge's
+    /// entry is `4 * cell` plus a slot offset fixed for the map ([`slot_offsets`]); the weights
+    /// are kept by direction, so the roulette walks the open moves' bits again instead of a
+    /// list of candidates. The same sums in the same order: the candidates are the set bits of
+    /// the open mask, lowest first, as in the general loop.
+    // Not inlined: the general loop's function stays as it was (its registers, its count of
+    // instructions on the device).
+    #[inline(never)]
+    fn walk_cells(
+        &self,
+        trail: &mut Trail,
+        rng: &mut Xoshiro128pp,
+        tabu: &mut [u32],
+        tour: &mut [Dir],
+        limit: &mut u32,
+        pow: impl Fn(f32) -> f32,
+    ) -> Result<Option<Walk>, Lost> {
+        // The generator as a local: the loop keeps its state in registers (through `rng` it
+        // would store it at every draw, since the tour and tabu writes might alias it).
+        let mut gen = rng.clone();
+        let r = self.cells_loop(trail, &mut gen, tabu, tour, limit, pow);
+        *rng = gen;
+        r
+    }
+
+    /// The loop of [`Ant::walk_cells`].
+    #[inline(always)]
+    fn cells_loop(
+        &self,
+        trail: &mut Trail,
+        rng: &mut Xoshiro128pp,
+        tabu: &mut [u32],
+        tour: &mut [Dir],
+        limit: &mut u32,
+        pow: impl Fn(f32) -> f32,
+    ) -> Result<Option<Walk>, Lost> {
+        let grid = self.moves.grid();
+        // The offset of a step, computed where it is needed: a table of them would be one
+        // more array on the stack, whose depth the device's RAM budget counts.
+        let w_off = grid.width() as isize;
+        let step = |d: usize| {
+            let (dx, dy) = (
+                DX.get(d & 7).copied().unwrap_or(0),
+                DY.get(d & 7).copied().unwrap_or(0),
+            );
+            // |dy|, |dx| <= 1 and the width <= 65535: no overflow.
+            (dy as isize).wrapping_mul(w_off).wrapping_add(dx as isize)
+        };
+        let slots = slot_offsets(&grid.offsets());
+        let tau = self.tau.flat();
+        let goal = grid.index(self.goal);
+        let Trail {
+            mut cur,
+            mut ci,
+            mut steps,
+            mut moves,
+            mut may_tighten,
+            block,
+            target,
+        } = *trail;
+        // By direction; only the open moves' entries are read, each written first in the same
+        // step.
+        let mut weight = [0.0f32; 8];
+        let width = usize::from(grid.width());
+        let last_row = usize::from(grid.height()).wrapping_sub(1);
+        let first = moves;
+        let stop = self.budget.min(moves.saturating_add(*limit));
+        while ci != goal {
+            let allowed = self.moves.at(ci, cur);
+            let (x, y) = (usize::from(cur.x), usize::from(cur.y));
+            let tabu_moves = if x > 0 && y > 0 && x.wrapping_add(1) < width && y < last_row {
+                bitmap::around(tabu, ci, width) & allowed
+            } else {
+                let mut t = 0u8;
+                let mut m = allowed;
+                while m != 0 {
+                    let di = m.trailing_zeros() as usize & 7;
+                    m &= m.wrapping_sub(1);
+                    let ni = ci.wrapping_add_signed(step(di));
+                    if bitmap::get(tabu, ni) {
+                        t |= 1 << di;
+                    }
+                }
+                t
+            };
+            // As in the general loop.
+            if !may_tighten && tabu_moves & tabu_moves.wrapping_sub(1) != 0 {
+                let mut seen = 0u32;
+                let mut m = tabu_moves;
+                while m != 0 {
+                    let di = m.trailing_zeros() as usize & 7;
+                    m &= m.wrapping_sub(1);
+                    let ni = ci.wrapping_add_signed(step(di));
+                    seen = seen.wrapping_add(u32::from(!bitmap::marked(self.dead, ni)));
+                }
+                may_tighten = seen > 1;
+            }
+            let open = allowed & !tabu_moves;
+            moves = moves.saturating_add(1);
+            if moves > stop {
+                if moves > self.budget {
+                    *limit = limit.saturating_sub(moves.wrapping_sub(first));
+                    return Err(Lost::Budget);
+                }
+                // The piece is over: the next one makes this move (nothing above changed the
+                // walk but `may_tighten`, which it sets again).
+                *trail = Trail {
+                    cur,
+                    ci,
+                    steps,
+                    moves: moves.wrapping_sub(1),
+                    may_tighten,
+                    block,
+                    target,
+                };
+                *limit = 0;
+                return Ok(None);
+            }
+            let d = if open == 0 {
+                match self.dead_end {
+                    DeadEnd::Die => {
+                        *limit = limit.saturating_sub(moves.wrapping_sub(first));
+                        return Err(Lost::Died);
+                    }
+                    DeadEnd::Backtrack => {
+                        // As in the general loop.
+                        let Some(s) = steps.checked_sub(1) else {
+                            let filled = tour.last().is_none_or(|&d| d != UNFILLED);
+                            *limit = limit.saturating_sub(moves.wrapping_sub(first));
+                            return Err(if filled {
+                                Lost::Overflow
+                            } else {
+                                Lost::Exhausted
+                            });
+                        };
+                        steps = s;
+                        let back = opposite(tour.get(steps).copied().ok_or(Lost::Overflow)?);
+                        ci = ci.wrapping_add_signed(step(usize::from(back)));
+                        cur = neighbour(cur, back);
+                        continue;
+                    }
+                }
+            } else if open & open.wrapping_sub(1) == 0 {
+                // One open move: taken without a draw.
+                open.trailing_zeros() as u8 & 7
+            } else {
+                let eta = self.heuristic.row(cur);
+                // `4 * ci` fits: the table holds 4 entries a cell.
+                let c4 = ci.wrapping_mul(4);
+                let mut total = 0.0f32;
+                let mut m = open;
+                while m != 0 {
+                    let di = m.trailing_zeros() as usize & 7;
+                    m &= m.wrapping_sub(1);
+                    let ti = c4.wrapping_add_signed(slots.get(di).copied().unwrap_or(0));
+                    let w = pow(tau.get(ti).copied().unwrap_or(0.0)) * eta.get(di);
+                    if let Some(slot) = weight.get_mut(di) {
+                        *slot = w;
+                    }
+                    total += w;
+                }
+                roulette_open(rng, &weight, open, total)
+            };
+            let Some(slot) = tour.get_mut(steps) else {
+                // As in the general loop: not a move.
+                match self.dead_end {
+                    DeadEnd::Die => {
+                        *limit = limit.saturating_sub(moves.wrapping_sub(first));
+                        return Err(Lost::Overflow);
+                    }
+                    DeadEnd::Backtrack => {
+                        let ni = ci.wrapping_add_signed(step(usize::from(d)));
+                        bitmap::set(tabu, ni);
+                        moves = moves.wrapping_sub(1); // counted above: at least 1
+                        continue;
+                    }
+                }
+            };
+            *slot = d;
+            steps = steps.wrapping_add(1); // < tour.len() + 1: the slot existed
+            ci = ci.wrapping_add_signed(step(usize::from(d)));
+            cur = neighbour(cur, d);
+            bitmap::set(tabu, ci);
+        }
+        *limit = limit.saturating_sub(moves.wrapping_sub(first));
+        self.arrived(tabu, tour, steps, moves, may_tighten)
+    }
+
+    /// The walk that reached the goal with `steps` steps in `tour` after `moves` moves.
+    #[inline(always)]
+    fn arrived(
+        &self,
+        tabu: &[u32],
+        tour: &[Dir],
+        steps: usize,
+        moves: u32,
+        mut may_tighten: bool,
+    ) -> Result<Option<Walk>, Lost> {
+        let offsets = self.moves.grid().offsets();
+        let goal = self.moves.grid().index(self.goal);
         // The loop checks for a second visited neighbour at every cell but the goal; a detour
         // whose only shortcut ends at the goal (e.g. (0,0) -> (0,1) -> (1,0) on an empty map) is
         // caught here.
@@ -456,6 +687,46 @@ fn roulette(rng: &mut Xoshiro128pp, w: &[f32], total: f32) -> usize {
     }
     // Rounding can leave r just above the running sum: take the last candidate.
     n.saturating_sub(1)
+}
+
+/// [`roulette`] over the open moves (the set bits of `open`, at least two, lowest first) with
+/// their weights by direction in `weight`: the direction [`roulette`] picks from the list of
+/// those moves' weights, with the same draw and the same running sums (so bit for bit the same
+/// choice).
+#[inline]
+fn roulette_open(rng: &mut Xoshiro128pp, weight: &[f32; 8], open: u8, total: f32) -> Dir {
+    if !(total > 0.0 && total <= f32::MAX) {
+        return uniform_open(rng, open);
+    }
+    let r = rng.next_unit() * total;
+    let mut acc = 0.0f32;
+    let mut m = open;
+    let mut last = 0u8;
+    while m != 0 {
+        let di = m.trailing_zeros() as u8 & 7;
+        m &= m.wrapping_sub(1);
+        acc += weight.get(usize::from(di)).copied().unwrap_or(0.0);
+        if r < acc {
+            return di;
+        }
+        last = di;
+    }
+    // Rounding can leave r just above the running sum: the last open move.
+    last
+}
+
+/// [`roulette`]'s uniform choice among the open moves (every weight underflowed, or the sum
+/// overflowed: rare, so out of the loop): the k-th of the set bits of `open`.
+#[cold]
+#[inline(never)]
+fn uniform_open(rng: &mut Xoshiro128pp, open: u8) -> Dir {
+    let n = u64::from(open.count_ones());
+    let k = (u64::from(rng.next_word()).wrapping_mul(n) >> 32) as u32;
+    let mut m = open;
+    for _ in 0..k {
+        m &= m.wrapping_sub(1);
+    }
+    m.trailing_zeros() as u8 & 7
 }
 
 #[cfg(test)]
@@ -525,6 +796,136 @@ mod tests {
         let mut rng = Xoshiro128pp::from_u64(seed);
         let walk = c.walk(&mut rng, &mut tabu, &mut tour);
         (walk, tour)
+    }
+
+    /// Walk the ant in pieces of `piece` moves by one loop (`cells`: [`Ant::walk_cells`]): every
+    /// piece's result, the tour, the tabu set and the generator's state at the end.
+    #[allow(clippy::type_complexity)]
+    fn pieces(
+        ant: &Ant<'_, '_, '_>,
+        cells: bool,
+        seed: u64,
+        piece: u32,
+        tour_len: usize,
+    ) -> (
+        Vec<Result<Option<Walk>, Lost>>,
+        Vec<u8>,
+        Vec<u32>,
+        Xoshiro128pp,
+    ) {
+        let cells_n = ant.moves.grid().cells();
+        let mut tabu = vec![0u32; bitmap::words(cells_n)];
+        let mut tour = vec![0u8; tour_len];
+        let mut rng = Xoshiro128pp::from_u64(seed);
+        let mut trail = ant.begin(&mut tabu, &mut tour);
+        let mut out = Vec::new();
+        loop {
+            let mut left = piece;
+            let r = ant.resume_by(cells, &mut trail, &mut rng, &mut tabu, &mut tour, &mut left);
+            out.push(r);
+            if !matches!(r, Ok(None)) {
+                break;
+            }
+        }
+        (out, tour, tabu, rng)
+    }
+
+    #[test]
+    fn the_loop_for_an_entry_a_cell_walks_as_the_general_one() {
+        // Random maps, pruning marks, pheromone (zeros and huge values included, so that every
+        // weight can underflow or the sum overflow: the uniform draw), exponents, dead-end rules,
+        // budgets, tour lengths and pieces: the same results, tours, tabu sets and generators.
+        let mut r = Xoshiro128pp::from_u64(36);
+        let taus = [0.0f32, 1e-30, 0.01, 0.5, 1.0, 3.0, 1e30, f32::MAX];
+        let mut compared = (0, 0, 0);
+        for case in 0..400u64 {
+            let (w, h) = (
+                3 + (r.next_word() % 14) as u16,
+                3 + (r.next_word() % 12) as u16,
+            );
+            let bits = crate::testutil::random_bits(&mut r, w, h, 0.3);
+            let g = Grid::new(w, h, &bits).unwrap();
+            let free: Vec<usize> = (0..g.cells()).filter(|&i| !g.blocked_at(i)).collect();
+            if free.len() < 2 {
+                continue;
+            }
+            let pick = |r: &mut Xoshiro128pp| free[r.next_word() as usize % free.len()];
+            let (si, gi) = (pick(&mut r), pick(&mut r));
+            let at =
+                |i: usize| Point::new((i % usize::from(w)) as u16, (i / usize::from(w)) as u16);
+            let (start, goal) = (at(si), at(gi));
+            let mut tau_buf = vec![[1.0f32; 4]; g.cells()];
+            let spread = r.next_word() % 3;
+            for e in tau_buf.iter_mut().flatten() {
+                *e = match spread {
+                    0 => 0.1 + r.next_unit() * 5.0,
+                    1 => taus[r.next_word() as usize % taus.len()],
+                    _ => 1.0,
+                };
+            }
+            let blocks = Blocks::new(w, h);
+            assert_eq!(blocks.shift(), 0);
+            let tau = Table::new(blocks, &mut tau_buf);
+            let a = [0.05, 0.5, 1.0][r.next_word() as usize % 3];
+            let beta = [0.0, 0.5, 2.0, 7.0][r.next_word() as usize % 4];
+            let heur = Heuristic::new(goal, Some(Attraction { a, xi: 1.0 }), beta);
+            let mut table = vec![0u8; g.cells()];
+            assert!(Moves::fill(&g, &mut table));
+            let moves = if case % 2 == 0 {
+                Moves::new(g, &table)
+            } else {
+                Moves::new(g, &[])
+            };
+            let mut dead = vec![0u32; bitmap::words(g.cells())];
+            if case % 3 == 0 {
+                for &i in &free {
+                    if i != si && i != gi && r.next_word() % 8 == 0 {
+                        bitmap::set(&mut dead, i);
+                    }
+                }
+            }
+            let ant = Ant {
+                moves: &moves,
+                start,
+                goal,
+                tau: &tau,
+                heuristic: &heur,
+                alpha: [1.0, 1.0, 0.7, 2.0][r.next_word() as usize % 4],
+                dead_end: if case % 5 == 0 {
+                    DeadEnd::Die
+                } else {
+                    DeadEnd::Backtrack
+                },
+                dead: if case % 7 == 0 { &[] } else { &dead },
+                route: None,
+                budget: if case % 4 == 0 {
+                    r.next_word() % 60
+                } else {
+                    u32::MAX
+                },
+            };
+            let tour_len = if case % 6 == 0 {
+                1 + r.next_word() as usize % 12
+            } else {
+                g.cells()
+            };
+            let piece = [u32::MAX, 1, 3, 17][r.next_word() as usize % 4];
+            let seed = u64::from(r.next_word());
+            let cells = pieces(&ant, true, seed, piece, tour_len);
+            let general = pieces(&ant, false, seed, piece, tour_len);
+            assert_eq!(cells.0, general.0, "case {case}");
+            assert_eq!(cells.1, general.1, "case {case}: tour");
+            assert_eq!(cells.2, general.2, "case {case}: tabu");
+            assert_eq!(cells.3, general.3, "case {case}: generator");
+            match cells.0.last() {
+                Some(Ok(Some(_))) => compared.0 += 1,
+                Some(Err(_)) => compared.1 += 1,
+                _ => {}
+            }
+            compared.2 += cells.0.len();
+        }
+        // Both kinds of ending, and walks cut into pieces, were compared.
+        assert!(compared.0 > 100 && compared.1 > 20, "{compared:?}");
     }
 
     #[test]

@@ -116,6 +116,34 @@ const LN_SQRT_2: f32 = 0.5 * core::f32::consts::LN_2;
 /// `1.8e-35`, above `f32::MIN_POSITIVE` (`1.2e-38`) with room for a pheromone factor of 0.01.
 const LOG_SPAN: f32 = 80.0;
 
+/// [`key_of`] of the offset `p - g`. On x86-64 from the coordinates themselves: each sign from
+/// two comparisons, each magnitude an absolute difference (fewer instructions a step there than
+/// the signed offset's `signum` and `abs`; on the M4 it is the other way round, so the device
+/// keeps [`key_of`]). The same class for every pair either way, pinned by a test.
+#[inline]
+fn key_between(p: Point, g: Point) -> usize {
+    if cfg!(target_arch = "arm") {
+        // Differences of u16 values: no i32 overflow.
+        return key_of(
+            i32::from(p.x).wrapping_sub(i32::from(g.x)),
+            i32::from(p.y).wrapping_sub(i32::from(g.y)),
+        );
+    }
+    // 0, 1, 2 for p left of, level with, right of g: `signum(p.x - g.x) + 1`.
+    // At most 2 each; the difference of two u16 values fits an i32: nothing wraps.
+    let sx = usize::from(p.x > g.x).wrapping_add(usize::from(p.x >= g.x));
+    let sy = usize::from(p.y > g.y).wrapping_add(usize::from(p.y >= g.y));
+    let diff = i32::from(p.x.abs_diff(g.x)).wrapping_sub(i32::from(p.y.abs_diff(g.y)));
+    // In 0..=6: the difference clamped to -3..=3, plus 3 (`max`/`min`, not `clamp`, which
+    // keeps a panic path).
+    #[allow(clippy::manual_clamp)]
+    let d = diff.max(-3).min(3).wrapping_add(3) as usize;
+    // Below 63: sx, sy <= 2, d <= 6.
+    sx.wrapping_mul(21)
+        .wrapping_add(sy.wrapping_mul(7))
+        .wrapping_add(d)
+}
+
 /// Class of a goal offset (see [`CLASS`]). Offsets are differences of `u16` coordinates, so
 /// nothing here can overflow: the `wrapping_` operations never wrap.
 const fn key_of(dx: i32, dy: i32) -> usize {
@@ -248,11 +276,7 @@ impl Heuristic {
     /// The class of cell `p` (its offset class relative to the goal).
     #[inline]
     pub fn key(&self, p: Point) -> usize {
-        // Differences of u16 values: no i32 overflow.
-        key_of(
-            i32::from(p.x).wrapping_sub(i32::from(self.goal.x)),
-            i32::from(p.y).wrapping_sub(i32::from(self.goal.y)),
-        )
+        key_between(p, self.goal)
     }
 
     /// `eta^beta` of the 8 moves from cell `p`.
@@ -270,11 +294,7 @@ impl Heuristic {
     #[inline]
     pub fn row_toward(&self, p: Point, target: Point) -> Row<'_> {
         const NONE: [u8; 8] = [(WEIGHTS - 1) as u8; 8];
-        // Differences of u16 values: no i32 overflow.
-        let key = key_of(
-            i32::from(p.x).wrapping_sub(i32::from(target.x)),
-            i32::from(p.y).wrapping_sub(i32::from(target.y)),
-        );
+        let key = key_between(p, target);
         Row {
             class: CLASS.get(key).unwrap_or(&NONE),
             weights: &self.weights,
@@ -394,6 +414,35 @@ mod tests {
             }
         }
         out
+    }
+
+    #[test]
+    fn the_class_from_coordinates_is_the_class_of_the_offset() {
+        // Every offset within 9 cells and far ones, from goals at the map's corners, edges and
+        // middle (coordinates up to u16::MAX: the offsets' whole range).
+        let goals = [
+            (0u16, 0u16),
+            (5, 7),
+            (9, 0),
+            (u16::MAX, u16::MAX),
+            (40_000, 3),
+        ];
+        let far = [0i32, 1, 2, 3, 4, 5, 9, 100, 30_000, 65_535];
+        for (gx, gy) in goals {
+            let g = Point::new(gx, gy);
+            let mut offsets: Vec<i32> = (-9..=9).collect();
+            offsets.extend(far.iter().flat_map(|&f| [f, -f]));
+            for &dx in &offsets {
+                for &dy in &offsets {
+                    let (x, y) = (i32::from(gx) + dx, i32::from(gy) + dy);
+                    if !(0..=65_535).contains(&x) || !(0..=65_535).contains(&y) {
+                        continue;
+                    }
+                    let p = Point::new(x as u16, y as u16);
+                    assert_eq!(key_between(p, g), key_of(dx, dy), "{p:?} from {g:?}");
+                }
+            }
+        }
     }
 
     #[test]

@@ -219,21 +219,18 @@ impl<'a> Table<'a> {
     /// `tau = clamp((1 - rho) tau + delta, lo, hi)` for every entry, then `delta = 0`.
     pub fn evaporate_and_merge(&mut self, delta: &mut Table<'_>, rho: f32, lo: f32, hi: f32) {
         let keep = 1.0 - rho;
-        for (t, d) in self.tau.iter_mut().zip(delta.tau.iter_mut()) {
-            for (tv, dv) in t.iter_mut().zip(d.iter_mut()) {
-                // Comparisons rather than `f32::clamp` (which has a panic path and pulls float
-                // formatting into the firmware) or `max`/`min` (library calls on the M4, 6% of a
-                // plan). A NaN would land on `lo`.
-                let v = keep * *tv + *dv;
-                *tv = if v > hi {
-                    hi
-                } else if v >= lo {
-                    v
-                } else {
-                    lo
-                };
-                *dv = 0.0;
-            }
+        // Over the flat entries, one select after the other (no branch): the host's compiler
+        // does four entries at a time; the same multiplication and addition per entry.
+        let tau = self.tau.as_flattened_mut();
+        let delta = delta.tau.as_flattened_mut();
+        for (tv, dv) in tau.iter_mut().zip(delta.iter_mut()) {
+            // Comparisons rather than `f32::clamp` (which has a panic path and pulls float
+            // formatting into the firmware) or `max`/`min` (library calls on the M4, 6% of a
+            // plan). A NaN would land on `lo`.
+            let v = keep * *tv + *dv;
+            let above = if v >= lo { v } else { lo };
+            *tv = if v > hi { hi } else { above };
+            *dv = 0.0;
         }
     }
 
@@ -280,6 +277,12 @@ impl<'a> Table<'a> {
     #[inline]
     pub fn flat(&self) -> &[f32] {
         self.tau.as_flattened()
+    }
+
+    /// The entries as one flat slice to write (`4 * block + slot`).
+    #[inline]
+    pub fn flat_mut(&mut self) -> &mut [f32] {
+        self.tau.as_flattened_mut()
     }
 
     /// Add `amount` at flat index `i` (ignored if out of range).

@@ -51,15 +51,17 @@ pub fn deposit(table: &mut Table<'_>, grid: &Grid<'_>, start: Point, tour: &[Dir
     let offsets = grid.offsets();
     let slots = slot_offsets(&offsets);
     let mut c = grid.index(start);
+    let flat = table.flat_mut();
     for &d in tour {
+        // `& 7`: in range of both 8-entry tables, which the compiler sees.
         let d = usize::from(d & 7);
-        let (Some(&slot), Some(&off)) = (slots.get(d), offsets.get(d)) else {
-            return;
-        };
+        let slot = slots.get(d).copied().unwrap_or(0);
         // `c` is a cell index (< cells, and the table's 16 bytes a cell fit in memory), so `4 * c`
-        // does not wrap; a stray index would only be ignored by `add_flat`.
-        table.add_flat(c.wrapping_mul(4).wrapping_add_signed(slot), amount);
-        c = c.wrapping_add_signed(off);
+        // does not wrap; a stray index is ignored.
+        if let Some(v) = flat.get_mut(c.wrapping_mul(4).wrapping_add_signed(slot)) {
+            *v += amount;
+        }
+        c = c.wrapping_add_signed(offsets.get(d).copied().unwrap_or(0));
     }
 }
 
