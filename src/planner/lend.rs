@@ -36,6 +36,7 @@
 
 #[cfg(doc)]
 use crate::colony::route;
+use crate::colony::tabu::TabuSet;
 use crate::map::grid::{Dir, Point};
 
 pub(super) use super::workspace::Guide;
@@ -131,7 +132,7 @@ pub(super) struct Colony<'w> {
     pub(super) tau: &'w mut [[f32; 4]],
     pub(super) delta: &'w mut [[f32; 4]],
     /// The ant's tabu set (and tightening's filter).
-    pub(super) tabu: &'w mut [u32],
+    pub(super) tabu: TabuSet<'w>,
     pub(super) dead: &'w [u32],
     pub(super) moves: &'w [u8],
     /// The ant's path, the iteration's best and worst (empty: walked again), the run's best.
@@ -224,7 +225,7 @@ impl<'a> Workspace<'a> {
         Colony {
             tau: self.tau,
             delta: self.delta,
-            tabu: self.tabu,
+            tabu: TabuSet::new(self.tabu),
             dead: self.dead,
             moves: self.moves,
             tours: [self.tour, self.iter_best, self.iter_worst, self.best],
