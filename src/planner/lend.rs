@@ -36,6 +36,7 @@
 
 #[cfg(doc)]
 use crate::colony::route;
+use crate::colony::route::RouteHeap;
 use crate::colony::tabu::TabuSet;
 use crate::map::grid::{Dir, Point};
 
@@ -101,14 +102,14 @@ impl Idle<'_> {
         &'g mut self,
         guide: &'g mut Guide<'_>,
         count: usize,
-    ) -> Option<(&'g mut [u32], &'g mut [u32])> {
+    ) -> Option<(&'g mut [u32], RouteHeap<'g>)> {
         let Guide::Words(words) = guide else {
             return None;
         };
         let lent = Lent::new(self.links, self.tabu, &mut [], &mut []);
         let take = heap_take(lent.lengths(), count);
         let (heap, _) = lent.take(take)?;
-        Some((words, heap))
+        Some((words, RouteHeap::new(heap)))
     }
 
     /// A packed route of `count` blocks: the words and heap to build it in ([`route_take`], the table
@@ -117,13 +118,14 @@ impl Idle<'_> {
         &'g mut self,
         guide: &'g mut Guide<'_>,
         count: usize,
-    ) -> Option<(Pair<'g>, &'g mut [u32])> {
+    ) -> Option<((&'g mut [u32], RouteHeap<'g>), &'g mut [u32])> {
         let Guide::Packed(out) = guide else {
             return None;
         };
         let lent = Lent::new(self.links, self.tabu, self.cells, &mut []);
         let take = route_take(lent.lengths(), count)?;
-        Some((lent.take(take)?, out))
+        let (words, heap) = lent.take(take)?;
+        Some(((words, RouteHeap::new(heap)), out))
     }
 }
 
