@@ -39,6 +39,7 @@ use crate::colony::route;
 use crate::colony::route::RouteHeap;
 use crate::colony::tabu::TabuSet;
 use crate::map::grid::{Dir, Point};
+use crate::polish::links::PathLinks;
 
 pub(super) use super::workspace::Guide;
 use super::workspace::Workspace;
@@ -195,10 +196,10 @@ impl Spent<'_> {
     }
 
     /// The smoothing's links for a raw path of `n` cells ([`smoothing_take`]).
-    pub(super) fn smoothing(&mut self, n: usize) -> &mut [u32] {
+    pub(super) fn smoothing(&mut self, n: usize) -> PathLinks<'_> {
         let lent = Lent::new(self.links, self.tabu, &mut [], &mut []);
         let take = smoothing_take(lent.lengths(), n);
-        lent.take(take).map_or(&mut [], |(links, _)| links)
+        PathLinks::new(lent.take(take).map_or(&mut [], |(links, _)| links))
     }
 
     /// The links (the corridor search's scratch on small maps).
