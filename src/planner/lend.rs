@@ -34,10 +34,13 @@
 //! and the route's words are scratch once the colony is done ([`super::Memory`] keeps nothing of
 //! them, or stashes what it keeps in the pheromone increments first).
 
+use super::run::{REFINE_WORDS, SHORT_REFINE_WORDS};
 #[cfg(doc)]
 use crate::colony::route;
 use crate::colony::route::RouteHeap;
+use crate::colony::route::GUIDE_BLOCKS;
 use crate::colony::tabu::TabuSet;
+use crate::colony::tighten::{hash_words, keyed_fits, keyed_words};
 use crate::map::grid::{Dir, Point};
 use crate::polish::links::PathLinks;
 
@@ -108,7 +111,11 @@ impl Idle<'_> {
             return None;
         };
         let lent = Lent::new(self.links, self.tabu, &mut [], &mut []);
-        let take = heap_take(lent.lengths(), count);
+        let ask = Ask {
+            blocks: count,
+            ..Ask::default()
+        };
+        let take = Need::Route.take(lent.lengths(), ask)?;
         let (heap, _) = lent.take(take)?;
         Some((words, RouteHeap::new(heap)))
     }
@@ -124,7 +131,12 @@ impl Idle<'_> {
             return None;
         };
         let lent = Lent::new(self.links, self.tabu, self.cells, &mut []);
-        let take = route_take(lent.lengths(), count)?;
+        let ask = Ask {
+            blocks: count,
+            packed: true,
+            ..Ask::default()
+        };
+        let take = Need::Route.take(lent.lengths(), ask)?;
         let (words, heap) = lent.take(take)?;
         Some(((words, RouteHeap::new(heap)), out))
     }
@@ -176,7 +188,12 @@ impl Spent<'_> {
         fewest: usize,
     ) -> Option<(&'g mut [u32], &'g mut [u32])> {
         let lent = Lent::new(self.links, self.tabu, &mut [], guide.reborrow().scratch());
-        let take = refine_take(lent.lengths(), words, fewest)?;
+        let ask = Ask {
+            words,
+            fewest,
+            ..Ask::default()
+        };
+        let take = Need::Refine.take(lent.lengths(), ask)?;
         lent.take(take)
     }
 
@@ -198,8 +215,13 @@ impl Spent<'_> {
     /// The smoothing's links for a raw path of `n` cells ([`smoothing_take`]).
     pub(super) fn smoothing(&mut self, n: usize) -> PathLinks<'_> {
         let lent = Lent::new(self.links, self.tabu, &mut [], &mut []);
-        let take = smoothing_take(lent.lengths(), n);
-        PathLinks::new(lent.take(take).map_or(&mut [], |(links, _)| links))
+        let ask = Ask {
+            cells: n,
+            ..Ask::default()
+        };
+        let take = Need::Smoothing.take(lent.lengths(), ask);
+        let links = take.and_then(|t| lent.take(t));
+        PathLinks::new(links.map_or(&mut [], |(links, _)| links))
     }
 
     /// The links (the corridor search's scratch on small maps).
@@ -396,7 +418,7 @@ impl<'x> Lent<'x> {
 /// holds at least `fewest` words (a smaller window,
 /// [`crate::polish::refine::Scratch::side`]); `None`: not enough. Reads the links, the tabu set
 /// and the route's words.
-pub(super) const fn refine_take(l: Lengths, words: usize, fewest: usize) -> Option<Take> {
+const fn refine_take(l: Lengths, words: usize, fewest: usize) -> Option<Take> {
     if l.links >= words && l.guide >= words {
         return Some(Take::Pair(Buf::Links, Buf::Guide, words));
     }
@@ -458,7 +480,7 @@ const fn min(a: usize, b: usize) -> usize {
 /// The words and the heap of a packed route of `count` blocks, built before the first ant (the
 /// table above): the tabu set halved, else the tabu set and the path cells' words, else either
 /// of them and the links, else the links halved; `None`: not enough.
-pub(super) const fn route_take(l: Lengths, count: usize) -> Option<Take> {
+const fn route_take(l: Lengths, count: usize) -> Option<Take> {
     let take = match (l.tabu >= count, l.points >= count) {
         _ if l.tabu >= count.saturating_mul(2) => Take::Halves(Buf::Tabu, count),
         (true, true) => Take::Pair(Buf::Tabu, Buf::Points, count),
@@ -471,7 +493,7 @@ pub(super) const fn route_take(l: Lengths, count: usize) -> Option<Take> {
 
 /// The heap of a word-a-block route of `count` blocks (the full layout): the links when they hold
 /// `count` words, else the tabu set.
-pub(super) const fn heap_take(l: Lengths, count: usize) -> Take {
+const fn heap_take(l: Lengths, count: usize) -> Take {
     if l.links >= count {
         Take::Whole(Buf::Links)
     } else {
@@ -481,7 +503,7 @@ pub(super) const fn heap_take(l: Lengths, count: usize) -> Take {
 
 /// The smoothing's links for a raw path of `n` cells: the links when they hold `n`, else the
 /// tabu set when it does, else the links (the greedy rule).
-pub(super) const fn smoothing_take(l: Lengths, n: usize) -> Take {
+const fn smoothing_take(l: Lengths, n: usize) -> Take {
     if l.links < n && l.tabu >= n {
         Take::Whole(Buf::Tabu)
     } else {
@@ -489,65 +511,191 @@ pub(super) const fn smoothing_take(l: Lengths, n: usize) -> Take {
     }
 }
 
-/// Idle buffers of these lengths, with `links` links.
-const fn with_links(links: usize, tabu: usize, points: usize) -> Lengths {
-    Lengths {
-        links,
-        tabu,
-        points,
-        guide: 0,
+/// One buffer need of a phase: what it borrows of the idle buffers, by which lending rule, and
+/// how much of it is enough. A phase's needs are a const list ([`SETUP`], [`COLONY`], [`POLISH`],
+/// all of them in [`PHASES`]); the slices a view lends ([`Need::take`], through [`Lent::take`]),
+/// the links an arena lays out for them ([`links`]) and the tabu lengths at which that changes
+/// ([`cuts`], what the arena's capacity search walks) are all read from that list, so a new
+/// phase or a new need is one entry here and its rule.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+pub(super) enum Need {
+    /// The coarse route's heap, a word a block ([`heap_take`]), or a packed route's words and
+    /// heap ([`route_take`]), by [`Ask::packed`].
+    Route,
+    /// Tightening's index over the links: [`Ask::table`] words of them (the path cells' words
+    /// beside them when its keys are packed); not lent by a rule (the colony's view holds the
+    /// links whole), but laid out.
+    Tighten,
+    /// The local search's two slices of [`Ask::words`] (at least [`Ask::fewest`], [`refine_take`]).
+    Refine,
+    /// The smoothing's links for [`Ask::cells`] path cells ([`smoothing_take`]).
+    Smoothing,
+}
+
+/// The setup's needs (before the first ant): the coarse route. (Its flood fill and pruning
+/// stack take the tabu set and the links whole, whatever their lengths.)
+pub(super) const SETUP: &[Need] = &[Need::Route];
+/// The colony's needs: tightening's index.
+pub(super) const COLONY: &[Need] = &[Need::Tighten];
+/// The polish's needs: the local search's slices, the smoothing's links. (A repair's detour
+/// takes what it gets: [`detour_take`].)
+pub(super) const POLISH: &[Need] = &[Need::Refine, Need::Smoothing];
+/// Every phase's needs: what an arena must lay out besides the tabu set.
+pub(super) const PHASES: [&[Need]; 3] = [SETUP, COLONY, POLISH];
+
+/// The figures the needs are functions of (each need reads its own).
+#[derive(Clone, Copy, PartialEq, Eq, Debug, Default)]
+pub(super) struct Ask {
+    /// The route's blocks (a word each of words and of heap).
+    pub(super) blocks: usize,
+    /// Whether the route is packed (its words lent, not laid out).
+    pub(super) packed: bool,
+    /// Cells of the longest path (`steps + 1`).
+    pub(super) cells: usize,
+    /// Words of tightening's table in the links.
+    pub(super) table: usize,
+    /// Words of each of the local search's slices, and the fewest it takes.
+    pub(super) words: usize,
+    pub(super) fewest: usize,
+}
+
+impl Ask {
+    /// What a layout asks of its links for a map of `cells` cells, paths of `steps` steps and a
+    /// route packed or not: the route's blocks ([`GUIDE_BLOCKS`] at most), tightening's table
+    /// (packed keys when a cell and a position fit a word, [`keyed_words`], else positions,
+    /// [`hash_words`]) and the local search's [`REFINE_WORDS`] (at least [`SHORT_REFINE_WORDS`]).
+    pub(super) const fn of(cells: usize, steps: usize, packed: bool) -> Self {
+        let n = steps.saturating_add(1);
+        Self {
+            blocks: min(cells, GUIDE_BLOCKS),
+            packed,
+            cells: n,
+            table: if keyed_fits(cells, n) {
+                keyed_words(n)
+            } else {
+                hash_words(n)
+            },
+            words: REFINE_WORDS,
+            fewest: SHORT_REFINE_WORDS,
+        }
     }
 }
 
-/// Words [`refine_take`] needs in the links beside a tabu set of `tabu` words (and a route of
-/// fewer than `words` words): the fewest of 0, `words` and twice `words` that it lends from.
-pub(super) const fn refine_links(tabu: usize, words: usize, fewest: usize) -> usize {
-    if refine_take(with_links(0, tabu, 0), words, fewest).is_some() {
-        0
-    } else if refine_take(with_links(words, tabu, 0), words, fewest).is_some() {
-        words
+impl Need {
+    /// What it takes of buffers of lengths `l` (its rule), `None`: they do not hold it.
+    pub(super) const fn take(self, l: Lengths, a: Ask) -> Option<Take> {
+        match self {
+            Need::Route if a.packed => route_take(l, a.blocks),
+            Need::Route => Some(heap_take(l, a.blocks)),
+            Need::Tighten => Some(Take::Whole(Buf::Links)),
+            Need::Refine => refine_take(l, a.words, a.fewest),
+            Need::Smoothing => Some(smoothing_take(l, a.cells)),
+        }
+    }
+
+    /// Words of its shorter slice that are enough.
+    const fn wants(self, a: Ask) -> usize {
+        match self {
+            Need::Route => a.blocks,
+            Need::Tighten => a.table,
+            Need::Refine => a.fewest,
+            Need::Smoothing => a.cells,
+        }
+    }
+
+    /// Whether buffers of lengths `l` give it enough.
+    pub(super) const fn enough(self, l: Lengths, a: Ask) -> bool {
+        match self.take(l, a) {
+            Some(t) => t.fits(l) && t.words(l) >= self.wants(a),
+            None => false,
+        }
+    }
+
+    /// The lengths of links it may ask for, fewest first.
+    const fn steps(self, a: Ask) -> [usize; 3] {
+        let w = self.wants(a);
+        match self {
+            Need::Route if a.packed => [0, w, w.saturating_mul(2)],
+            Need::Route | Need::Smoothing => [0, w, w],
+            Need::Tighten => [w, w, w],
+            Need::Refine => [0, a.words, a.words.saturating_mul(2)],
+        }
+    }
+
+    /// Words it needs in the links beside the other idle buffers of `l` (`l.links` unread): the
+    /// fewest of its [`Need::steps`] that are enough.
+    pub(super) const fn links(self, l: Lengths, a: Ask) -> usize {
+        let [x, y, z] = self.steps(a);
+        if self.enough(Lengths { links: x, ..l }, a) {
+            x
+        } else if self.enough(Lengths { links: y, ..l }, a) {
+            y
+        } else {
+            z
+        }
+    }
+
+    /// The tabu-set lengths at which [`Need::links`] may change (0: none).
+    const fn cuts(self, a: Ask) -> [usize; 3] {
+        let w = self.wants(a);
+        match self {
+            Need::Route if a.packed => [w, w.saturating_mul(2), 0],
+            Need::Route | Need::Smoothing => [w, 0, 0],
+            Need::Tighten => [0, 0, 0],
+            Need::Refine => [
+                a.words,
+                a.words.saturating_mul(2),
+                a.fewest.saturating_mul(2),
+            ],
+        }
+    }
+}
+
+/// Words every phase of [`PHASES`] needs in the links beside the other idle buffers of `l`: the
+/// most any of their needs asks for.
+pub(super) const fn links(l: Lengths, a: Ask) -> usize {
+    let mut most = 0;
+    let mut phases: &[&[Need]] = &PHASES;
+    while let [needs, rest @ ..] = phases {
+        let mut needs: &[Need] = needs;
+        while let [need, tail @ ..] = needs {
+            most = max(most, need.links(l, a));
+            needs = tail;
+        }
+        phases = rest;
+    }
+    most
+}
+
+/// The smallest tabu-set length above `x` at which [`links`] may change (for the same other
+/// buffers), at most `end`: between two of them it is the same ([`super::arena::capacity`]
+/// walks the tabu lengths piece by piece).
+pub(super) const fn next_cut(x: usize, a: Ask, end: usize) -> usize {
+    let mut best = end;
+    let mut phases: &[&[Need]] = &PHASES;
+    while let [needs, rest @ ..] = phases {
+        let mut needs: &[Need] = needs;
+        while let [need, tail @ ..] = needs {
+            let mut cuts: &[usize] = &need.cuts(a);
+            while let [c, more @ ..] = cuts {
+                if *c > x && *c < best {
+                    best = *c;
+                }
+                cuts = more;
+            }
+            needs = tail;
+        }
+        phases = rest;
+    }
+    best
+}
+
+const fn max(a: usize, b: usize) -> usize {
+    if a > b {
+        a
     } else {
-        words.saturating_mul(2)
+        b
     }
-}
-
-/// Words [`route_take`] needs in the links beside a tabu set of `tabu` words and `points` words
-/// of path cells for a route of `count` blocks: the fewest of 0, `count` and twice `count` that
-/// it lends from.
-pub(super) const fn route_links(tabu: usize, points: usize, count: usize) -> usize {
-    if route_take(with_links(0, tabu, points), count).is_some() {
-        0
-    } else if route_take(with_links(count, tabu, points), count).is_some() {
-        count
-    } else {
-        count.saturating_mul(2)
-    }
-}
-
-/// Words [`smoothing_take`] needs in the links beside a tabu set of `tabu` words for `n`
-/// cells: 0 when it lends `n` words without them, else `n`.
-pub(super) const fn smoothing_links(tabu: usize, n: usize) -> usize {
-    let l = with_links(0, tabu, 0);
-    if smoothing_take(l, n).words(l) >= n {
-        0
-    } else {
-        n
-    }
-}
-
-/// The tabu-set lengths at which the rules above change what they need of the links, for the
-/// local search's `words` and `fewest`, a route of `count` blocks and paths of `n` cells (when
-/// the path cells hold `count` words): between two of them every `*_links` above is the same
-/// ([`super::arena::capacity`] walks the tabu lengths piece by piece).
-pub(super) const fn cuts(words: usize, fewest: usize, count: usize, n: usize) -> [usize; 6] {
-    [
-        words,
-        words.saturating_mul(2),
-        fewest.saturating_mul(2),
-        count,
-        count.saturating_mul(2),
-        n,
-    ]
 }
 
 #[cfg(test)]
@@ -576,35 +724,44 @@ mod tests {
         lent.take(take).map(|(x, y)| (x.len(), y.len()))
     }
 
+    /// What the tests ask: a packed route of `blocks`, the local search's `words` (at least
+    /// `fewest`), `cells` path cells.
+    fn ask(blocks: usize, words: usize, fewest: usize, cells: usize) -> Ask {
+        Ask {
+            blocks,
+            packed: true,
+            cells,
+            table: 0,
+            words,
+            fewest,
+        }
+    }
+
     #[test]
     fn every_lending_fits_what_its_size_says() {
         // For lengths around the boundaries, the route and the local search find their slices
-        // exactly when the sizes say the links suffice, and the slices lent are as long as the
+        // exactly when the needs say the links suffice, and the slices lent are as long as the
         // rule says (two `&mut` slices never overlap, by type).
+        let a = ask(100, 100, 60, 120);
         for tabu in [0usize, 10, 99, 100, 150, 199, 200, 500] {
             for links in [0usize, 50, 99, 100, 199, 200, 300] {
                 let l = lengths(links, tabu, 0, 7);
-                let got = route_take(l, 100);
-                assert_eq!(
-                    got.is_some(),
-                    links >= route_links(tabu, 0, 100),
-                    "{tabu} {links}"
-                );
+                let need = |n: Need| links >= n.links(l, a);
+                let got = Need::Route.take(l, a);
+                assert_eq!(got.is_some(), need(Need::Route), "{tabu} {links}");
                 if let Some(take) = got {
                     assert_eq!(lend(l, take), Some((100, 100)));
                 }
-                let got = refine_take(l, 100, 60);
-                let need = refine_links(tabu, 100, 60);
-                assert_eq!(got.is_some(), links >= need, "{tabu} {links}");
+                let got = Need::Refine.take(l, a);
+                assert_eq!(got.is_some(), need(Need::Refine), "{tabu} {links}");
                 if let Some(take) = got {
                     let w = take.words(l);
                     assert!(w == 100 || w >= 60 && w == tabu / 2, "{take:?}");
                     assert_eq!(lend(l, take), Some((w, w)));
                 }
-                let n = 120;
-                let take = smoothing_take(l, n);
+                let take = Need::Smoothing.take(l, a).unwrap();
                 let s = lend(l, take).map_or(0, |(x, _)| x);
-                assert_eq!(s >= n, links >= smoothing_links(tabu, n), "{tabu} {links}");
+                assert_eq!(s >= 120, need(Need::Smoothing), "{tabu} {links}");
             }
         }
         // A pair of one buffer with itself is never lent.
@@ -615,22 +772,40 @@ mod tests {
     }
 
     #[test]
+    fn a_short_buffer_is_not_enough() {
+        // Each need says when the idle buffers fall short: then the arena lays out more links,
+        // or the phase counts a shortfall (`planner::Shortfalls`).
+        let a = Ask {
+            table: 50,
+            ..ask(100, 100, 60, 120)
+        };
+        let l = lengths(0, 0, 0, 0);
+        for need in [Need::Route, Need::Tighten, Need::Refine, Need::Smoothing] {
+            assert!(!need.enough(l, a), "{need:?}");
+            let links = need.links(l, a);
+            assert!(need.enough(lengths(links, 0, 0, 0), a), "{need:?}");
+            assert!(!need.enough(lengths(links - 1, 0, 0, 0), a), "{need:?}");
+        }
+        // The arena's links are the most any phase's need asks: with a tabu set of 200 words,
+        // which lends the route, the local search and the smoothing theirs, tightening's table.
+        assert_eq!(links(l, a), 200);
+        assert_eq!(links(lengths(0, 200, 0, 0), a), 50);
+    }
+
+    #[test]
     fn the_links_change_only_at_the_cuts() {
-        // Between two tabu lengths of `cuts`, every size the arena lays out is the same: the
+        // Between two tabu lengths of `next_cut`, the links every phase needs are the same: the
         // arena's capacity search relies on it. A rule whose threshold is not a cut fails here.
         for (words, fewest, count, n) in
             [(100, 60, 70, 300), (4056, 3456, 4096, 4096), (8, 3, 20, 9)]
         {
-            let cuts = cuts(words, fewest, count, n);
+            let a = ask(count, words, fewest, n);
             let sizes = |tabu| {
-                (
-                    refine_links(tabu, words, fewest),
-                    route_links(tabu, n, count),
-                    smoothing_links(tabu, n),
-                )
+                let l = lengths(0, tabu, n, 0);
+                [Need::Route, Need::Refine, Need::Smoothing].map(|need| need.links(l, a))
             };
             for tabu in 1..3 * (words + count + n) {
-                if !cuts.contains(&tabu) {
+                if next_cut(tabu - 1, a, usize::MAX) != tabu {
                     assert_eq!(sizes(tabu), sizes(tabu - 1), "{tabu}");
                 }
             }
