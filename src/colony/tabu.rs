@@ -85,10 +85,14 @@ impl<'a> TabuSet<'a> {
 
 #[cfg(test)]
 mod tests {
-    use super::*;
+    use super::TabuSet;
 
     #[test]
     fn a_set_holds_its_cells_and_refuses_the_rest() {
+        // A set too short for its map is refused.
+        let mut short = [0u32; 2];
+        assert!(TabuSet::of(&mut short, 65).is_none());
+        assert!(TabuSet::of(&mut short, 64).is_some());
         let mut words = [0u32; 2];
         let mut t = TabuSet::new(&mut words);
         assert_eq!(t.cells(), 64);
@@ -102,10 +106,6 @@ mod tests {
         t.insert(64);
         t.insert(usize::MAX);
         assert_eq!(words, [1 | 1 << 31, 1 | 1 << 31]);
-        // A set too short for its map is refused.
-        let mut short = [0u32; 2];
-        assert!(TabuSet::of(&mut short, 65).is_none());
-        assert!(TabuSet::of(&mut short, 64).is_some());
     }
 
     #[test]

@@ -55,12 +55,10 @@ use crate::map::bitmap::words;
 use crate::map::grid::{Dir, Point};
 
 use crate::colony::route::packed_words;
-#[cfg(doc)]
-use crate::colony::tighten::{hash_words, keyed_words};
+use crate::colony::tighten::{hash_words, keyed_fits, keyed_words};
 
 use super::lend;
-#[cfg(any(test, doc))]
-use super::run::REFINE_WORDS;
+use super::run::{REFINE_WORDS, SHORT_REFINE_WORDS};
 use super::workspace::{Buffers, Workspace};
 
 /// Most pheromone entries of the compact layout: 64 (on a 512 x 512 map, 64 blocks of 64 x 64
@@ -89,7 +87,7 @@ const fn full_links_hold(links: usize) -> bool {
             points: 0,
             guide: GUIDE_BLOCKS,
         };
-        if lend::links(idle, lend::Ask::of(cells, FULL_STEPS, false)) > links {
+        if lend::links(idle, ask(cells, FULL_STEPS, false)) > links {
             return false;
         }
         cells = if cells < 8192 {
@@ -206,7 +204,31 @@ pub const fn compact_words(cells: usize, steps: usize) -> usize {
 /// tabu set is shorter, the local search's two slices of [`REFINE_WORDS`] and the packed route's
 /// words and heap (a word a block) as far as the tabu set does not hold them.
 const fn compact_links(cells: usize, steps: usize) -> usize {
-    lend::links(idle(cells, steps), lend::Ask::of(cells, steps, true))
+    lend::links(idle(cells, steps), ask(cells, steps, true))
+}
+
+/// What a layout asks of its links for a map of `cells` cells, paths of `steps` steps and a route
+/// packed or not: the route's blocks ([`GUIDE_BLOCKS`] at most), tightening's table (packed keys
+/// when a cell and a position fit a word, [`keyed_words`], else positions, [`hash_words`]) and
+/// the local search's [`REFINE_WORDS`] (at least [`SHORT_REFINE_WORDS`]).
+const fn ask(cells: usize, steps: usize, packed: bool) -> lend::Ask {
+    let n = steps.saturating_add(1);
+    let blocks = if cells < GUIDE_BLOCKS {
+        cells
+    } else {
+        GUIDE_BLOCKS
+    };
+    let table = if keyed_fits(cells, n) {
+        keyed_words(n)
+    } else {
+        hash_words(n)
+    };
+    lend::Ask {
+        route: (blocks, packed),
+        cells: n,
+        table,
+        refine: (REFINE_WORDS, SHORT_REFINE_WORDS),
+    }
 }
 
 /// The idle buffers besides the links of the compact layout: the tabu set and the path cells'
@@ -268,7 +290,7 @@ const fn fits_compact(arena: usize, w: usize) -> bool {
 /// the largest route.
 const fn next_cut(x: usize) -> usize {
     let cells = GUIDE_BLOCKS.saturating_mul(32);
-    lend::next_cut(x, lend::Ask::of(cells, MIN_STEPS, true), usize::MAX / 64)
+    lend::next_cut(x, ask(cells, MIN_STEPS, true), usize::MAX / 64)
 }
 
 /// The longest path a map of `cells` cells gets in an arena of `arena` words with paths bounded

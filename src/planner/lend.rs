@@ -27,6 +27,26 @@
 //! | a reused answer's repair ([`super::repair`]): the detour | two slices, as many words as it can get (its box is sized by what blocks the answer, up to what the slices hold; no memo) | the pair of the links, the route's words and the tabu set, or one of them halved, whose shorter slice is longest (the first such in that order on a tie) |
 //! | a reused answer's repair: the smoothing | `n` links, as in the polish | as in the polish |
 //!
+//! **Needs, declared once per phase.** What a phase borrows of the idle buffers is a const list of
+//! [`Need`]s: [`SETUP`], [`COLONY`], [`POLISH`], all of them in [`PHASES`]. A need is one lending
+//! rule (the `*_take` functions below: a [`Take`] from the buffers' lengths alone) and how much of
+//! it is enough ([`Need::enough`]). Everything else is read from that list: the slices a view
+//! lends ([`Need::take`], then [`Lent::take`]), the links the compact arena lays out beside the
+//! tabu set ([`links`]: the most any need asks), the tabu lengths at which that changes
+//! ([`next_cut`], what `arena::capacity` walks), and the compile-time check that the full
+//! layout's fixed links hold every need (`arena::full_links_hold`). To add a phase or a need: a
+//! [`Need`] variant with its rule, its `wants`, `steps` and `cuts`, and an entry in its phase's
+//! list; the tests here (`the_links_change_only_at_the_cuts`, `a_short_buffer_is_not_enough`)
+//! fail when the cuts or the sizes do not follow the rule. A buffer the setup or the polish finds
+//! short is a counted shortfall ([`super::Shortfalls`]: the route, its stash, the local search,
+//! the smoothing, the corridor), never a silent fallback; the arena and the boards' storages have
+//! none. (Tightening's index is the one left: a walk no index holds stays untightened, uncounted.)
+//!
+//! **Typed views.** A lent buffer reaches the phase as its own type, which owns the operations
+//! the phase needs, so no call site does word arithmetic on a buffer of another role: the ant's
+//! [`TabuSet`], the route search's [`RouteHeap`], the smoothing's [`PathLinks`], the local
+//! search's [`crate::polish::refine::Scratch`].
+//!
 //! Every choice depends only on the buffers' lengths (never on their contents or addresses), so
 //! a host that lays out a device's arena plans exactly what the device plans, and a choice made
 //! at the start of a phase is the same at each of its pieces. None of these buffers is kept
@@ -34,13 +54,10 @@
 //! and the route's words are scratch once the colony is done ([`super::Memory`] keeps nothing of
 //! them, or stashes what it keeps in the pheromone increments first).
 
-use super::run::{REFINE_WORDS, SHORT_REFINE_WORDS};
 #[cfg(doc)]
 use crate::colony::route;
 use crate::colony::route::RouteHeap;
-use crate::colony::route::GUIDE_BLOCKS;
 use crate::colony::tabu::TabuSet;
-use crate::colony::tighten::{hash_words, keyed_fits, keyed_words};
 use crate::map::grid::{Dir, Point};
 use crate::polish::links::PathLinks;
 
@@ -111,10 +128,7 @@ impl Idle<'_> {
             return None;
         };
         let lent = Lent::new(self.links, self.tabu, &mut [], &mut []);
-        let ask = Ask {
-            blocks: count,
-            ..Ask::default()
-        };
+        let ask = Ask::route(count, false);
         let take = Need::Route.take(lent.lengths(), ask)?;
         let (heap, _) = lent.take(take)?;
         Some((words, RouteHeap::new(heap)))
@@ -131,11 +145,7 @@ impl Idle<'_> {
             return None;
         };
         let lent = Lent::new(self.links, self.tabu, self.cells, &mut []);
-        let ask = Ask {
-            blocks: count,
-            packed: true,
-            ..Ask::default()
-        };
+        let ask = Ask::route(count, true);
         let take = Need::Route.take(lent.lengths(), ask)?;
         let (words, heap) = lent.take(take)?;
         Some(((words, RouteHeap::new(heap)), out))
@@ -188,11 +198,7 @@ impl Spent<'_> {
         fewest: usize,
     ) -> Option<(&'g mut [u32], &'g mut [u32])> {
         let lent = Lent::new(self.links, self.tabu, &mut [], guide.reborrow().scratch());
-        let ask = Ask {
-            words,
-            fewest,
-            ..Ask::default()
-        };
+        let ask = Ask::refine(words, fewest);
         let take = Need::Refine.take(lent.lengths(), ask)?;
         lent.take(take)
     }
@@ -215,10 +221,7 @@ impl Spent<'_> {
     /// The smoothing's links for a raw path of `n` cells ([`smoothing_take`]).
     pub(super) fn smoothing(&mut self, n: usize) -> PathLinks<'_> {
         let lent = Lent::new(self.links, self.tabu, &mut [], &mut []);
-        let ask = Ask {
-            cells: n,
-            ..Ask::default()
-        };
+        let ask = Ask::smoothing(n);
         let take = Need::Smoothing.take(lent.lengths(), ask);
         let links = take.and_then(|t| lent.take(t));
         PathLinks::new(links.map_or(&mut [], |(links, _)| links))
@@ -520,13 +523,13 @@ const fn smoothing_take(l: Lengths, n: usize) -> Take {
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
 pub(super) enum Need {
     /// The coarse route's heap, a word a block ([`heap_take`]), or a packed route's words and
-    /// heap ([`route_take`]), by [`Ask::packed`].
+    /// heap ([`route_take`]), by [`Ask::route`].
     Route,
     /// Tightening's index over the links: [`Ask::table`] words of them (the path cells' words
     /// beside them when its keys are packed); not lent by a rule (the colony's view holds the
     /// links whole), but laid out.
     Tighten,
-    /// The local search's two slices of [`Ask::words`] (at least [`Ask::fewest`], [`refine_take`]).
+    /// The local search's two slices ([`Ask::refine`]: of its words, at least its fewest, [`refine_take`]).
     Refine,
     /// The smoothing's links for [`Ask::cells`] path cells ([`smoothing_take`]).
     Smoothing,
@@ -546,37 +549,41 @@ pub(super) const PHASES: [&[Need]; 3] = [SETUP, COLONY, POLISH];
 /// The figures the needs are functions of (each need reads its own).
 #[derive(Clone, Copy, PartialEq, Eq, Debug, Default)]
 pub(super) struct Ask {
-    /// The route's blocks (a word each of words and of heap).
-    pub(super) blocks: usize,
-    /// Whether the route is packed (its words lent, not laid out).
-    pub(super) packed: bool,
+    /// The route's blocks (a word each of words and of heap), and whether it is packed (its
+    /// words lent, not laid out).
+    pub(super) route: (usize, bool),
     /// Cells of the longest path (`steps + 1`).
     pub(super) cells: usize,
     /// Words of tightening's table in the links.
     pub(super) table: usize,
     /// Words of each of the local search's slices, and the fewest it takes.
-    pub(super) words: usize,
-    pub(super) fewest: usize,
+    pub(super) refine: (usize, usize),
 }
 
 impl Ask {
-    /// What a layout asks of its links for a map of `cells` cells, paths of `steps` steps and a
-    /// route packed or not: the route's blocks ([`GUIDE_BLOCKS`] at most), tightening's table
-    /// (packed keys when a cell and a position fit a word, [`keyed_words`], else positions,
-    /// [`hash_words`]) and the local search's [`REFINE_WORDS`] (at least [`SHORT_REFINE_WORDS`]).
-    pub(super) const fn of(cells: usize, steps: usize, packed: bool) -> Self {
-        let n = steps.saturating_add(1);
+    /// A route of `blocks` blocks, packed or not.
+    pub(super) const fn route(blocks: usize, packed: bool) -> Self {
         Self {
-            blocks: min(cells, GUIDE_BLOCKS),
-            packed,
-            cells: n,
-            table: if keyed_fits(cells, n) {
-                keyed_words(n)
-            } else {
-                hash_words(n)
-            },
-            words: REFINE_WORDS,
-            fewest: SHORT_REFINE_WORDS,
+            route: (blocks, packed),
+            cells: 0,
+            table: 0,
+            refine: (0, 0),
+        }
+    }
+
+    /// The local search's slices of `words` (at least `fewest`).
+    pub(super) const fn refine(words: usize, fewest: usize) -> Self {
+        Self {
+            refine: (words, fewest),
+            ..Self::route(0, false)
+        }
+    }
+
+    /// The smoothing's links for `cells` path cells.
+    pub(super) const fn smoothing(cells: usize) -> Self {
+        Self {
+            cells,
+            ..Self::route(0, false)
         }
     }
 }
@@ -585,10 +592,10 @@ impl Need {
     /// What it takes of buffers of lengths `l` (its rule), `None`: they do not hold it.
     pub(super) const fn take(self, l: Lengths, a: Ask) -> Option<Take> {
         match self {
-            Need::Route if a.packed => route_take(l, a.blocks),
-            Need::Route => Some(heap_take(l, a.blocks)),
+            Need::Route if a.route.1 => route_take(l, a.route.0),
+            Need::Route => Some(heap_take(l, a.route.0)),
             Need::Tighten => Some(Take::Whole(Buf::Links)),
-            Need::Refine => refine_take(l, a.words, a.fewest),
+            Need::Refine => refine_take(l, a.refine.0, a.refine.1),
             Need::Smoothing => Some(smoothing_take(l, a.cells)),
         }
     }
@@ -596,9 +603,9 @@ impl Need {
     /// Words of its shorter slice that are enough.
     const fn wants(self, a: Ask) -> usize {
         match self {
-            Need::Route => a.blocks,
+            Need::Route => a.route.0,
             Need::Tighten => a.table,
-            Need::Refine => a.fewest,
+            Need::Refine => a.refine.1,
             Need::Smoothing => a.cells,
         }
     }
@@ -615,10 +622,10 @@ impl Need {
     const fn steps(self, a: Ask) -> [usize; 3] {
         let w = self.wants(a);
         match self {
-            Need::Route if a.packed => [0, w, w.saturating_mul(2)],
+            Need::Route if a.route.1 => [0, w, w.saturating_mul(2)],
             Need::Route | Need::Smoothing => [0, w, w],
             Need::Tighten => [w, w, w],
-            Need::Refine => [0, a.words, a.words.saturating_mul(2)],
+            Need::Refine => [0, a.refine.0, a.refine.0.saturating_mul(2)],
         }
     }
 
@@ -639,13 +646,13 @@ impl Need {
     const fn cuts(self, a: Ask) -> [usize; 3] {
         let w = self.wants(a);
         match self {
-            Need::Route if a.packed => [w, w.saturating_mul(2), 0],
+            Need::Route if a.route.1 => [w, w.saturating_mul(2), 0],
             Need::Route | Need::Smoothing => [w, 0, 0],
             Need::Tighten => [0, 0, 0],
             Need::Refine => [
-                a.words,
-                a.words.saturating_mul(2),
-                a.fewest.saturating_mul(2),
+                a.refine.0,
+                a.refine.0.saturating_mul(2),
+                a.refine.1.saturating_mul(2),
             ],
         }
     }
@@ -728,12 +735,10 @@ mod tests {
     /// `fewest`), `cells` path cells.
     fn ask(blocks: usize, words: usize, fewest: usize, cells: usize) -> Ask {
         Ask {
-            blocks,
-            packed: true,
+            route: (blocks, true),
             cells,
             table: 0,
-            words,
-            fewest,
+            refine: (words, fewest),
         }
     }
 

@@ -94,17 +94,17 @@ impl<'a> PathLinks<'a> {
 
 #[cfg(test)]
 mod tests {
-    use super::*;
+    use super::PathLinks;
 
     #[test]
     fn links_beyond_the_words_are_refused_and_a_chain_reverses() {
         let mut words = [0u32; 5];
         let mut l = PathLinks::new(&mut words);
-        assert!(l.holds(5) && !l.holds(6));
         // 0 <- 1 <- 3 <- 4 (2 is off the chain).
         for (j, from) in [(0, 0), (1, 0), (2, 1), (3, 1), (4, 3)] {
             l.link(j, from);
         }
+        assert!(l.holds(5) && !l.holds(6));
         l.link(5, 2);
         assert_eq!(l.from(5), None);
         assert_eq!(l.from(4), Some(3));

@@ -645,6 +645,16 @@ mod tests {
     use super::*;
     use crate::geometry::polyline_length;
 
+    /// No links: the smoothing takes its greedy rule.
+    fn unlinked() -> PathLinks<'static> {
+        PathLinks::new(&mut [])
+    }
+
+    /// The links over `words`.
+    fn linked(words: &mut [u32]) -> PathLinks<'_> {
+        PathLinks::new(words)
+    }
+
     fn grid(rows: &[&str]) -> (Vec<u8>, u16, u16) {
         crate::testutil::bits(rows)
     }
@@ -662,7 +672,7 @@ mod tests {
             let mut p = raw.clone();
             let mut d = vec![0.0; 6];
             let mut pr = vec![0; 6];
-            let k = smooth(&g, kind, &mut p, 6, &mut d, &mut PathLinks::new(&mut pr));
+            let k = smooth(&g, kind, &mut p, 6, &mut d, &mut linked(&mut pr));
             assert_eq!(&p[..k], &pts(&[(0, 0), (5, 2)])[..], "{kind:?}");
         }
     }
@@ -672,14 +682,7 @@ mod tests {
         let (b, w, h) = grid(&["....", "....", "...."]);
         let g = Grid::new(w, h, &b).unwrap();
         let mut p = pts(&[(0, 0), (1, 0), (2, 0), (3, 1), (3, 2)]);
-        let k = smooth(
-            &g,
-            SmoothingKind::None,
-            &mut p,
-            5,
-            &mut [],
-            &mut PathLinks::new(&mut []),
-        );
+        let k = smooth(&g, SmoothingKind::None, &mut p, 5, &mut [], &mut unlinked());
         assert_eq!(&p[..k], &pts(&[(0, 0), (2, 0), (3, 1), (3, 2)])[..]);
     }
 
@@ -716,7 +719,7 @@ mod tests {
             let mut p = raw.clone();
             let mut d = vec![0.0; n];
             let mut pr = vec![0; n];
-            let k = smooth(&g, kind, &mut p, n, &mut d, &mut PathLinks::new(&mut pr));
+            let k = smooth(&g, kind, &mut p, n, &mut d, &mut linked(&mut pr));
             let wp = &p[..k];
             assert_eq!(wp[0], raw[0]);
             assert_eq!(wp[k - 1], raw[n - 1]);
@@ -830,14 +833,7 @@ mod tests {
             let (want_dist, want_prev) = rule(&g, &raw);
             // The ring as long as the path, so every distance stays readable.
             let (mut dist, mut prev) = (vec![0f32; n], vec![0u32; n]);
-            dp_cells(
-                &g,
-                &raw,
-                &mut dist,
-                &mut PathLinks::new(&mut prev),
-                LOOKBACK,
-                1..n,
-            );
+            dp_cells(&g, &raw, &mut dist, &mut linked(&mut prev), LOOKBACK, 1..n);
             assert_eq!(prev[1..], want_prev[1..], "case {case}");
             let (bits, want_bits): (Vec<u32>, Vec<u32>) = (
                 dist.iter().map(|d| d.to_bits()).collect(),
@@ -851,14 +847,7 @@ mod tests {
             let mut j = 1;
             while j < n {
                 let to = (j + chunk).min(n);
-                dp_cells(
-                    &g,
-                    &raw,
-                    &mut dist,
-                    &mut PathLinks::new(&mut prev),
-                    LOOKBACK,
-                    j..to,
-                );
+                dp_cells(&g, &raw, &mut dist, &mut linked(&mut prev), LOOKBACK, j..to);
                 j = to;
             }
             assert_eq!(prev[1..], want_prev[1..], "ring, case {case}");
@@ -875,18 +864,18 @@ mod tests {
             let n = raw.len();
             for kind in SmoothingKind::ALL {
                 let (mut p1, mut d1, mut r1) = (raw.clone(), vec![0.0; n], vec![0; n]);
-                let k1 = smooth(&g, kind, &mut p1, n, &mut d1, &mut PathLinks::new(&mut r1));
+                let k1 = smooth(&g, kind, &mut p1, n, &mut d1, &mut linked(&mut r1));
                 let (mut p2, mut d2, mut r2) = (raw.clone(), vec![7.0; n], vec![9; n]);
-                let mut sm = Smoother::new(kind, n, &mut d2, &mut PathLinks::new(&mut r2));
+                let mut sm = Smoother::new(kind, n, &mut d2, &mut linked(&mut r2));
                 let chunk = 1 + case % 13;
                 let mut calls = 0;
-                while sm.resume(&g, &p2, &mut d2, &mut PathLinks::new(&mut r2), chunk) {
+                while sm.resume(&g, &p2, &mut d2, &mut linked(&mut r2), chunk) {
                     calls += 1;
                 }
                 if kind == SmoothingKind::Shortest {
                     assert_eq!(calls, (n - 1).div_ceil(chunk) - 1, "{n} {chunk}");
                 }
-                let k2 = sm.finish(&g, &mut p2, &mut d2, &mut PathLinks::new(&mut r2));
+                let k2 = sm.finish(&g, &mut p2, &mut d2, &mut linked(&mut r2));
                 assert_eq!(p1[..k1], p2[..k2], "{kind:?} case {case}");
             }
         }
@@ -914,25 +903,16 @@ mod tests {
                     }
                 };
                 let (mut p1, mut d1, mut r1) = (raw.clone(), vec![0.0; n], vec![0; n]);
-                let k1 = start(&mut d1, &mut r1).finish(
-                    &g,
-                    &mut p1,
-                    &mut d1,
-                    &mut PathLinks::new(&mut r1),
-                );
+                let k1 = start(&mut d1, &mut r1).finish(&g, &mut p1, &mut d1, &mut linked(&mut r1));
                 for budget in [1u32, 7, 60, 100_000] {
                     let (mut p2, mut d2, mut r2) = (raw.clone(), vec![0.0; n], vec![0; n]);
                     let mut sm = start(&mut d2, &mut r2);
-                    while sm.resume(&g, &p2, &mut d2, &mut PathLinks::new(&mut r2), 9) {}
+                    while sm.resume(&g, &p2, &mut d2, &mut linked(&mut r2), 9) {}
                     let mut pieces = 1;
                     let k2 = loop {
-                        if let Some(k) = sm.finish_piece(
-                            &g,
-                            &mut p2,
-                            &mut d2,
-                            &mut PathLinks::new(&mut r2),
-                            budget,
-                        ) {
+                        if let Some(k) =
+                            sm.finish_piece(&g, &mut p2, &mut d2, &mut linked(&mut r2), budget)
+                        {
                             break k;
                         }
                         pieces += 1;
@@ -968,7 +948,7 @@ mod tests {
                 &mut got,
                 n,
                 &mut vec![0.0; dn],
-                &mut PathLinks::new(&mut vec![0; pn]),
+                &mut linked(&mut vec![0; pn]),
             );
             assert_eq!(&got[..kg], &want[..kw], "case {case}");
         }
@@ -992,7 +972,7 @@ mod tests {
                 &mut got,
                 n,
                 &mut vec![0.0; dn],
-                &mut PathLinks::new(&mut vec![0; pn]),
+                &mut linked(&mut vec![0; pn]),
             );
             let wp = &got[..k];
             assert_eq!(wp[0], raw[0]);
@@ -1007,7 +987,7 @@ mod tests {
                 &mut gr,
                 n,
                 &mut [],
-                &mut PathLinks::new(&mut []),
+                &mut unlinked(),
             );
             let (ls, lg) = (polyline_length(wp), polyline_length(&gr[..kg]));
             assert!(ls <= polyline_length(&raw));
@@ -1039,12 +1019,12 @@ mod tests {
                 SmoothingKind::Shortest,
                 n,
                 &mut dist,
-                &mut PathLinks::new(&mut prev),
+                &mut linked(&mut prev),
             );
             if bounded {
                 sm = sm.bounded();
             }
-            while sm.resume(&g, &pts, &mut dist, &mut PathLinks::new(&mut prev), 50) {}
+            while sm.resume(&g, &pts, &mut dist, &mut linked(&mut prev), 50) {}
             let farthest = (1..n).map(|j| j - prev[j] as usize).max().unwrap();
             assert!(farthest <= reach, "{bounded}: {farthest}");
             assert!(farthest > reach - STRIDE, "{bounded}: {farthest}");
@@ -1092,7 +1072,7 @@ mod tests {
                     count,
                     &raw,
                     &mut dist,
-                    &mut PathLinks::new(&mut prev),
+                    &mut linked(&mut prev),
                     LOOKBACK,
                     j..j + 1,
                 );
@@ -1103,20 +1083,15 @@ mod tests {
             // The smoothing as a whole (bounded DP, merge, taut pull) against the full scan's.
             let mut p = raw.clone();
             let (mut d, mut r) = (vec![0f32; ring], vec![0u32; n]);
-            let k = Smoother::new(
-                SmoothingKind::Shortest,
-                n,
-                &mut d,
-                &mut PathLinks::new(&mut r),
-            )
-            .bounded()
-            .finish(&g, &mut p, &mut d, &mut PathLinks::new(&mut r));
+            let k = Smoother::new(SmoothingKind::Shortest, n, &mut d, &mut linked(&mut r))
+                .bounded()
+                .finish(&g, &mut p, &mut d, &mut linked(&mut r));
             for s in p[..k].windows(2) {
                 assert!(segment_clear(&g, s[0], s[1]), "case {case} {s:?}");
             }
             chain_len += polyline_length(&p[..k]);
             let mut q = raw.clone();
-            let kq = shortest_with(&g, &mut q, n, &mut d, &mut PathLinks::new(&mut r), LOOKBACK);
+            let kq = shortest_with(&g, &mut q, n, &mut d, &mut linked(&mut r), LOOKBACK);
             let kq = drop_collinear(&mut q, kq);
             let kq = crate::polish::taut::pull(&g, &mut q, kq);
             full_len += polyline_length(&q[..kq]);
@@ -1153,7 +1128,7 @@ mod tests {
             &mut p,
             n,
             &mut vec![0.0; dn],
-            &mut PathLinks::new(&mut vec![0; pn]),
+            &mut linked(&mut vec![0; pn]),
         );
         assert_eq!(&p[..k], &[raw[0], raw[n - 1]]);
         // Scratch: the ring only, not n floats.
@@ -1166,7 +1141,7 @@ mod tests {
             &mut q,
             n,
             &mut vec![0.0; LOOKBACK],
-            &mut PathLinks::new(&mut vec![0; n]),
+            &mut linked(&mut vec![0; n]),
         );
         assert_eq!(&q[..k], &[raw[0], raw[n - 1]]);
     }

@@ -59,14 +59,14 @@ impl<'a> RouteHeap<'a> {
 
 #[cfg(test)]
 mod tests {
-    use super::*;
+    use super::RouteHeap;
 
     #[test]
     fn a_heap_shorter_than_the_blocks_is_refused() {
         let mut words = [7u32; 5];
+        assert!(RouteHeap::new(&mut words).cut(6).is_none());
         let mut heap = RouteHeap::new(&mut words);
         assert_eq!(heap.blocks(), 5);
-        assert!(heap.cut(6).is_none());
         let mut cut = heap.cut(4).expect("four of five");
         assert_eq!(cut.blocks(), 4);
         cut.clear();
