@@ -67,6 +67,9 @@ use super::workspace::Workspace;
 /// Two slices of scratch words.
 type Pair<'g> = (&'g mut [u32], &'g mut [u32]);
 
+/// A route's words and its search's heap.
+type Routing<'g> = (&'g mut [u32], RouteHeap<'g>);
+
 /// Windows the local search's memo remembers ([`crate::polish::refine::Memo`]): more than a pass
 /// searches on the large maps' longest paths (at most 23 on `maze-128-128-2`'s 1,380 cells).
 pub(super) const MEMO_RECORDS: usize = 32;
@@ -123,7 +126,7 @@ impl Idle<'_> {
         &'g mut self,
         guide: &'g mut Guide<'_>,
         count: usize,
-    ) -> Option<(&'g mut [u32], RouteHeap<'g>)> {
+    ) -> Option<Routing<'g>> {
         let Guide::Words(words) = guide else {
             return None;
         };
@@ -140,7 +143,7 @@ impl Idle<'_> {
         &'g mut self,
         guide: &'g mut Guide<'_>,
         count: usize,
-    ) -> Option<((&'g mut [u32], RouteHeap<'g>), &'g mut [u32])> {
+    ) -> Option<(Routing<'g>, &'g mut [u32])> {
         let Guide::Packed(out) = guide else {
             return None;
         };
@@ -518,7 +521,7 @@ const fn smoothing_take(l: Lengths, n: usize) -> Take {
 /// how much of it is enough. A phase's needs are a const list ([`SETUP`], [`COLONY`], [`POLISH`],
 /// all of them in [`PHASES`]); the slices a view lends ([`Need::take`], through [`Lent::take`]),
 /// the links an arena lays out for them ([`links`]) and the tabu lengths at which that changes
-/// ([`cuts`], what the arena's capacity search walks) are all read from that list, so a new
+/// ([`next_cut`], what the arena's capacity search walks) are all read from that list, so a new
 /// phase or a new need is one entry here and its rule.
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
 pub(super) enum Need {
