@@ -37,10 +37,10 @@
 //! layout's fixed links hold every need (`arena::full_links_hold`). To add a phase or a need: a
 //! [`Need`] variant with its rule, its `wants`, `steps` and `cuts`, and an entry in its phase's
 //! list; the tests here (`the_links_change_only_at_the_cuts`, `a_short_buffer_is_not_enough`)
-//! fail when the cuts or the sizes do not follow the rule. A buffer the setup or the polish finds
-//! short is a counted shortfall ([`super::Shortfalls`]: the route, its stash, the local search,
-//! the smoothing, the corridor), never a silent fallback; the arena and the boards' storages have
-//! none. (Tightening's index is the one left: a walk no index holds stays untightened, uncounted.)
+//! fail when the cuts or the sizes do not follow the rule. A buffer a phase finds
+//! short is a counted shortfall ([`super::Shortfalls`]: the route, its stash, tightening's index,
+//! the local search, the smoothing, the corridor), never a silent fallback; the arena and the
+//! boards' storages have none.
 //!
 //! **Typed views.** A lent buffer reaches the phase as its own type, which owns the operations
 //! the phase needs, so no call site does word arithmetic on a buffer of another role: the ant's

@@ -14,6 +14,7 @@ use crate::rng::Xoshiro128pp;
 
 use crate::planner::lend::Colony;
 use crate::planner::plan::CurvePoint;
+use crate::planner::Shortfalls;
 
 use super::{Phase, Run};
 
@@ -236,6 +237,7 @@ fn go(
     tour: &mut [Dir],
     (points, links): (&mut [Point], &mut [u32]),
     left: &mut u32,
+    short: &mut Shortfalls,
 ) -> Result<Option<Walk>, Lost> {
     loop {
         match going {
@@ -248,7 +250,11 @@ fn go(
                 }
                 match Tightening::begin(ant.moves, ant.start, walk, tour, points, links) {
                     Some(t) => *going = Going::Tighten(t),
-                    None => return Ok(Some(walk)),
+                    None => {
+                        // No index holds the path: it stays as the ant walked it.
+                        short.insert(Shortfalls::TIGHTEN);
+                        return Ok(Some(walk));
+                    }
                 }
             }
             Going::Tighten(t) => {
@@ -303,7 +309,10 @@ fn again(
         }
     };
     ant.budget = r.budget;
-    match go(ant, tight, &mut going, &mut rng, tabu, buf, index, left) {
+    // The walk again is the first: a shortfall was counted then.
+    let mut short = Shortfalls::NONE;
+    let (r, short) = (&mut rng, &mut short);
+    match go(ant, tight, &mut going, r, tabu, buf, index, left, short) {
         Ok(None) => {
             *slot = Some((going, rng));
             None
@@ -415,8 +424,9 @@ impl Run<'_, '_> {
                     ant.budget = budget;
                     let idx = (&mut *points, &mut *links);
                     let rng = &mut self.rng;
+                    let short = &mut self.short;
                     let walk = match go(
-                        &ant, tight, &mut going, rng, &mut tabu, tour, idx, &mut left,
+                        &ant, tight, &mut going, rng, &mut tabu, tour, idx, &mut left, short,
                     ) {
                         Ok(None) => {
                             w.now = Some((going, before, budget));
