@@ -38,10 +38,19 @@ pub(super) enum Buf {
     Guide,
 }
 
+/// The lengths, in words, of the idle buffers a rule chooses among.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+pub(super) struct Lengths {
+    pub(super) links: usize,
+    pub(super) tabu: usize,
+    pub(super) points: usize,
+    pub(super) guide: usize,
+}
+
 /// What a phase takes of the idle buffers: each lending rule below chooses one from the
 /// buffers' lengths alone, and [`Take::fits`] says whether those lengths hold it. The rule is
 /// written once: the slices a phase gets ([`Lent::take`]) and the links an arena must lay out
-/// for it (the `*_links` functions) are both derived from it.
+/// for it ([`Need::links`]) are both derived from it.
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
 pub(super) enum Take {
     /// The first `words` words of each of two buffers.
@@ -50,15 +59,6 @@ pub(super) enum Take {
     Halves(Buf, usize),
     /// One buffer, whole (the second slice empty).
     Whole(Buf),
-}
-
-/// The lengths, in words, of the idle buffers a rule chooses among.
-#[derive(Clone, Copy, PartialEq, Eq, Debug)]
-pub(super) struct Lengths {
-    pub(super) links: usize,
-    pub(super) tabu: usize,
-    pub(super) points: usize,
-    pub(super) guide: usize,
 }
 
 impl Lengths {
