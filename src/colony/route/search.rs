@@ -348,20 +348,24 @@ impl Heap<'_> {
     /// it closes a band about a block wide and the sub-goals lie along the line, where the
     /// paper's straight pull would lead (other orders gave routes along the parallelogram's
     /// sides, and the ants made twice the moves on Nav2's depot).
+    ///
+    /// The pair `(distance from the line, h)` compares as the one word `cross << 24 | h` did
+    /// (`h` < 2^24), in 32-bit arithmetic: both factors of each product are block coordinate
+    /// differences, below `across` and `down`, whose product (the blocks) is below 2^16, so the
+    /// products and their difference fit an `i32`. The order runs in every comparison of the
+    /// heap's sifts, and 64-bit products and shifts take several Cortex-M4 instructions each
+    /// (0.97 M of Boston_0_256's 16.9 M on the device, `docs/bench/boston-issue36.md`).
     #[inline]
-    fn tie(&self, b: usize) -> u64 {
+    fn tie(&self, b: usize) -> (u32, u32) {
         // `across >= 1`: the checked forms never fail.
-        let bx = b.checked_rem(self.across).unwrap_or(0) as i64;
-        let by = b.checked_div(self.across).unwrap_or(0) as i64;
-        let (sx, sy) = (self.start.0 as i64, self.start.1 as i64);
-        let (gx, gy) = (self.goal.0 as i64, self.goal.1 as i64);
-        // Block coordinates are below 2^16: the products fit.
-        let cross = (bx.wrapping_sub(gx))
-            .wrapping_mul(sy.wrapping_sub(gy))
-            .wrapping_sub(by.wrapping_sub(gy).wrapping_mul(sx.wrapping_sub(gx)))
+        let bx = b.checked_rem(self.across).unwrap_or(0);
+        let by = b.checked_div(self.across).unwrap_or(0);
+        let d = |a: usize, z: usize| (a as i32).wrapping_sub(z as i32); // coordinates < 2^16
+        let cross = d(bx, self.goal.0)
+            .wrapping_mul(d(self.start.1, self.goal.1))
+            .wrapping_sub(d(by, self.goal.1).wrapping_mul(d(self.start.0, self.goal.0)))
             .unsigned_abs();
-        let h = octile(bx as usize, by as usize, self.start.0, self.start.1);
-        cross << 24 | u64::from(h)
+        (cross, octile(bx, by, self.start.0, self.start.1))
     }
 
     fn block_at(&self, i: usize) -> usize {
