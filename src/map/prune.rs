@@ -117,7 +117,6 @@ pub fn resume(
     let (w, h) = (usize::from(grid.width()), usize::from(grid.height()));
     // Each try: the local rule at a cell, then depth-first over the neighbours whose
     // neighbourhood just shrank (as `repair`'s re-pruning does); `touched` is not needed here.
-    let mut touched = Bounds::default();
     let mut settle = Settle {
         moves,
         offsets: &offsets,
@@ -125,7 +124,7 @@ pub fn resume(
         gi,
         stack,
         full: at.full,
-        touched: &mut touched,
+        touched: None,
         tried: 0,
     };
     let mut next = at.next as usize;
@@ -337,7 +336,7 @@ pub fn repair(
         gi,
         stack: rest,
         full: false,
-        touched: &mut touched,
+        touched: Some(&mut touched),
         tried: 0,
     };
     for &ci in list.iter() {
@@ -392,7 +391,8 @@ struct Settle<'m, 's> {
     stack: &'s mut [u32],
     /// The stack was too short for some neighbours.
     full: bool,
-    touched: &'s mut Bounds,
+    /// The bounds of the cells pruned ([`repair`]'s; `None`: not kept).
+    touched: Option<&'s mut Bounds>,
     /// Cells tried so far by the settling of pruned cells' neighbours (the callers count the
     /// cells they try: the budget of [`resume`]).
     tried: u32,
@@ -400,28 +400,37 @@ struct Settle<'m, 's> {
 
 impl Settle<'_, '_> {
     fn at(&mut self, dead: &mut [u32], ci: usize) {
-        let grid = *self.moves.grid();
         let (m, o, si, gi) = (self.moves, self.offsets, self.si, self.gi);
-        if !try_prune(m, o, si, gi, dead, ci, grid.point(ci)) {
+        let Some(live) = try_prune(m, o, si, gi, dead, ci) else {
             return;
-        }
-        self.touched.add(grid.point(ci));
+        };
+        self.mark(ci);
         let mut top = 0usize;
-        self.full |= push_neighbours(m, o, ci, self.stack, &mut top);
+        self.full |= push_neighbours(o, ci, live, self.stack, &mut top);
         while top > 0 {
             top = top.wrapping_sub(1);
             let Some(&u) = self.stack.get(top) else { break };
             let u = u as usize;
             self.tried = self.tried.wrapping_add(1);
-            if try_prune(m, o, si, gi, dead, u, grid.point(u)) {
-                self.touched.add(grid.point(u));
-                self.full |= push_neighbours(m, o, u, self.stack, &mut top);
+            if let Some(live) = try_prune(m, o, si, gi, dead, u) {
+                self.mark(u);
+                self.full |= push_neighbours(o, u, live, self.stack, &mut top);
             }
+        }
+    }
+
+    /// Cell `ci` was pruned now: grow the bounds of what moved, if they are kept.
+    #[inline]
+    fn mark(&mut self, ci: usize) {
+        if let Some(t) = self.touched.as_deref_mut() {
+            t.add(self.moves.grid().point(ci));
         }
     }
 }
 
-/// Prune cell `ci` (at `p`) if it is prunable; true if it was pruned now.
+/// Prune cell `ci` if it is prunable: `Some(its live neighbours)` (a direction mask: the
+/// neighbours one allowed move away that are not pruned, whose neighbourhoods shrink now) if it
+/// was pruned now, `None` if not.
 #[inline]
 fn try_prune(
     moves: &Moves<'_>,
@@ -430,16 +439,16 @@ fn try_prune(
     gi: usize,
     dead: &mut [u32],
     ci: usize,
-    p: Point,
-) -> bool {
+) -> Option<u8> {
     if ci == si || ci == gi || bitmap::get(dead, ci) {
-        return false;
-    }
-    let all = moves.at(ci, p);
-    if all == 0 {
-        return false; // blocked (or isolated: nothing to gain)
+        return None;
     }
     let grid = moves.grid();
+    let p = grid.point(ci);
+    let all = moves.at(ci, p);
+    if all == 0 {
+        return None; // blocked (or isolated: nothing to gain)
+    }
     let w = usize::from(grid.width());
     let (x, y) = (usize::from(p.x), usize::from(p.y));
     let live = if x > 0
@@ -467,22 +476,24 @@ fn try_prune(
         1 => true,
         t => (all >> (t.wrapping_sub(2) & 7)) & 1 == 1,
     };
-    if ok {
-        bitmap::set(dead, ci);
+    if !ok {
+        return None;
     }
-    ok
+    bitmap::set(dead, ci);
+    Some(live)
 }
 
-/// Push the free neighbours of `ci`; true if the stack was full for some.
+/// Push the neighbours of `ci` in `live` (the pruned neighbours' neighbourhoods do not change,
+/// and a neighbour one allowed move away is one the other way too); true if the stack was full
+/// for some.
 fn push_neighbours(
-    moves: &Moves<'_>,
     offsets: &[isize; 8],
     ci: usize,
+    live: u8,
     stack: &mut [u32],
     top: &mut usize,
 ) -> bool {
-    let grid = moves.grid();
-    let mut m = moves.at(ci, grid.point(ci));
+    let mut m = live;
     let mut full = false;
     while m != 0 {
         let d = m.trailing_zeros() as usize & 7;
