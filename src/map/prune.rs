@@ -431,7 +431,13 @@ impl Settle<'_, '_> {
 /// Prune cell `ci` if it is prunable: `Some(its live neighbours)` (a direction mask: the
 /// neighbours one allowed move away that are not pruned, whose neighbourhoods shrink now) if it
 /// was pruned now, `None` if not.
-#[inline]
+///
+/// Inlined into the settling's loop, with one border test: a cell off the border reads its
+/// allowed moves ([`crate::map::grid::Grid::interior_mask`]) and its pruned neighbours ([`bitmap::around_top`])
+/// from the same 3 x 3 corner, where [`Moves::at`] and [`bitmap::around`] each tested the
+/// border and worked the corner out again (a try is most of the pruning's cost: 14,800 of them
+/// on Boston_0_256, `docs/bench/boston-issue36.md`).
+#[inline(always)]
 fn try_prune(
     moves: &Moves<'_>,
     offsets: &[isize; 8],
@@ -444,21 +450,30 @@ fn try_prune(
         return None;
     }
     let grid = moves.grid();
-    let p = grid.point(ci);
-    let all = moves.at(ci, p);
-    if all == 0 {
-        return None; // blocked (or isolated: nothing to gain)
-    }
     let w = usize::from(grid.width());
-    let (x, y) = (usize::from(p.x), usize::from(p.y));
-    let live = if x > 0
-        && y > 0
-        && x.wrapping_add(1) < w
-        && y.wrapping_add(1) < usize::from(grid.height())
-    {
-        // Away from the border: the dead neighbours in one 3 x 3 read.
-        all & !bitmap::around(dead, ci, w)
+    // `w > 0` (a grid's sides are): the checked forms never fail.
+    let (x, y) = (
+        ci.checked_rem(w).unwrap_or(0),
+        ci.checked_div(w).unwrap_or(0),
+    );
+    let interior =
+        x > 0 && y > 0 && x.wrapping_add(1) < w && y.wrapping_add(1) < usize::from(grid.height());
+    let (all, live) = if interior {
+        // Off the border: `ci - w - 1` does not wrap.
+        let top = ci.wrapping_sub(w).wrapping_sub(1);
+        let all = match moves.table_at(ci) {
+            Some(m) => m,
+            None => grid.interior_mask(top),
+        };
+        if all == 0 {
+            return None; // blocked (or isolated: nothing to gain)
+        }
+        (all, all & !bitmap::around_top(dead, top, w))
     } else {
+        let all = moves.at(ci, grid.point(ci));
+        if all == 0 {
+            return None;
+        }
         let mut live = all;
         let mut m = all;
         while m != 0 {
@@ -469,7 +484,7 @@ fn try_prune(
                 live &= !(1 << d);
             }
         }
-        live
+        (all, live)
     };
     let ok = match CLIQUE.get(usize::from(live)).copied().unwrap_or(0) {
         0 => false,
