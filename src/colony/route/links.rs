@@ -165,7 +165,9 @@ pub(super) fn links(
         ((r.y1.wrapping_add(1) << s).wrapping_sub(1)).min(h.wrapping_sub(1)),
     );
     // The links of the block of cell (x, y) gain `d`, and the neighbour block's `d + 4`, if
-    // they are in the region.
+    // they are in the region. On the whole map both are: a move's two ends are cells of the
+    // map (the windows read cells off it as blocked), so their blocks are on it too.
+    let all = r.x0 == 0 && r.y0 == 0 && r.x1 == whole.x1 && r.y1 == whole.y1;
     let mut link = |x: usize, y: usize, d: u32| {
         let (dx, dy) = match d {
             0 => (1isize, 0usize),
@@ -174,13 +176,13 @@ pub(super) fn links(
             _ => (-1, 1),
         };
         let (bx, by) = (x >> s, y >> s);
-        if r.holds(bx, by) {
+        if all || r.holds(bx, by) {
             if let Some(wd) = words.get_mut(by.wrapping_mul(across).wrapping_add(bx)) {
                 *wd |= 1 << d;
             }
         }
         let (nx, ny) = (bx.wrapping_add_signed(dx), by.wrapping_add(dy));
-        if r.holds(nx, ny) {
+        if all || r.holds(nx, ny) {
             if let Some(wd) = words.get_mut(ny.wrapping_mul(across).wrapping_add(nx)) {
                 *wd |= 1 << (d.wrapping_add(4) & 7);
             }
