@@ -159,12 +159,17 @@ fn heap_of<'h>(
     len: usize,
 ) -> Heap<'h> {
     let s = blocks.shift();
+    let start = (usize::from(start.x >> s), usize::from(start.y >> s));
+    let goal = (usize::from(goal.x >> s), usize::from(goal.y >> s));
+    // Block coordinates are below 2^16.
+    let d = |a: usize, z: usize| (a as i32).wrapping_sub(z as i32);
     Heap {
         w: heap,
         len,
         across: blocks.across().max(1),
-        start: (usize::from(start.x >> s), usize::from(start.y >> s)),
-        goal: (usize::from(goal.x >> s), usize::from(goal.y >> s)),
+        start,
+        goal,
+        line: (d(start.0, goal.0), d(start.1, goal.1)),
     }
 }
 
@@ -329,6 +334,9 @@ pub(super) struct Heap<'a> {
     across: usize,
     start: (usize, usize),
     goal: (usize, usize),
+    /// The start's block less the goal's: the line's direction (worked out once, not in every
+    /// comparison).
+    line: (i32, i32),
 }
 
 impl Heap<'_> {
@@ -362,8 +370,8 @@ impl Heap<'_> {
         let by = b.checked_div(self.across).unwrap_or(0);
         let d = |a: usize, z: usize| (a as i32).wrapping_sub(z as i32); // coordinates < 2^16
         let cross = d(bx, self.goal.0)
-            .wrapping_mul(d(self.start.1, self.goal.1))
-            .wrapping_sub(d(by, self.goal.1).wrapping_mul(d(self.start.0, self.goal.0)))
+            .wrapping_mul(self.line.1)
+            .wrapping_sub(d(by, self.goal.1).wrapping_mul(self.line.0))
             .unsigned_abs();
         (cross, octile(bx, by, self.start.0, self.start.1))
     }
@@ -401,6 +409,7 @@ impl Heap<'_> {
                 across: self.across,
                 start: self.start,
                 goal: self.goal,
+                line: self.line,
             },
             words,
         }
