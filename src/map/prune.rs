@@ -737,6 +737,68 @@ mod tests {
         assert!(marked > 1000, "the maps had little to prune: {marked}");
     }
 
+    /// The module's rule read literally, to a fixed point: a free cell (not `s` or `t`, with
+    /// some allowed move) goes when every two of its remaining neighbours are one allowed move
+    /// apart ([`Grid::move_mask`] and [`Grid::step`] only: no table, no 3 x 3 reads).
+    fn by_the_rule(g: &Grid<'_>, s: Point, t: Point) -> Vec<bool> {
+        let n = g.cells();
+        let mut dead = vec![false; n];
+        let apart = |a: Point, b: Point| (0..8u8).any(|d| g.step(a, d) == Some(b));
+        loop {
+            let mut changed = false;
+            for i in 0..n {
+                let p = g.point(i);
+                if dead[i] || p == s || p == t || !g.is_free(p) || g.move_mask(p) == 0 {
+                    continue;
+                }
+                let live: Vec<Point> = (0..8u8)
+                    .filter_map(|d| g.step(p, d))
+                    .filter(|&q| !dead[g.index(q)])
+                    .collect();
+                let clique = live
+                    .iter()
+                    .enumerate()
+                    .all(|(k, &a)| live[k + 1..].iter().all(|&b| apart(a, b)));
+                if clique {
+                    dead[i] = true;
+                    changed = true;
+                }
+            }
+            if !changed {
+                return dead;
+            }
+        }
+    }
+
+    #[test]
+    fn pruning_marks_the_rules_fixed_point_on_random_maps() {
+        // The settling's try (one 3 x 3 read of the map and one of the marks off the border,
+        // the neighbours pushed only when live) against the rule applied literally until
+        // nothing changes, with a move table and without, on maps of many widths and
+        // densities (breaking the try's reads or its pushes fails it).
+        let mut rng = crate::rng::Xoshiro128pp::from_u64(36);
+        let mut marked = 0;
+        for &(w, h) in &[(3u16, 3u16), (9, 4), (33, 12), (40, 37), (70, 9)] {
+            for density in [2u32, 4, 6, 8] {
+                for _ in 0..3 {
+                    let cells = usize::from(w) * usize::from(h);
+                    let (b, st, go) = corner_to_corner(&mut rng, w, h, density);
+                    let grid = Grid::new(w, h, &b).unwrap();
+                    let want = by_the_rule(&grid, st, go);
+                    let mut table = vec![0u8; cells];
+                    assert!(Moves::fill(&grid, &mut table));
+                    for moves in [Moves::new(grid, &[]), Moves::new(grid, &table)] {
+                        let mut dead = vec![0u32; bitmap::words(cells)];
+                        marked += prune(&moves, st, go, &mut dead, &mut vec![0u32; 64]);
+                        let got: Vec<bool> = (0..cells).map(|i| bitmap::get(&dead, i)).collect();
+                        assert_eq!(got, want, "{w} x {h}, density {density}");
+                    }
+                }
+            }
+        }
+        assert!(marked > 1000, "the maps had little to prune: {marked}");
+    }
+
     /// A random `w` x `h` map, a cell blocked with probability `density / 16`, and its corner
     /// pair (0, 0) -> (w - 1, h - 1), both free.
     fn corner_to_corner(
