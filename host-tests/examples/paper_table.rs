@@ -68,7 +68,14 @@ fn first_iteration_arrivals(prep: &Prepared, params: &Params, seeds: &[u64]) -> 
         let mut rng = Xoshiro128pp::from_u64(seed);
         for _ in 0..params.ants {
             total += 1;
-            arrived += u64::from(ant.walk(&mut rng, &mut tabu, &mut tour).is_ok());
+            arrived += u64::from(
+                ant.walk(
+                    &mut rng,
+                    &mut ohaca::colony::tabu::TabuSet::new(&mut tabu),
+                    &mut tour,
+                )
+                .is_ok(),
+            );
         }
     }
     arrived as f64 / total as f64

@@ -213,9 +213,23 @@ fn smoothed(m: &LargeMap, path: &[Point], k: usize) -> (f64, f64) {
     let grid = m.map.grid();
     let t0 = Instant::now();
     let len = if k == 0 {
-        smooth(&grid, SmoothingKind::Greedy, &mut p, n, &mut [], &mut [])
+        smooth(
+            &grid,
+            SmoothingKind::Greedy,
+            &mut p,
+            n,
+            &mut [],
+            &mut ohaca::polish::links::PathLinks::new(&mut []),
+        )
     } else {
-        let c = shortest_with(&grid, &mut p, n, &mut dist, &mut prev, k);
+        let c = shortest_with(
+            &grid,
+            &mut p,
+            n,
+            &mut dist,
+            &mut ohaca::polish::links::PathLinks::new(&mut prev),
+            k,
+        );
         ohaca::smoothing::drop_collinear(&mut p, c)
     };
     let t = t0.elapsed().as_secs_f64();

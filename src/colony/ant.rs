@@ -31,6 +31,7 @@
 use crate::colony::heuristic::Heuristic;
 use crate::colony::pheromone::{slot_offsets, Table};
 use crate::colony::route::Route;
+use crate::colony::tabu::TabuSet;
 use crate::map::bitmap;
 use crate::map::grid::{is_diagonal, neighbour, opposite, Dir, Moves, Point, DX, DY};
 use crate::named::named;
@@ -145,13 +146,13 @@ fn pow_alpha(tau: f32, alpha: f32) -> f32 {
 }
 
 impl Ant<'_, '_, '_> {
-    /// Walk one ant. `tabu` is a bit set of at least `words(cells)` words (its content is
+    /// Walk one ant. `tabu` holds at least the map's cells ([`TabuSet::of`]; its content is
     /// replaced: it starts as the dead cells); `tour` receives the directions and bounds the path's
     /// length.
     pub fn walk(
         &self,
         rng: &mut Xoshiro128pp,
-        tabu: &mut [u32],
+        tabu: &mut TabuSet<'_>,
         tour: &mut [Dir],
     ) -> Result<Walk, Lost> {
         let mut trail = self.begin(tabu, tour);
@@ -165,13 +166,9 @@ impl Ant<'_, '_, '_> {
 
     /// Start a walk to be done a piece at a time ([`Ant::resume`]): the tabu set becomes the dead
     /// cells and the start (a pass over the set's words), the ant stands at the start.
-    pub fn begin(&self, tabu: &mut [u32], tour: &mut [Dir]) -> Trail {
+    pub fn begin(&self, tabu: &mut TabuSet<'_>, tour: &mut [Dir]) -> Trail {
         let grid = self.moves.grid();
-        if self.dead.is_empty() {
-            bitmap::clear(tabu, grid.cells());
-        } else {
-            bitmap::copy(tabu, self.dead, grid.cells());
-        }
+        tabu.reset(grid.cells(), self.dead);
         let ci = grid.index(self.start);
         // The tour's last slot, unwritten until the path fills the tour: only then can a cell be
         // refused for the tour's length (below), and a walk that backs out of everything proves
@@ -179,7 +176,7 @@ impl Ant<'_, '_, '_> {
         if let Some(last) = tour.last_mut() {
             *last = UNFILLED;
         }
-        bitmap::set(tabu, ci);
+        tabu.insert(ci);
         Trail {
             cur: self.start,
             ci,
@@ -202,7 +199,7 @@ impl Ant<'_, '_, '_> {
         &self,
         trail: &mut Trail,
         rng: &mut Xoshiro128pp,
-        tabu: &mut [u32],
+        tabu: &mut TabuSet<'_>,
         tour: &mut [Dir],
         left: &mut u32,
     ) -> Result<Option<Walk>, Lost> {
@@ -241,7 +238,7 @@ impl Ant<'_, '_, '_> {
         &self,
         trail: &mut Trail,
         rng: &mut Xoshiro128pp,
-        tabu: &mut [u32],
+        tabu: &mut TabuSet<'_>,
         tour: &mut [Dir],
         limit: &mut u32,
         pow: impl Fn(f32) -> f32,
@@ -274,7 +271,7 @@ impl Ant<'_, '_, '_> {
             // set away from the border, one test a move on it.
             let (x, y) = (usize::from(cur.x), usize::from(cur.y));
             let tabu_moves = if x > 0 && y > 0 && x.wrapping_add(1) < width && y < last_row {
-                bitmap::around(tabu, ci, width) & allowed
+                tabu.around(ci, width) & allowed
             } else {
                 let mut t = 0u8;
                 let mut m = allowed;
@@ -282,7 +279,7 @@ impl Ant<'_, '_, '_> {
                     let di = m.trailing_zeros() as usize & 7;
                     m &= m.wrapping_sub(1);
                     let ni = ci.wrapping_add_signed(offsets.get(di).copied().unwrap_or(0));
-                    if bitmap::get(tabu, ni) {
+                    if tabu.contains(ni) {
                         t |= 1 << di;
                     }
                 }
@@ -418,7 +415,7 @@ impl Ant<'_, '_, '_> {
                     DeadEnd::Backtrack => {
                         let ni = ci
                             .wrapping_add_signed(offsets.get(usize::from(d)).copied().unwrap_or(0));
-                        bitmap::set(tabu, ni);
+                        tabu.insert(ni);
                         moves = moves.wrapping_sub(1); // counted above: at least 1
                         continue;
                     }
@@ -428,7 +425,7 @@ impl Ant<'_, '_, '_> {
             steps = steps.wrapping_add(1); // < tour.len() + 1: the slot existed
             ci = ci.wrapping_add_signed(offsets.get(usize::from(d)).copied().unwrap_or(0));
             cur = neighbour(cur, d);
-            bitmap::set(tabu, ci);
+            tabu.insert(ci);
         }
         *limit = limit.saturating_sub(moves.wrapping_sub(first));
         self.arrived(tabu, tour, steps, moves, may_tighten)
@@ -647,7 +644,7 @@ impl Ant<'_, '_, '_> {
                 mask &= mask.wrapping_sub(1);
                 let ni = goal.wrapping_add_signed(offsets.get(di).copied().unwrap_or(0));
                 // At most 8, one per bit of the mask.
-                let visited = bitmap::get(tabu, ni) && !bitmap::marked(self.dead, ni);
+                let visited = tabu.contains(ni) && !bitmap::marked(self.dead, ni);
                 seen = seen.wrapping_add(u32::from(visited));
             }
             may_tighten = seen > 1;
@@ -794,7 +791,7 @@ mod tests {
         let mut tabu = vec![0u32; bitmap::words(g.cells())];
         let mut tour = vec![0u8; g.cells()];
         let mut rng = Xoshiro128pp::from_u64(seed);
-        let walk = c.walk(&mut rng, &mut tabu, &mut tour);
+        let walk = c.walk(&mut rng, &mut TabuSet::new(&mut tabu), &mut tour);
         (walk, tour)
     }
 

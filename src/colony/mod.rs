@@ -11,5 +11,6 @@ pub mod ant;
 pub mod heuristic;
 pub mod pheromone;
 pub mod route;
+pub mod tabu;
 pub mod tighten;
 pub mod update;

@@ -8,7 +8,7 @@
 //! every index is checked, and a path it cannot index is returned unchanged.
 
 use crate::colony::ant::Walk;
-use crate::map::bitmap;
+use crate::colony::tabu::TabuSet;
 use crate::map::grid::{is_diagonal, neighbour, opposite, Dir, Moves, Point};
 
 /// Straighten a finished walk in place: from each cell of the path, jump to the furthest later
@@ -40,7 +40,7 @@ pub fn tighten(
     tour: &mut [Dir],
     cells: &mut [Point],
     pos: &mut [u32],
-    visited: &[u32],
+    visited: &TabuSet<'_>,
 ) -> Walk {
     let Some(mut t) = Tightening::begin(moves, start, walk, tour, cells, pos) else {
         return walk;
@@ -145,7 +145,7 @@ impl Tightening {
         tour: &mut [Dir],
         cells: &mut [Point],
         pos: &mut [u32],
-        visited: &[u32],
+        visited: &TabuSet<'_>,
         budget: &mut u32,
     ) -> Option<Walk> {
         let grid = moves.grid();
@@ -262,7 +262,7 @@ impl Tightening {
         &mut self,
         moves: &Moves<'_>,
         tour: &mut [Dir],
-        visited: &[u32],
+        visited: &TabuSet<'_>,
         budget: &mut u32,
         find: impl Fn(usize) -> Option<usize>,
     ) -> Option<Walk> {
@@ -293,7 +293,7 @@ impl Tightening {
             if let Some(&next_d) = tour.get(i) {
                 let (x, y) = (usize::from(cp.x), usize::from(cp.y));
                 if x > 0 && y > 0 && x.wrapping_add(1) < width && y.wrapping_add(1) < height {
-                    let mut others = bitmap::around(visited, ci, width) & !(1u8 << (next_d & 7));
+                    let mut others = visited.around(ci, width) & !(1u8 << (next_d & 7));
                     if let Some(&in_d) = i.checked_sub(1).and_then(|k| tour.get(k)) {
                         others &= !(1u8 << (opposite(in_d) & 7));
                     }
@@ -332,7 +332,7 @@ impl Tightening {
                 // Not visited: not on the path (a cell beyond the set reads as visited). The
                 // previous cell cannot be the furthest; the next one is at `i + 1` (cells are
                 // unique on a path).
-                if !bitmap::get(visited, nb) || nb == prev {
+                if !visited.contains(nb) || nb == prev {
                     continue;
                 }
                 if nb == next {
@@ -735,7 +735,9 @@ mod tests {
         };
         let mut tabu = vec![0u32; crate::map::bitmap::words(cells)];
         let mut tour = vec![0u8; cells];
-        let walk = ant.walk(&mut rng, &mut tabu, &mut tour).ok()?;
+        let walk = ant
+            .walk(&mut rng, &mut TabuSet::new(&mut tabu), &mut tour)
+            .ok()?;
         Some(Wandering {
             bits,
             walk,
@@ -765,7 +767,7 @@ mod tests {
             &mut t,
             &mut cells,
             &mut pos,
-            tabu,
+            &TabuSet::new(&mut tabu.to_vec()),
         );
         (out, t[..out.steps].to_vec())
     }
@@ -825,7 +827,7 @@ mod tests {
                             &mut t,
                             &mut cells,
                             &mut pos,
-                            &wd.tabu,
+                            &TabuSet::new(&mut wd.tabu.clone()),
                             &mut budget,
                         );
                         if let Some(out) = done {
@@ -872,7 +874,7 @@ mod tests {
                 &mut t,
                 &mut cells,
                 &mut pos,
-                &wd.tabu,
+                &TabuSet::new(&mut wd.tabu.clone()),
                 &mut budget,
             );
             if first.is_none() {
@@ -888,7 +890,7 @@ mod tests {
                     &mut t,
                     &mut cells,
                     &mut none,
-                    &wd.tabu,
+                    &TabuSet::new(&mut wd.tabu.clone()),
                     &mut budget,
                 )
                 .expect("done at once");
@@ -1054,7 +1056,7 @@ mod tests {
                 &mut t,
                 &mut cells,
                 &mut pos,
-                &[],
+                &TabuSet::new(&mut []),
             );
             assert_eq!(
                 (out, t[..out.steps].to_vec()),

@@ -57,7 +57,7 @@ use crate::map::grid::{Dir, Point};
 use crate::colony::route::packed_words;
 use crate::colony::tighten::{hash_words, keyed_fits, keyed_words};
 
-use super::lend;
+use super::needs;
 use super::run::{REFINE_WORDS, SHORT_REFINE_WORDS};
 use super::workspace::{Buffers, Workspace};
 
@@ -73,6 +73,37 @@ pub const LINKS: usize = 4096;
 /// step bound goes to the compact layout only, so a map that fits the full layout plans as it
 /// always did.
 pub const FULL_STEPS: usize = LINKS / 2 - 1;
+/// Whether [`LINKS`] hold what every phase needs (`planner::needs`' `PHASES`) in the full
+/// layout, beside its tabu set, its route's [`GUIDE_BLOCKS`] words and paths of [`FULL_STEPS`],
+/// on every map: each map of up to 8,192 cells (where the route's blocks grow with the map), then
+/// each tabu length up to 8,192 words (beyond that the tabu set lends every need's slices
+/// itself). Checked at compile time: a need the full layout's links do not hold does not build.
+const fn full_links_hold(links: usize) -> bool {
+    let mut cells = 1usize;
+    while cells <= 8192 * 32 {
+        let idle = needs::Lengths {
+            links: 0,
+            tabu: words(cells),
+            points: 0,
+            guide: GUIDE_BLOCKS,
+        };
+        if needs::links(idle, ask(cells, FULL_STEPS, false)) > links {
+            return false;
+        }
+        cells = if cells < 8192 {
+            cells.saturating_add(1)
+        } else {
+            cells.saturating_add(32)
+        };
+    }
+    true
+}
+
+const _: () = assert!(
+    full_links_hold(LINKS),
+    "a phase needs more links than the full layout has"
+);
+
 /// The fewest path steps a layout may leave: a map whose compact layout leaves fewer is too
 /// large for the arena.
 pub const MIN_STEPS: usize = 1023;
@@ -166,39 +197,48 @@ pub const fn compact_words(cells: usize, steps: usize) -> usize {
     Sizes::of(cells, steps, true).words()
 }
 
-/// Links of the compact layout: the most any phase borrows beside the tabu set
-/// (`planner::lend`): tightening's keyed table over the links and the path cells' words
-/// ([`keyed_words`]: `(steps + 1) / 2`; [`hash_words`] on maps too large for its keys), the
-/// smoothing's `steps + 1` links where the tabu set is shorter, the local search's two slices of
-/// [`REFINE_WORDS`] and the packed route's words and heap (a word a block) as far as the tabu
-/// set does not hold them.
+/// Links of the compact layout: the most any phase borrows beside the tabu set and the path
+/// cells' words, read from the phases' needs (`planner::needs`' `PHASES`): tightening's keyed
+/// table over the links and the path cells' words ([`keyed_words`]: `(steps + 1) / 2`;
+/// [`hash_words`] on maps too large for its keys), the smoothing's `steps + 1` links where the
+/// tabu set is shorter, the local search's two slices of [`REFINE_WORDS`] and the packed route's
+/// words and heap (a word a block) as far as the tabu set does not hold them.
 const fn compact_links(cells: usize, steps: usize) -> usize {
+    needs::links(idle(cells, steps), ask(cells, steps, true))
+}
+
+/// What a layout asks of its links for a map of `cells` cells, paths of `steps` steps and a route
+/// packed or not: the route's blocks ([`GUIDE_BLOCKS`] at most), tightening's table (packed keys
+/// when a cell and a position fit a word, [`keyed_words`], else positions, [`hash_words`]) and
+/// the local search's [`REFINE_WORDS`] (at least [`SHORT_REFINE_WORDS`]).
+const fn ask(cells: usize, steps: usize, packed: bool) -> needs::Ask {
     let n = steps.saturating_add(1);
-    let w = words(cells);
-    let table = if keyed_fits(cells, n) {
-        keyed_words(n)
-    } else {
-        hash_words(n)
-    };
     let blocks = if cells < GUIDE_BLOCKS {
         cells
     } else {
         GUIDE_BLOCKS
     };
-    max(
-        max(table, lend::smoothing_links(w, n)),
-        max(
-            lend::refine_links(w, REFINE_WORDS, SHORT_REFINE_WORDS),
-            lend::route_links(w, n, blocks),
-        ),
-    )
+    let table = if keyed_fits(cells, n) {
+        keyed_words(n)
+    } else {
+        hash_words(n)
+    };
+    needs::Ask {
+        route: (blocks, packed),
+        cells: n,
+        table,
+        refine: (REFINE_WORDS, SHORT_REFINE_WORDS),
+    }
 }
 
-const fn max(a: usize, b: usize) -> usize {
-    if a > b {
-        a
-    } else {
-        b
+/// The idle buffers besides the links of the compact layout: the tabu set and the path cells'
+/// words (the route, packed, lends nothing).
+const fn idle(cells: usize, steps: usize) -> needs::Lengths {
+    needs::Lengths {
+        links: 0,
+        tabu: words(cells),
+        points: steps.saturating_add(1),
+        guide: 0,
     }
 }
 
@@ -246,30 +286,11 @@ const fn fits_compact(arena: usize, w: usize) -> bool {
 
 /// The smallest tabu-set length above `x` at which the compact layout's links change (what the
 /// tabu set lends: the local search's slices, the route's words and heap, the smoothing's links):
-/// the cuts of the lending rules themselves ([`lend::cuts`]).
+/// the cuts of the phases' needs themselves ([`needs::next_cut`]), for paths of [`MIN_STEPS`] on
+/// the largest route.
 const fn next_cut(x: usize) -> usize {
-    let cuts = lend::cuts(
-        REFINE_WORDS,
-        SHORT_REFINE_WORDS,
-        GUIDE_BLOCKS,
-        MIN_STEPS.saturating_add(1),
-    );
-    let mut best = usize::MAX / 64;
-    let mut rest: &[usize] = &cuts;
-    while let [c, tail @ ..] = rest {
-        best = min_above(best, *c, x);
-        rest = tail;
-    }
-    best
-}
-
-/// `c` if it lies above `x` and below `best`, else `best`.
-const fn min_above(best: usize, c: usize, x: usize) -> usize {
-    if c > x && c < best {
-        c
-    } else {
-        best
-    }
+    let cells = GUIDE_BLOCKS.saturating_mul(32);
+    needs::next_cut(x, ask(cells, MIN_STEPS, true), usize::MAX / 64)
 }
 
 /// The longest path a map of `cells` cells gets in an arena of `arena` words with paths bounded
@@ -409,6 +430,14 @@ mod tests {
             }
         }
         assert!(with_cap > 150, "{with_cap}");
+    }
+
+    #[test]
+    fn the_full_layouts_links_are_what_the_phases_need() {
+        // The compile-time check is tight: with a link fewer, the route's heap of 4,096 blocks
+        // beside a tabu set of fewer words does not fit (the build then fails, `full_links_hold`).
+        assert!(full_links_hold(LINKS));
+        assert!(!full_links_hold(LINKS - 1));
     }
 
     /// A `w x h` map with random walls (`density`), its corners free.

@@ -27,6 +27,15 @@
 //! | a reused answer's repair ([`super::repair`]): the detour | two slices, as many words as it can get (its box is sized by what blocks the answer, up to what the slices hold; no memo) | the pair of the links, the route's words and the tabu set, or one of them halved, whose shorter slice is longest (the first such in that order on a tie) |
 //! | a reused answer's repair: the smoothing | `n` links, as in the polish | as in the polish |
 //!
+//! **Needs, declared once per phase** (`planner::needs`): each phase's buffer needs are a const
+//! list there, with the lending rules; the views here lend by them ([`Need::take`], then
+//! [`Lent::take`]), and the arena lays out and sizes from the same list.
+//!
+//! **Typed views.** A lent buffer reaches the phase as its own type, which owns the operations
+//! the phase needs, so no call site does word arithmetic on a buffer of another role: the ant's
+//! [`TabuSet`], the route search's [`RouteHeap`], the smoothing's [`PathLinks`], the local
+//! search's [`crate::polish::refine::Scratch`].
+//!
 //! Every choice depends only on the buffers' lengths (never on their contents or addresses), so
 //! a host that lays out a device's arena plans exactly what the device plans, and a choice made
 //! at the start of a phase is the same at each of its pieces. None of these buffers is kept
@@ -36,13 +45,20 @@
 
 #[cfg(doc)]
 use crate::colony::route;
+use crate::colony::route::RouteHeap;
+use crate::colony::tabu::TabuSet;
 use crate::map::grid::{Dir, Point};
+use crate::polish::links::PathLinks;
+
+use super::needs::{detour_take, Ask, Lent, Need, Pair};
+#[cfg(doc)]
+use super::needs::{refine_take, route_take, smoothing_take, Take};
 
 pub(super) use super::workspace::Guide;
 use super::workspace::Workspace;
 
-/// Two slices of scratch words.
-type Pair<'g> = (&'g mut [u32], &'g mut [u32]);
+/// A route's words and its search's heap.
+type Routing<'g> = (&'g mut [u32], RouteHeap<'g>);
 
 /// Windows the local search's memo remembers ([`crate::polish::refine::Memo`]): more than a pass
 /// searches on the large maps' longest paths (at most 23 on `maze-128-128-2`'s 1,380 cells).
@@ -100,14 +116,15 @@ impl Idle<'_> {
         &'g mut self,
         guide: &'g mut Guide<'_>,
         count: usize,
-    ) -> Option<(&'g mut [u32], &'g mut [u32])> {
+    ) -> Option<Routing<'g>> {
         let Guide::Words(words) = guide else {
             return None;
         };
         let lent = Lent::new(self.links, self.tabu, &mut [], &mut []);
-        let take = heap_take(lent.lengths(), count);
+        let ask = Ask::route(count, false);
+        let take = Need::Route.take(lent.lengths(), ask)?;
         let (heap, _) = lent.take(take)?;
-        Some((words, heap))
+        Some((words, RouteHeap::new(heap)))
     }
 
     /// A packed route of `count` blocks: the words and heap to build it in ([`route_take`], the table
@@ -116,13 +133,15 @@ impl Idle<'_> {
         &'g mut self,
         guide: &'g mut Guide<'_>,
         count: usize,
-    ) -> Option<(Pair<'g>, &'g mut [u32])> {
+    ) -> Option<(Routing<'g>, &'g mut [u32])> {
         let Guide::Packed(out) = guide else {
             return None;
         };
         let lent = Lent::new(self.links, self.tabu, self.cells, &mut []);
-        let take = route_take(lent.lengths(), count)?;
-        Some((lent.take(take)?, out))
+        let ask = Ask::route(count, true);
+        let take = Need::Route.take(lent.lengths(), ask)?;
+        let (words, heap) = lent.take(take)?;
+        Some(((words, RouteHeap::new(heap)), out))
     }
 }
 
@@ -131,7 +150,7 @@ pub(super) struct Colony<'w> {
     pub(super) tau: &'w mut [[f32; 4]],
     pub(super) delta: &'w mut [[f32; 4]],
     /// The ant's tabu set (and tightening's filter).
-    pub(super) tabu: &'w mut [u32],
+    pub(super) tabu: TabuSet<'w>,
     pub(super) dead: &'w [u32],
     pub(super) moves: &'w [u8],
     /// The ant's path, the iteration's best and worst (empty: walked again), the run's best.
@@ -172,7 +191,8 @@ impl Spent<'_> {
         fewest: usize,
     ) -> Option<(&'g mut [u32], &'g mut [u32])> {
         let lent = Lent::new(self.links, self.tabu, &mut [], guide.reborrow().scratch());
-        let take = refine_take(lent.lengths(), words, fewest)?;
+        let ask = Ask::refine(words, fewest);
+        let take = Need::Refine.take(lent.lengths(), ask)?;
         lent.take(take)
     }
 
@@ -192,10 +212,12 @@ impl Spent<'_> {
     }
 
     /// The smoothing's links for a raw path of `n` cells ([`smoothing_take`]).
-    pub(super) fn smoothing(&mut self, n: usize) -> &mut [u32] {
+    pub(super) fn smoothing(&mut self, n: usize) -> PathLinks<'_> {
         let lent = Lent::new(self.links, self.tabu, &mut [], &mut []);
-        let take = smoothing_take(lent.lengths(), n);
-        lent.take(take).map_or(&mut [], |(links, _)| links)
+        let ask = Ask::smoothing(n);
+        let take = Need::Smoothing.take(lent.lengths(), ask);
+        let links = take.and_then(|t| lent.take(t));
+        PathLinks::new(links.map_or(&mut [], |(links, _)| links))
     }
 
     /// The links (the corridor search's scratch on small maps).
@@ -224,7 +246,7 @@ impl<'a> Workspace<'a> {
         Colony {
             tau: self.tau,
             delta: self.delta,
-            tabu: self.tabu,
+            tabu: TabuSet::new(self.tabu),
             dead: self.dead,
             moves: self.moves,
             tours: [self.tour, self.iter_best, self.iter_worst, self.best],
@@ -245,419 +267,5 @@ impl<'a> Workspace<'a> {
                 links: self.links,
             },
         }
-    }
-}
-
-/// A buffer a phase borrows while it is idle.
-#[derive(Clone, Copy, PartialEq, Eq, Debug)]
-pub(super) enum Buf {
-    /// The links.
-    Links,
-    /// The tabu bit set.
-    Tabu,
-    /// The path cells' words (idle before the first ant).
-    Points,
-    /// The route's words (scratch after the colony).
-    Guide,
-}
-
-/// What a phase takes of the idle buffers: each lending rule below chooses one from the
-/// buffers' lengths alone, and [`Take::fits`] says whether those lengths hold it. The rule is
-/// written once: the slices a phase gets ([`Lent::take`]) and the links an arena must lay out
-/// for it (the `*_links` functions) are both derived from it.
-#[derive(Clone, Copy, PartialEq, Eq, Debug)]
-pub(super) enum Take {
-    /// The first `words` words of each of two buffers.
-    Pair(Buf, Buf, usize),
-    /// Two slices of `words` words one after the other in one buffer.
-    Halves(Buf, usize),
-    /// One buffer, whole (the second slice empty).
-    Whole(Buf),
-}
-
-/// The lengths, in words, of the idle buffers a rule chooses among.
-#[derive(Clone, Copy, PartialEq, Eq, Debug)]
-pub(super) struct Lengths {
-    pub(super) links: usize,
-    pub(super) tabu: usize,
-    pub(super) points: usize,
-    pub(super) guide: usize,
-}
-
-impl Lengths {
-    const fn of(self, b: Buf) -> usize {
-        match b {
-            Buf::Links => self.links,
-            Buf::Tabu => self.tabu,
-            Buf::Points => self.points,
-            Buf::Guide => self.guide,
-        }
-    }
-}
-
-impl Take {
-    /// Whether buffers of these lengths hold it.
-    pub(super) const fn fits(self, l: Lengths) -> bool {
-        match self {
-            Take::Pair(a, b, words) => {
-                !matches!(
-                    (a, b),
-                    (Buf::Links, Buf::Links)
-                        | (Buf::Tabu, Buf::Tabu)
-                        | (Buf::Points, Buf::Points)
-                        | (Buf::Guide, Buf::Guide)
-                ) && l.of(a) >= words
-                    && l.of(b) >= words
-            }
-            Take::Halves(a, words) => l.of(a) >= words.saturating_mul(2),
-            Take::Whole(_) => true,
-        }
-    }
-
-    /// Words of its shorter slice.
-    pub(super) const fn words(self, l: Lengths) -> usize {
-        match self {
-            Take::Pair(_, _, words) | Take::Halves(_, words) => words,
-            Take::Whole(b) => l.of(b),
-        }
-    }
-
-    /// `Some(self)` when buffers of these lengths hold it.
-    const fn within(self, l: Lengths) -> Option<Take> {
-        if self.fits(l) {
-            Some(self)
-        } else {
-            None
-        }
-    }
-}
-
-/// The idle buffers themselves, to lend what a [`Take`] says.
-pub(super) struct Lent<'x> {
-    /// Indexed by [`Buf`]: each is handed out at most once.
-    bufs: [Option<&'x mut [u32]>; 4],
-}
-
-impl<'x> Lent<'x> {
-    pub(super) fn new(
-        links: &'x mut [u32],
-        tabu: &'x mut [u32],
-        points: &'x mut [u32],
-        guide: &'x mut [u32],
-    ) -> Self {
-        Self {
-            bufs: [Some(links), Some(tabu), Some(points), Some(guide)],
-        }
-    }
-
-    /// Their lengths.
-    pub(super) fn lengths(&self) -> Lengths {
-        let len = |b: Buf| {
-            self.bufs
-                .get(b as usize)
-                .and_then(|x| x.as_ref())
-                .map_or(0, |x| x.len())
-        };
-        Lengths {
-            links: len(Buf::Links),
-            tabu: len(Buf::Tabu),
-            points: len(Buf::Points),
-            guide: len(Buf::Guide),
-        }
-    }
-
-    fn buf(&mut self, b: Buf) -> Option<&'x mut [u32]> {
-        self.bufs.get_mut(b as usize)?.take()
-    }
-
-    /// The slices `take` names; `None` when the buffers do not hold it.
-    pub(super) fn take(mut self, take: Take) -> Option<Pair<'x>> {
-        match take {
-            Take::Pair(a, b, words) => {
-                let x = self.buf(a)?.get_mut(..words)?;
-                Some((x, self.buf(b)?.get_mut(..words)?))
-            }
-            Take::Halves(a, words) => {
-                let (x, y) = self.buf(a)?.split_at_mut_checked(words)?;
-                Some((x, y.get_mut(..words)?))
-            }
-            Take::Whole(a) => Some((self.buf(a)?, &mut [])),
-        }
-    }
-}
-
-/// The local search's scratch after the last ant, two slices of `words` words (the table
-/// above): the links and the route's words, the tabu set and the route's words, the links and
-/// the tabu set (one of each, else both from one), else the tabu set halved when each half
-/// holds at least `fewest` words (a smaller window,
-/// [`crate::polish::refine::Scratch::side`]); `None`: not enough. Reads the links, the tabu set
-/// and the route's words.
-pub(super) const fn refine_take(l: Lengths, words: usize, fewest: usize) -> Option<Take> {
-    if l.links >= words && l.guide >= words {
-        return Some(Take::Pair(Buf::Links, Buf::Guide, words));
-    }
-    if l.links < words && l.guide >= words && l.tabu >= words {
-        return Some(Take::Pair(Buf::Tabu, Buf::Guide, words));
-    }
-    if l.links >= words && l.tabu >= words
-        || l.links >= words.saturating_mul(2)
-        || l.tabu >= words.saturating_mul(2)
-    {
-        return if l.links >= words && l.tabu >= words {
-            Some(Take::Pair(Buf::Links, Buf::Tabu, words))
-        } else if l.links >= words {
-            Some(Take::Halves(Buf::Links, words))
-        } else {
-            Some(Take::Halves(Buf::Tabu, words))
-        };
-    }
-    let half = l.tabu / 2;
-    if half < fewest {
-        None
-    } else {
-        Some(Take::Halves(Buf::Tabu, half))
-    }
-}
-
-/// A repair's detour scratch between plans, when the links, the route's words and the tabu set are
-/// all idle: of the pairs (links, route), (links, tabu set), (tabu set, route) and of each of the
-/// three halved, the one whose shorter slice is longest (the first in that order on a tie), both
-/// slices cut to that length (empty when every buffer is).
-pub(super) const fn detour_take(l: Lengths) -> Take {
-    let ways = [
-        Take::Pair(Buf::Links, Buf::Guide, min(l.links, l.guide)),
-        Take::Pair(Buf::Links, Buf::Tabu, min(l.links, l.tabu)),
-        Take::Pair(Buf::Tabu, Buf::Guide, min(l.tabu, l.guide)),
-        Take::Halves(Buf::Links, l.links / 2),
-        Take::Halves(Buf::Tabu, l.tabu / 2),
-        Take::Halves(Buf::Guide, l.guide / 2),
-    ];
-    let mut best = Take::Pair(Buf::Links, Buf::Guide, 0);
-    let mut rest: &[Take] = &ways;
-    while let [way, tail @ ..] = rest {
-        if way.words(l) > best.words(l) {
-            best = *way;
-        }
-        rest = tail;
-    }
-    best
-}
-
-const fn min(a: usize, b: usize) -> usize {
-    if a < b {
-        a
-    } else {
-        b
-    }
-}
-
-/// The words and the heap of a packed route of `count` blocks, built before the first ant (the
-/// table above): the tabu set halved, else the tabu set and the path cells' words, else either
-/// of them and the links, else the links halved; `None`: not enough.
-pub(super) const fn route_take(l: Lengths, count: usize) -> Option<Take> {
-    let take = match (l.tabu >= count, l.points >= count) {
-        _ if l.tabu >= count.saturating_mul(2) => Take::Halves(Buf::Tabu, count),
-        (true, true) => Take::Pair(Buf::Tabu, Buf::Points, count),
-        (true, false) => Take::Pair(Buf::Tabu, Buf::Links, count),
-        (false, true) => Take::Pair(Buf::Points, Buf::Links, count),
-        (false, false) => Take::Halves(Buf::Links, count),
-    };
-    take.within(l)
-}
-
-/// The heap of a word-a-block route of `count` blocks (the full layout): the links when they hold
-/// `count` words, else the tabu set.
-pub(super) const fn heap_take(l: Lengths, count: usize) -> Take {
-    if l.links >= count {
-        Take::Whole(Buf::Links)
-    } else {
-        Take::Whole(Buf::Tabu)
-    }
-}
-
-/// The smoothing's links for a raw path of `n` cells: the links when they hold `n`, else the
-/// tabu set when it does, else the links (the greedy rule).
-pub(super) const fn smoothing_take(l: Lengths, n: usize) -> Take {
-    if l.links < n && l.tabu >= n {
-        Take::Whole(Buf::Tabu)
-    } else {
-        Take::Whole(Buf::Links)
-    }
-}
-
-/// Idle buffers of these lengths, with `links` links.
-const fn with_links(links: usize, tabu: usize, points: usize) -> Lengths {
-    Lengths {
-        links,
-        tabu,
-        points,
-        guide: 0,
-    }
-}
-
-/// Words [`refine_take`] needs in the links beside a tabu set of `tabu` words (and a route of
-/// fewer than `words` words): the fewest of 0, `words` and twice `words` that it lends from.
-pub(super) const fn refine_links(tabu: usize, words: usize, fewest: usize) -> usize {
-    if refine_take(with_links(0, tabu, 0), words, fewest).is_some() {
-        0
-    } else if refine_take(with_links(words, tabu, 0), words, fewest).is_some() {
-        words
-    } else {
-        words.saturating_mul(2)
-    }
-}
-
-/// Words [`route_take`] needs in the links beside a tabu set of `tabu` words and `points` words
-/// of path cells for a route of `count` blocks: the fewest of 0, `count` and twice `count` that
-/// it lends from.
-pub(super) const fn route_links(tabu: usize, points: usize, count: usize) -> usize {
-    if route_take(with_links(0, tabu, points), count).is_some() {
-        0
-    } else if route_take(with_links(count, tabu, points), count).is_some() {
-        count
-    } else {
-        count.saturating_mul(2)
-    }
-}
-
-/// Words [`smoothing_take`] needs in the links beside a tabu set of `tabu` words for `n`
-/// cells: 0 when it lends `n` words without them, else `n`.
-pub(super) const fn smoothing_links(tabu: usize, n: usize) -> usize {
-    let l = with_links(0, tabu, 0);
-    if smoothing_take(l, n).words(l) >= n {
-        0
-    } else {
-        n
-    }
-}
-
-/// The tabu-set lengths at which the rules above change what they need of the links, for the
-/// local search's `words` and `fewest`, a route of `count` blocks and paths of `n` cells (when
-/// the path cells hold `count` words): between two of them every `*_links` above is the same
-/// ([`super::arena::capacity`] walks the tabu lengths piece by piece).
-pub(super) const fn cuts(words: usize, fewest: usize, count: usize, n: usize) -> [usize; 6] {
-    [
-        words,
-        words.saturating_mul(2),
-        fewest.saturating_mul(2),
-        count,
-        count.saturating_mul(2),
-        n,
-    ]
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn lengths(links: usize, tabu: usize, points: usize, guide: usize) -> Lengths {
-        Lengths {
-            links,
-            tabu,
-            points,
-            guide,
-        }
-    }
-
-    /// Lend `take` from fresh buffers of these lengths: the two slices' lengths.
-    fn lend(l: Lengths, take: Take) -> Option<(usize, usize)> {
-        let (mut a, mut b, mut c, mut d) = (
-            vec![0u32; l.links],
-            vec![0u32; l.tabu],
-            vec![0u32; l.points],
-            vec![0u32; l.guide],
-        );
-        let lent = Lent::new(&mut a, &mut b, &mut c, &mut d);
-        assert_eq!(lent.lengths(), l);
-        lent.take(take).map(|(x, y)| (x.len(), y.len()))
-    }
-
-    #[test]
-    fn every_lending_fits_what_its_size_says() {
-        // For lengths around the boundaries, the route and the local search find their slices
-        // exactly when the sizes say the links suffice, and the slices lent are as long as the
-        // rule says (two `&mut` slices never overlap, by type).
-        for tabu in [0usize, 10, 99, 100, 150, 199, 200, 500] {
-            for links in [0usize, 50, 99, 100, 199, 200, 300] {
-                let l = lengths(links, tabu, 0, 7);
-                let got = route_take(l, 100);
-                assert_eq!(
-                    got.is_some(),
-                    links >= route_links(tabu, 0, 100),
-                    "{tabu} {links}"
-                );
-                if let Some(take) = got {
-                    assert_eq!(lend(l, take), Some((100, 100)));
-                }
-                let got = refine_take(l, 100, 60);
-                let need = refine_links(tabu, 100, 60);
-                assert_eq!(got.is_some(), links >= need, "{tabu} {links}");
-                if let Some(take) = got {
-                    let w = take.words(l);
-                    assert!(w == 100 || w >= 60 && w == tabu / 2, "{take:?}");
-                    assert_eq!(lend(l, take), Some((w, w)));
-                }
-                let n = 120;
-                let take = smoothing_take(l, n);
-                let s = lend(l, take).map_or(0, |(x, _)| x);
-                assert_eq!(s >= n, links >= smoothing_links(tabu, n), "{tabu} {links}");
-            }
-        }
-        // A pair of one buffer with itself is never lent.
-        let l = lengths(10, 10, 10, 10);
-        assert!(!Take::Pair(Buf::Links, Buf::Links, 1).fits(l));
-        assert_eq!(lend(l, Take::Pair(Buf::Tabu, Buf::Tabu, 1)), None);
-        assert_eq!(lend(l, Take::Halves(Buf::Tabu, 6)), None);
-    }
-
-    #[test]
-    fn the_links_change_only_at_the_cuts() {
-        // Between two tabu lengths of `cuts`, every size the arena lays out is the same: the
-        // arena's capacity search relies on it. A rule whose threshold is not a cut fails here.
-        for (words, fewest, count, n) in
-            [(100, 60, 70, 300), (4056, 3456, 4096, 4096), (8, 3, 20, 9)]
-        {
-            let cuts = cuts(words, fewest, count, n);
-            let sizes = |tabu| {
-                (
-                    refine_links(tabu, words, fewest),
-                    route_links(tabu, n, count),
-                    smoothing_links(tabu, n),
-                )
-            };
-            for tabu in 1..3 * (words + count + n) {
-                if !cuts.contains(&tabu) {
-                    assert_eq!(sizes(tabu), sizes(tabu - 1), "{tabu}");
-                }
-            }
-        }
-    }
-
-    #[test]
-    fn a_detour_gets_the_longest_pair_the_idle_buffers_give() {
-        // Every pairing against a brute force over the six ways: both slices as long as the best
-        // way's shorter one.
-        for l in [0usize, 1, 7, 100, 4056, 4096] {
-            for g in [0usize, 512, 4096] {
-                for t in [0usize, 2048, 5795, 8192] {
-                    let best = [l.min(g), l.min(t), t.min(g), l / 2, t / 2, g / 2]
-                        .into_iter()
-                        .max()
-                        .unwrap();
-                    let len = lengths(l, t, 0, g);
-                    assert_eq!(
-                        lend(len, detour_take(len)),
-                        Some((best, best)),
-                        "{l} {g} {t}"
-                    );
-                }
-            }
-        }
-        // The F411's layouts: the full one (links and route words, 4,096 each) and the compact
-        // one at 512 x 512 (its tabu set halved) and at Nav2's depot (the links and the tabu set).
-        let words = |l, g, t| detour_take(lengths(l, t, 0, g)).words(lengths(l, t, 0, g));
-        assert_eq!(words(4096, 4096, 2048), 4096);
-        assert_eq!(words(2048, 512, 8192), 4096);
-        assert_eq!(words(4056, 512, 5795), 4056);
     }
 }

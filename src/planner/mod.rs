@@ -34,6 +34,7 @@
 
 pub mod arena;
 mod lend;
+mod needs;
 mod params;
 mod placed;
 mod plan;

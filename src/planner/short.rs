@@ -28,13 +28,17 @@ impl Shortfalls {
     pub const SMOOTHING: Self = Self(1 << 3);
     /// Too little scratch for the small maps' exact corridor search: the smoothed path stands.
     pub const CORRIDOR: Self = Self(1 << 4);
+    /// Too few links (and path cells' words) for tightening's index: some ants' walks were not
+    /// tightened.
+    pub const TIGHTEN: Self = Self(1 << 5);
 
-    const NAMES: [(Self, &'static str); 5] = [
+    const NAMES: [(Self, &'static str); 6] = [
         (Self::ROUTE, "route"),
         (Self::STASH, "stash"),
         (Self::REFINE, "refine"),
         (Self::SMOOTHING, "smoothing"),
         (Self::CORRIDOR, "corridor"),
+        (Self::TIGHTEN, "tightening"),
     ];
 
     /// Whether no step ran short.
@@ -53,7 +57,7 @@ impl Shortfalls {
     }
 
     /// The set as a byte (bit 0 the route, 1 the stash, 2 the local search, 3 the smoothing, 4
-    /// the corridor search).
+    /// the corridor search, 5 tightening).
     pub const fn bits(self) -> u8 {
         self.0
     }

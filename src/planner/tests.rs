@@ -4,6 +4,7 @@ use super::*;
 use crate::error::{Endpoint, Param};
 use crate::map::grid::{Dir, Point};
 use alloc::boxed::Box;
+use alloc::vec;
 use alloc::vec::Vec;
 
 /// Storage for maps of up to 64 cells.
@@ -1012,6 +1013,56 @@ fn walking_the_iterations_best_and_worst_again_plans_what_keeping_them_does() {
         wolves_seen += usize::from(p.algorithm.wolves() && kept.is_ok());
     }
     assert!(wolves_seen >= 20, "{wolves_seen}");
+}
+
+#[test]
+fn too_few_links_for_tightening_is_a_shortfall() {
+    // 40 x 40 maps with a fifth of their cells walls, corner to corner: some ants wander, and
+    // their walks want tightening. With path cells that are not word-aligned (a workspace laid
+    // out by hand) the index cannot key its table on them, and eight links hold no table of a
+    // path of 20 cells or more, so those walks stay as walked and the plan says so; with a link a
+    // cell nothing runs short.
+    let (w, h) = (40u16, 40u16);
+    let mut rng = crate::rng::Xoshiro128pp::from_u64(5);
+    let mut b = vec![0u8; 200];
+    for i in 1..1599 {
+        if rng.next_unit() < 0.2 {
+            b[i / 8] |= 1 << (i % 8);
+        }
+    }
+    let g = Grid::new(w, h, &b).unwrap();
+    let (start, goal) = (Point::new(0, 0), Point::new(39, 39));
+    let p = Params::default();
+    let cells = g.cells();
+    let steps = 400;
+    let run = |links: usize| {
+        let (mut tau, mut delta) = (vec![[0f32; 4]; cells], vec![[0f32; 4]; cells]);
+        let (mut tabu, mut dead) = (
+            vec![0u32; cells.div_ceil(32)],
+            vec![0u32; cells.div_ceil(32)],
+        );
+        let (mut tour, mut best) = (vec![0 as Dir; steps], vec![0 as Dir; steps]);
+        // Point's halves: the cells start two bytes into a word.
+        let mut halves = vec![0u16; 2 * (steps + 1) + 1];
+        let points: &mut [Point] = bytemuck::cast_slice_mut(&mut halves[1..]);
+        let (mut links, mut guide) = (vec![0u32; links], vec![0u32; 4096]);
+        let ws = Workspace::new(Buffers {
+            tau: &mut tau,
+            delta: &mut delta,
+            tabu: &mut tabu,
+            dead: &mut dead,
+            moves: &mut [],
+            tours: [&mut tour, &mut [], &mut [], &mut best],
+            points,
+            links: &mut links,
+            curve: &mut [],
+            guide: &mut guide,
+        });
+        plan(&g, start, goal, &p, ws).unwrap().shortfalls
+    };
+    let short = run(8);
+    assert!(short.contains(Shortfalls::TIGHTEN), "{short}");
+    assert_eq!(run(cells), Shortfalls::NONE);
 }
 
 #[test]

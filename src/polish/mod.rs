@@ -6,6 +6,7 @@
 //! on it. Each module is also reachable at the crate root (`ohaca::smoothing`, `ohaca::refine`, ...).
 
 pub mod corridor;
+pub mod links;
 pub mod refine;
 pub mod smoothing;
 pub mod taut;

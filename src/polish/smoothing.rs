@@ -31,6 +31,7 @@ pub use crate::geometry::drop_collinear;
 use crate::geometry::{distance, drop_middles, segment_clear};
 use crate::map::grid::{Grid, Point};
 use crate::named::named;
+use crate::polish::links::PathLinks;
 use crate::polish::taut::{segment_units, Pass};
 
 /// How to post-process the raw path.
@@ -97,7 +98,7 @@ pub fn smooth(
     pts: &mut [Point],
     n: usize,
     dist: &mut [f32],
-    prev: &mut [u32],
+    prev: &mut PathLinks<'_>,
 ) -> usize {
     Smoother::new(kind, n, dist, prev).finish(grid, pts, dist, prev)
 }
@@ -142,16 +143,16 @@ const TRACE_CELLS: usize = 4;
 impl Smoother {
     /// Prepare to smooth `pts[..n]` with `kind`. Falls back to [`SmoothingKind::Greedy`] when
     /// `dist` and `prev` are shorter than [`scratch_for`]`(n)`.
-    pub fn new(kind: SmoothingKind, n: usize, dist: &mut [f32], prev: &mut [u32]) -> Self {
+    pub fn new(kind: SmoothingKind, n: usize, dist: &mut [f32], prev: &mut PathLinks<'_>) -> Self {
         let ring = n.min(LOOKBACK.wrapping_add(1));
-        let kind = if kind == SmoothingKind::Shortest && (dist.len() < ring || prev.len() < n) {
+        let kind = if kind == SmoothingKind::Shortest && (dist.len() < ring || !prev.holds(n)) {
             SmoothingKind::Greedy
         } else {
             kind
         };
-        if let (Some(d0), Some(p0)) = (dist.first_mut(), prev.first_mut()) {
+        if let (Some(d0), false) = (dist.first_mut(), prev.is_empty()) {
             *d0 = 0.0;
-            *p0 = 0;
+            prev.link(0, 0);
         }
         Smoother {
             kind,
@@ -197,7 +198,7 @@ impl Smoother {
         grid: &Grid<'_>,
         pts: &[Point],
         dist: &mut [f32],
-        prev: &mut [u32],
+        prev: &mut PathLinks<'_>,
         cells: usize,
     ) -> bool {
         let n = self.n.min(pts.len());
@@ -226,7 +227,7 @@ impl Smoother {
         grid: &Grid<'_>,
         pts: &mut [Point],
         dist: &mut [f32],
-        prev: &mut [u32],
+        prev: &mut PathLinks<'_>,
         budget: u32,
     ) -> Option<usize> {
         let n = self.n.min(pts.len());
@@ -295,7 +296,7 @@ impl Smoother {
         grid: &Grid<'_>,
         pts: &mut [Point],
         dist: &mut [f32],
-        prev: &mut [u32],
+        prev: &mut PathLinks<'_>,
     ) -> usize {
         let n = self.n.min(pts.len());
         if n < 3 {
@@ -364,7 +365,7 @@ pub fn shortest_with(
     pts: &mut [Point],
     n: usize,
     dist: &mut [f32],
-    prev: &mut [u32],
+    prev: &mut PathLinks<'_>,
     lookback: usize,
 ) -> usize {
     let n = n.min(pts.len());
@@ -373,7 +374,7 @@ pub fn shortest_with(
     }
     let lookback = lookback.max(1);
     let ring = n.min(lookback.saturating_add(1));
-    if dist.len() < ring || prev.len() < n {
+    if dist.len() < ring || !prev.holds(n) {
         return greedy(grid, pts, n);
     }
     let k = shortest(
@@ -399,12 +400,12 @@ fn shortest(
     pts: &mut [Point],
     n: usize,
     dist: &mut [f32],
-    prev: &mut [u32],
+    prev: &mut PathLinks<'_>,
     lookback: usize,
 ) -> usize {
-    if let (Some(d0), Some(p0)) = (dist.first_mut(), prev.first_mut()) {
+    if let (Some(d0), false) = (dist.first_mut(), prev.is_empty()) {
         *d0 = 0.0;
-        *p0 = 0;
+        prev.link(0, 0);
     }
     dp_cells(grid, pts, dist, prev, lookback, 1..n);
     trace(pts, n, prev)
@@ -426,7 +427,7 @@ fn dp_cells(
     grid: &Grid<'_>,
     pts: &[Point],
     dist: &mut [f32],
-    prev: &mut [u32],
+    prev: &mut PathLinks<'_>,
     lookback: usize,
     cells: core::ops::Range<usize>,
 ) {
@@ -478,7 +479,7 @@ fn chain_cells(
     clear: impl FnMut(Point, Point) -> bool,
     pts: &[Point],
     dist: &mut [f32],
-    prev: &mut [u32],
+    prev: &mut PathLinks<'_>,
     lookback: usize,
     cells: core::ops::Range<usize>,
 ) {
@@ -491,7 +492,7 @@ fn scan_cells(
     mut clear: impl FnMut(Point, Point) -> bool,
     pts: &[Point],
     dist: &mut [f32],
-    prev: &mut [u32],
+    prev: &mut PathLinks<'_>,
     lookback: usize,
     cells: core::ops::Range<usize>,
     bounded: bool,
@@ -535,8 +536,7 @@ fn scan_cells(
             // `j - 1`'s predecessors inside the window, nearest first (the start links to itself).
             let mut len = 0usize;
             let mut a = before;
-            while let (Some(&up), Some(s)) = (prev.get(a), chain.get_mut(len)) {
-                let up = up as usize;
+            while let (Some(up), Some(s)) = (prev.from(a), chain.get_mut(len)) {
                 if up >= a || up < lo {
                     break;
                 }
@@ -549,7 +549,7 @@ fn scan_cells(
             }
             let mut last = usize::MAX;
             for b in near..before {
-                let up = prev.get(b).map_or(b, |&u| u as usize);
+                let up = prev.from(b).unwrap_or(b);
                 for i in [up, b] {
                     if i >= lo && i != last && i < before {
                         last = i;
@@ -558,30 +558,20 @@ fn scan_cells(
                 }
             }
         }
-        if let (Some(d), Some(p)) = (dist.get_mut(slot(j)), prev.get_mut(j)) {
+        if let (Some(d), true) = (dist.get_mut(slot(j)), prev.holds(j.wrapping_add(1))) {
             *d = best;
-            *p = from as u32;
+            prev.link(j, from);
         }
     }
 }
 
 /// Follow the DP's links from the goal (`pts[n - 1]`) back to the start and compact the chosen
 /// cells to the front of `pts`; returns how many.
-fn trace(pts: &mut [Point], n: usize, prev: &mut [u32]) -> usize {
+fn trace(pts: &mut [Point], n: usize, prev: &mut PathLinks<'_>) -> usize {
     // Follow prev from the goal back to the start, reversing the links into "next" links.
-    let mut cur = n.wrapping_sub(1); // n >= 3 (see `smooth`)
-    let mut next = u32::MAX;
-    while let Some(slot) = prev.get_mut(cur) {
-        let p = *slot as usize;
-        *slot = next;
-        next = cur as u32;
-        if cur == 0 {
-            break;
-        }
-        cur = p;
-    }
-    // Walk forward, compacting the chosen cells to the front (indices only grow, so reading
-    // index i after writing slot k <= i is safe).
+    prev.reverse(n.wrapping_sub(1)); // n >= 3 (see `smooth`)
+                                     // Walk forward, compacting the chosen cells to the front (indices only grow, so reading
+                                     // index i after writing slot k <= i is safe).
     let mut k = 0usize;
     let mut i = 0usize;
     while let Some(&p) = pts.get(i) {
@@ -590,9 +580,9 @@ fn trace(pts: &mut [Point], n: usize, prev: &mut [u32]) -> usize {
         }
         // The links only go forward, so at most n cells are visited: k <= n.
         k = k.wrapping_add(1);
-        match prev.get(i) {
-            Some(&nx) if nx != u32::MAX => i = nx as usize,
-            _ => break,
+        match prev.next(i) {
+            Some(nx) => i = nx,
+            None => break,
         }
     }
     k
@@ -655,6 +645,16 @@ mod tests {
     use super::*;
     use crate::geometry::polyline_length;
 
+    /// No links: the smoothing takes its greedy rule.
+    fn unlinked() -> PathLinks<'static> {
+        PathLinks::new(&mut [])
+    }
+
+    /// The links over `words`.
+    fn linked(words: &mut [u32]) -> PathLinks<'_> {
+        PathLinks::new(words)
+    }
+
     fn grid(rows: &[&str]) -> (Vec<u8>, u16, u16) {
         crate::testutil::bits(rows)
     }
@@ -672,7 +672,7 @@ mod tests {
             let mut p = raw.clone();
             let mut d = vec![0.0; 6];
             let mut pr = vec![0; 6];
-            let k = smooth(&g, kind, &mut p, 6, &mut d, &mut pr);
+            let k = smooth(&g, kind, &mut p, 6, &mut d, &mut linked(&mut pr));
             assert_eq!(&p[..k], &pts(&[(0, 0), (5, 2)])[..], "{kind:?}");
         }
     }
@@ -682,7 +682,7 @@ mod tests {
         let (b, w, h) = grid(&["....", "....", "...."]);
         let g = Grid::new(w, h, &b).unwrap();
         let mut p = pts(&[(0, 0), (1, 0), (2, 0), (3, 1), (3, 2)]);
-        let k = smooth(&g, SmoothingKind::None, &mut p, 5, &mut [], &mut []);
+        let k = smooth(&g, SmoothingKind::None, &mut p, 5, &mut [], &mut unlinked());
         assert_eq!(&p[..k], &pts(&[(0, 0), (2, 0), (3, 1), (3, 2)])[..]);
     }
 
@@ -719,7 +719,7 @@ mod tests {
             let mut p = raw.clone();
             let mut d = vec![0.0; n];
             let mut pr = vec![0; n];
-            let k = smooth(&g, kind, &mut p, n, &mut d, &mut pr);
+            let k = smooth(&g, kind, &mut p, n, &mut d, &mut linked(&mut pr));
             let wp = &p[..k];
             assert_eq!(wp[0], raw[0]);
             assert_eq!(wp[k - 1], raw[n - 1]);
@@ -833,7 +833,7 @@ mod tests {
             let (want_dist, want_prev) = rule(&g, &raw);
             // The ring as long as the path, so every distance stays readable.
             let (mut dist, mut prev) = (vec![0f32; n], vec![0u32; n]);
-            dp_cells(&g, &raw, &mut dist, &mut prev, LOOKBACK, 1..n);
+            dp_cells(&g, &raw, &mut dist, &mut linked(&mut prev), LOOKBACK, 1..n);
             assert_eq!(prev[1..], want_prev[1..], "case {case}");
             let (bits, want_bits): (Vec<u32>, Vec<u32>) = (
                 dist.iter().map(|d| d.to_bits()).collect(),
@@ -847,7 +847,7 @@ mod tests {
             let mut j = 1;
             while j < n {
                 let to = (j + chunk).min(n);
-                dp_cells(&g, &raw, &mut dist, &mut prev, LOOKBACK, j..to);
+                dp_cells(&g, &raw, &mut dist, &mut linked(&mut prev), LOOKBACK, j..to);
                 j = to;
             }
             assert_eq!(prev[1..], want_prev[1..], "ring, case {case}");
@@ -864,18 +864,18 @@ mod tests {
             let n = raw.len();
             for kind in SmoothingKind::ALL {
                 let (mut p1, mut d1, mut r1) = (raw.clone(), vec![0.0; n], vec![0; n]);
-                let k1 = smooth(&g, kind, &mut p1, n, &mut d1, &mut r1);
+                let k1 = smooth(&g, kind, &mut p1, n, &mut d1, &mut linked(&mut r1));
                 let (mut p2, mut d2, mut r2) = (raw.clone(), vec![7.0; n], vec![9; n]);
-                let mut sm = Smoother::new(kind, n, &mut d2, &mut r2);
+                let mut sm = Smoother::new(kind, n, &mut d2, &mut linked(&mut r2));
                 let chunk = 1 + case % 13;
                 let mut calls = 0;
-                while sm.resume(&g, &p2, &mut d2, &mut r2, chunk) {
+                while sm.resume(&g, &p2, &mut d2, &mut linked(&mut r2), chunk) {
                     calls += 1;
                 }
                 if kind == SmoothingKind::Shortest {
                     assert_eq!(calls, (n - 1).div_ceil(chunk) - 1, "{n} {chunk}");
                 }
-                let k2 = sm.finish(&g, &mut p2, &mut d2, &mut r2);
+                let k2 = sm.finish(&g, &mut p2, &mut d2, &mut linked(&mut r2));
                 assert_eq!(p1[..k1], p2[..k2], "{kind:?} case {case}");
             }
         }
@@ -895,7 +895,7 @@ mod tests {
             let n = raw.len();
             for bounded in [false, true] {
                 let start = |d: &mut Vec<f32>, r: &mut Vec<u32>| {
-                    let sm = Smoother::new(SmoothingKind::Shortest, n, d, r);
+                    let sm = Smoother::new(SmoothingKind::Shortest, n, d, &mut PathLinks::new(r));
                     if bounded {
                         sm.bounded()
                     } else {
@@ -903,14 +903,16 @@ mod tests {
                     }
                 };
                 let (mut p1, mut d1, mut r1) = (raw.clone(), vec![0.0; n], vec![0; n]);
-                let k1 = start(&mut d1, &mut r1).finish(&g, &mut p1, &mut d1, &mut r1);
+                let k1 = start(&mut d1, &mut r1).finish(&g, &mut p1, &mut d1, &mut linked(&mut r1));
                 for budget in [1u32, 7, 60, 100_000] {
                     let (mut p2, mut d2, mut r2) = (raw.clone(), vec![0.0; n], vec![0; n]);
                     let mut sm = start(&mut d2, &mut r2);
-                    while sm.resume(&g, &p2, &mut d2, &mut r2, 9) {}
+                    while sm.resume(&g, &p2, &mut d2, &mut linked(&mut r2), 9) {}
                     let mut pieces = 1;
                     let k2 = loop {
-                        if let Some(k) = sm.finish_piece(&g, &mut p2, &mut d2, &mut r2, budget) {
+                        if let Some(k) =
+                            sm.finish_piece(&g, &mut p2, &mut d2, &mut linked(&mut r2), budget)
+                        {
                             break k;
                         }
                         pieces += 1;
@@ -946,7 +948,7 @@ mod tests {
                 &mut got,
                 n,
                 &mut vec![0.0; dn],
-                &mut vec![0; pn],
+                &mut linked(&mut vec![0; pn]),
             );
             assert_eq!(&got[..kg], &want[..kw], "case {case}");
         }
@@ -970,7 +972,7 @@ mod tests {
                 &mut got,
                 n,
                 &mut vec![0.0; dn],
-                &mut vec![0; pn],
+                &mut linked(&mut vec![0; pn]),
             );
             let wp = &got[..k];
             assert_eq!(wp[0], raw[0]);
@@ -979,7 +981,14 @@ mod tests {
                 assert!(segment_clear(&g, s[0], s[1]), "case {case} {s:?}");
             }
             let mut gr = raw.clone();
-            let kg = smooth(&g, SmoothingKind::Greedy, &mut gr, n, &mut [], &mut []);
+            let kg = smooth(
+                &g,
+                SmoothingKind::Greedy,
+                &mut gr,
+                n,
+                &mut [],
+                &mut unlinked(),
+            );
             let (ls, lg) = (polyline_length(wp), polyline_length(&gr[..kg]));
             assert!(ls <= polyline_length(&raw));
             if ls > lg + 1e-3 {
@@ -1006,11 +1015,16 @@ mod tests {
         let (ring, _) = scratch_for(n);
         for (bounded, reach) in [(true, BOUNDED_LOOKBACK), (false, LOOKBACK)] {
             let (mut dist, mut prev) = (vec![0f32; ring], vec![0u32; n]);
-            let mut sm = Smoother::new(SmoothingKind::Shortest, n, &mut dist, &mut prev);
+            let mut sm = Smoother::new(
+                SmoothingKind::Shortest,
+                n,
+                &mut dist,
+                &mut linked(&mut prev),
+            );
             if bounded {
                 sm = sm.bounded();
             }
-            while sm.resume(&g, &pts, &mut dist, &mut prev, 50) {}
+            while sm.resume(&g, &pts, &mut dist, &mut linked(&mut prev), 50) {}
             let farthest = (1..n).map(|j| j - prev[j] as usize).max().unwrap();
             assert!(farthest <= reach, "{bounded}: {farthest}");
             assert!(farthest > reach - STRIDE, "{bounded}: {farthest}");
@@ -1054,7 +1068,14 @@ mod tests {
                     tests += 1;
                     segment_clear(&g, a, c)
                 };
-                chain_cells(count, &raw, &mut dist, &mut prev, LOOKBACK, j..j + 1);
+                chain_cells(
+                    count,
+                    &raw,
+                    &mut dist,
+                    &mut linked(&mut prev),
+                    LOOKBACK,
+                    j..j + 1,
+                );
                 worst = worst.max(tests);
                 chain_tests += tests;
             }
@@ -1062,15 +1083,15 @@ mod tests {
             // The smoothing as a whole (bounded DP, merge, taut pull) against the full scan's.
             let mut p = raw.clone();
             let (mut d, mut r) = (vec![0f32; ring], vec![0u32; n]);
-            let k = Smoother::new(SmoothingKind::Shortest, n, &mut d, &mut r)
+            let k = Smoother::new(SmoothingKind::Shortest, n, &mut d, &mut linked(&mut r))
                 .bounded()
-                .finish(&g, &mut p, &mut d, &mut r);
+                .finish(&g, &mut p, &mut d, &mut linked(&mut r));
             for s in p[..k].windows(2) {
                 assert!(segment_clear(&g, s[0], s[1]), "case {case} {s:?}");
             }
             chain_len += polyline_length(&p[..k]);
             let mut q = raw.clone();
-            let kq = shortest_with(&g, &mut q, n, &mut d, &mut r, LOOKBACK);
+            let kq = shortest_with(&g, &mut q, n, &mut d, &mut linked(&mut r), LOOKBACK);
             let kq = drop_collinear(&mut q, kq);
             let kq = crate::polish::taut::pull(&g, &mut q, kq);
             full_len += polyline_length(&q[..kq]);
@@ -1107,7 +1128,7 @@ mod tests {
             &mut p,
             n,
             &mut vec![0.0; dn],
-            &mut vec![0; pn],
+            &mut linked(&mut vec![0; pn]),
         );
         assert_eq!(&p[..k], &[raw[0], raw[n - 1]]);
         // Scratch: the ring only, not n floats.
@@ -1120,7 +1141,7 @@ mod tests {
             &mut q,
             n,
             &mut vec![0.0; LOOKBACK],
-            &mut vec![0; n],
+            &mut linked(&mut vec![0; n]),
         );
         assert_eq!(&q[..k], &[raw[0], raw[n - 1]]);
     }

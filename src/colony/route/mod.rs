@@ -33,9 +33,11 @@
 use crate::colony::pheromone::Blocks;
 use crate::map::grid::{Moves, Point, DX, DY};
 
+pub mod heap;
 pub mod links;
 pub mod search;
 
+pub use heap::RouteHeap;
 pub use search::{Bound, Searched, Searching};
 
 /// Most blocks of the route: a map with more cells than this is cut into blocks of `2^k x 2^k`
@@ -185,7 +187,7 @@ pub fn build(
     (start, goal): (Point, Point),
     dead: &[u32],
     words: &mut [u32],
-    heap: &mut [u32],
+    heap: &mut RouteHeap<'_>,
     bound: Bound,
 ) -> Result<Searched, Short> {
     let mut at = begin_build(moves, blocks, (start, goal), dead, words, heap)?;
@@ -206,13 +208,13 @@ pub fn build(
 fn cut<'w>(
     blocks: Blocks,
     words: &'w mut [u32],
-    heap: &'w mut [u32],
-) -> Result<(&'w mut [u32], &'w mut [u32]), Short> {
+    heap: &'w mut RouteHeap<'_>,
+) -> Result<(&'w mut [u32], RouteHeap<'w>), Short> {
     let n = blocks.count();
     if n > usize::from(u16::MAX) {
         return Err(Short);
     }
-    match (words.get_mut(..n), heap.get_mut(..n)) {
+    match (words.get_mut(..n), heap.cut(n)) {
         (Some(words), Some(heap)) => Ok((words, heap)),
         _ => Err(Short),
     }
@@ -226,12 +228,12 @@ pub fn begin_build(
     ends: (Point, Point),
     dead: &[u32],
     words: &mut [u32],
-    heap: &mut [u32],
+    heap: &mut RouteHeap<'_>,
 ) -> Result<Searching, Short> {
-    let (words, heap) = cut(blocks, words, heap)?;
+    let (words, mut heap) = cut(blocks, words, heap)?;
     words.fill(unsearched(0));
     let read = whole_links(moves, blocks, dead, words, None);
-    let mut at = search::begin(blocks, ends, words, heap);
+    let mut at = search::begin(blocks, ends, words, &mut heap);
     at.linked(read);
     Ok(at)
 }
@@ -247,14 +249,14 @@ pub fn resume(
     ends: (Point, Point),
     dead: &[u32],
     words: &mut [u32],
-    heap: &mut [u32],
+    heap: &mut RouteHeap<'_>,
     bound: Bound,
     at: &mut Searching,
     limit: u32,
 ) -> Result<Option<Searched>, Short> {
-    let (words, heap) = cut(blocks, words, heap)?;
+    let (words, mut heap) = cut(blocks, words, heap)?;
     Ok(search::resume(
-        moves, blocks, ends, dead, words, heap, bound, at, limit,
+        moves, blocks, ends, dead, words, &mut heap, bound, at, limit,
     ))
 }
 
@@ -266,7 +268,7 @@ fn finish(
     ends: (Point, Point),
     dead: &[u32],
     words: &mut [u32],
-    heap: &mut [u32],
+    heap: &mut RouteHeap<'_>,
     bound: Bound,
     at: &mut Searching,
 ) -> Result<Searched, Short> {
@@ -336,7 +338,7 @@ pub fn repair(
     ends: (Point, Point),
     dead: &[u32],
     words: &mut [u32],
-    heap: &mut [u32],
+    heap: &mut RouteHeap<'_>,
     area: Option<(Point, Point)>,
     bound: Bound,
 ) -> Result<Searched, Short> {
@@ -352,10 +354,10 @@ pub fn begin_repair(
     ends: (Point, Point),
     dead: &[u32],
     words: &mut [u32],
-    heap: &mut [u32],
+    heap: &mut RouteHeap<'_>,
     area: Option<(Point, Point)>,
 ) -> Result<Searching, Short> {
-    let (words, heap) = cut(blocks, words, heap)?;
+    let (words, mut heap) = cut(blocks, words, heap)?;
     for w in words.iter_mut() {
         *w = unsearched(*w);
     }
@@ -394,7 +396,7 @@ pub fn begin_repair(
         y1: 0,
     }));
     let read = whole_links(moves, blocks, dead, words, region);
-    let mut at = search::begin(blocks, ends, words, heap);
+    let mut at = search::begin(blocks, ends, words, &mut heap);
     at.linked(read);
     Ok(at)
 }
@@ -503,7 +505,7 @@ mod tests {
             ends,
             &dead,
             &mut words,
-            &mut heap,
+            &mut RouteHeap::new(&mut heap),
             Bound::Plan,
         )
         .unwrap();
@@ -562,7 +564,7 @@ mod tests {
                     ends,
                     &[],
                     &mut words,
-                    &mut heap,
+                    &mut RouteHeap::new(&mut heap),
                     Bound::Whole,
                 )
                 .unwrap();
@@ -604,14 +606,14 @@ mod tests {
                 (start, goal),
                 &dead,
                 &mut words,
-                &mut heap,
+                &mut RouteHeap::new(&mut heap),
                 bound,
             );
             assert_eq!(r.unwrap().length, Some(search::octile(0, 0, sx, sy)));
             for (b, w) in words.iter().take(blocks.count()).enumerate() {
                 let (bx, by) = (b % blocks.across(), b / blocks.across());
                 // Not closed (the heap's slot of a closed block is `u16::MAX`): a key not final.
-                if heap[b] >> 16 != 0xFFFF {
+                if !RouteHeap::new(&mut heap).closed(b) {
                     assert_eq!(bound, Bound::Plan);
                     continue;
                 }
@@ -626,7 +628,7 @@ mod tests {
                 (start, goal),
                 &dead,
                 &mut words,
-                &mut short,
+                &mut RouteHeap::new(&mut short),
                 bound,
             );
             assert_eq!(r, Err(Short));
@@ -681,7 +683,7 @@ mod tests {
                 ends,
                 &dead,
                 &mut words,
-                &mut heap,
+                &mut RouteHeap::new(&mut heap),
                 bound,
             )
             .unwrap();
@@ -714,9 +716,28 @@ mod tests {
             assert!(unstash(blocks, &kept, &mut words));
             let m1 = Moves::new(g1, &[]);
             let ends = (moved, goal);
-            let r = repair(&m1, blocks, ends, &dead, &mut words, &mut heap, area, bound).unwrap();
+            let r = repair(
+                &m1,
+                blocks,
+                ends,
+                &dead,
+                &mut words,
+                &mut RouteHeap::new(&mut heap),
+                area,
+                bound,
+            )
+            .unwrap();
             let mut fresh = vec![0u32; GUIDE_BLOCKS];
-            let f = build(&m1, blocks, ends, &dead, &mut fresh, &mut heap, bound).unwrap();
+            let f = build(
+                &m1,
+                blocks,
+                ends,
+                &dead,
+                &mut fresh,
+                &mut RouteHeap::new(&mut heap),
+                bound,
+            )
+            .unwrap();
             assert_eq!((r.closed, r.length), (f.closed, f.length), "round {round}");
             assert!(r.linked <= f.linked, "round {round}");
             let n = blocks.count();
@@ -802,7 +823,7 @@ mod tests {
                 ends,
                 &dead,
                 &mut words,
-                &mut heap,
+                &mut RouteHeap::new(&mut heap),
                 Bound::Plan,
             )
             .unwrap();
@@ -813,7 +834,7 @@ mod tests {
                 ends,
                 &dead,
                 &mut lazy,
-                &mut heap,
+                &mut RouteHeap::new(&mut heap),
                 Bound::Plan,
             );
             let why = format!("round {round}: {w} x {h}, {ends:?}");

@@ -52,7 +52,7 @@ use crate::map::grid::{Moves, Point, DX, DY};
 use crate::search::cost::BLOCKS;
 use crate::search::heap;
 
-use super::{dist, DIST_SHIFT, KNOWN, LINKS, NEXT_SHIFT};
+use super::{dist, RouteHeap, DIST_SHIFT, KNOWN, LINKS, NEXT_SHIFT};
 
 /// After the start's block, the search closes the blocks whose key is at most `F + SLACK`
 /// (four straight block steps: block routes are coarse, and a corridor whose cells are as short
@@ -111,7 +111,7 @@ pub(super) fn search(
     ends: (Point, Point),
     dead: &[u32],
     words: &mut [u32],
-    heap: &mut [u32],
+    heap: &mut RouteHeap<'_>,
     bound: Bound,
 ) -> Searched {
     let mut at = begin(blocks, ends, words, heap);
@@ -155,12 +155,12 @@ impl Searching {
 fn heap_of<'h>(
     blocks: Blocks,
     (start, goal): (Point, Point),
-    heap: &'h mut [u32],
+    heap: &'h mut RouteHeap<'_>,
     len: usize,
 ) -> Heap<'h> {
     let s = blocks.shift();
     Heap {
-        w: heap,
+        w: heap.words(),
         len,
         across: blocks.across().max(1),
         start: (usize::from(start.x >> s), usize::from(start.y >> s)),
@@ -174,9 +174,9 @@ pub(super) fn begin(
     blocks: Blocks,
     ends: (Point, Point),
     words: &mut [u32],
-    heap: &mut [u32],
+    heap: &mut RouteHeap<'_>,
 ) -> Searching {
-    heap.fill(0);
+    heap.clear();
     let mut heap = heap_of(blocks, ends, heap, 0);
     let (sx, sy) = heap.start;
     let (gx, gy) = heap.goal;
@@ -205,7 +205,7 @@ pub(super) fn resume(
     (start, goal): (Point, Point),
     dead: &[u32],
     words: &mut [u32],
-    heap: &mut [u32],
+    heap: &mut RouteHeap<'_>,
     bound: Bound,
     at: &mut Searching,
     limit: u32,
@@ -524,7 +524,7 @@ mod tests {
                     (start, goal),
                     &dead,
                     &mut words,
-                    &mut heap,
+                    &mut RouteHeap::new(&mut heap),
                     bound,
                 );
                 (r, words, heap)
@@ -626,7 +626,7 @@ mod tests {
             (start, goal),
             &[],
             &mut words,
-            &mut heap,
+            &mut RouteHeap::new(&mut heap),
             Bound::Plan,
         );
         let r = r.unwrap();
@@ -642,7 +642,7 @@ mod tests {
             (start, goal),
             &[],
             &mut words,
-            &mut heap,
+            &mut RouteHeap::new(&mut heap),
             Bound::Whole,
         );
         assert_eq!(all.unwrap().closed, 4096);
@@ -666,7 +666,7 @@ mod tests {
             (start, goal),
             &[],
             &mut words,
-            &mut heap,
+            &mut RouteHeap::new(&mut heap),
             Bound::Plan,
         )
         .unwrap();
@@ -721,7 +721,7 @@ mod tests {
             (start, goal),
             &[],
             &mut words,
-            &mut heap,
+            &mut RouteHeap::new(&mut heap),
             Bound::Plan,
         );
         let r = r.unwrap();
@@ -733,7 +733,7 @@ mod tests {
             (start, goal),
             &[],
             &mut words[..10],
-            &mut heap,
+            &mut RouteHeap::new(&mut heap),
             Bound::Plan,
         );
         assert_eq!(r, Err(Short));

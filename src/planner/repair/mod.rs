@@ -367,8 +367,8 @@ pub(super) fn repair(
     let ks = {
         let dist = delta.as_flattened_mut();
         let input = points.get_mut(ns_at..).ok_or(NoRoom)?;
-        let links = idle.smoothing(ns);
-        Smoother::new(kind, ns, dist, links).finish(grid, input, dist, links)
+        let mut links = idle.smoothing(ns);
+        Smoother::new(kind, ns, dist, &mut links).finish(grid, input, dist, &mut links)
     };
     if ks < 2
         || points.get(ns_at) != Some(&li)

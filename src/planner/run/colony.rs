@@ -5,6 +5,7 @@
 
 use crate::colony::ant::{Ant, DeadEnd, Lost, Trail, Walk};
 use crate::colony::pheromone::Table;
+use crate::colony::tabu::TabuSet;
 use crate::colony::tighten::Tightening;
 use crate::colony::update::{deposit, wolves_amounts};
 use crate::geometry::steps_length;
@@ -13,6 +14,7 @@ use crate::rng::Xoshiro128pp;
 
 use crate::planner::lend::Colony;
 use crate::planner::plan::CurvePoint;
+use crate::planner::Shortfalls;
 
 use super::{Phase, Run};
 
@@ -231,10 +233,11 @@ fn go(
     tight: bool,
     going: &mut Going,
     rng: &mut Xoshiro128pp,
-    tabu: &mut [u32],
+    tabu: &mut TabuSet<'_>,
     tour: &mut [Dir],
     (points, links): (&mut [Point], &mut [u32]),
     left: &mut u32,
+    short: &mut Shortfalls,
 ) -> Result<Option<Walk>, Lost> {
     loop {
         match going {
@@ -247,7 +250,11 @@ fn go(
                 }
                 match Tightening::begin(ant.moves, ant.start, walk, tour, points, links) {
                     Some(t) => *going = Going::Tighten(t),
-                    None => return Ok(Some(walk)),
+                    None => {
+                        // No index holds the path: it stays as the ant walked it.
+                        short.insert(Shortfalls::TIGHTEN);
+                        return Ok(Some(walk));
+                    }
                 }
             }
             Going::Tighten(t) => {
@@ -288,7 +295,7 @@ fn again(
     r: &Option<Replay>,
     steps: usize,
     slot: &mut Option<(Going, Xoshiro128pp)>,
-    tabu: &mut [u32],
+    tabu: &mut TabuSet<'_>,
     buf: &mut [Dir],
     index: (&mut [Point], &mut [u32]),
     left: &mut u32,
@@ -302,7 +309,10 @@ fn again(
         }
     };
     ant.budget = r.budget;
-    match go(ant, tight, &mut going, &mut rng, tabu, buf, index, left) {
+    // The walk again is the first: a shortfall was counted then.
+    let mut short = Shortfalls::NONE;
+    let (r, short) = (&mut rng, &mut short);
+    match go(ant, tight, &mut going, r, tabu, buf, index, left, short) {
         Ok(None) => {
             *slot = Some((going, rng));
             None
@@ -330,7 +340,7 @@ impl Run<'_, '_> {
         let Colony {
             tau,
             delta,
-            tabu,
+            mut tabu,
             dead,
             moves,
             tours: [tour, iter_best, iter_worst, best],
@@ -379,7 +389,7 @@ impl Run<'_, '_> {
                     if let Some(mut fill) = w.filling.take() {
                         let cells = (left as usize).saturating_mul(FILL_CELLS);
                         let grid = self.grid;
-                        match grid.reach_resume(self.goal, tabu, links, &mut fill, cells) {
+                        match grid.reach_resume(self.goal, tabu.lend(), links, &mut fill, cells) {
                             None => {
                                 w.filling = Some(fill);
                                 left = 0;
@@ -404,7 +414,7 @@ impl Run<'_, '_> {
                             });
                             left = left.saturating_sub(start_cost(cells));
                             w.it.walked = w.ant.saturating_add(1);
-                            (Going::Walk(ant.begin(tabu, tour)), before, budget)
+                            (Going::Walk(ant.begin(&mut tabu, tour)), before, budget)
                         }
                         None => {
                             w.close = Close::Best;
@@ -414,7 +424,10 @@ impl Run<'_, '_> {
                     ant.budget = budget;
                     let idx = (&mut *points, &mut *links);
                     let rng = &mut self.rng;
-                    let walk = match go(&ant, tight, &mut going, rng, tabu, tour, idx, &mut left) {
+                    let short = &mut self.short;
+                    let walk = match go(
+                        &ant, tight, &mut going, rng, &mut tabu, tour, idx, &mut left, short,
+                    ) {
                         Ok(None) => {
                             w.now = Some((going, before, budget));
                             continue;
@@ -451,7 +464,12 @@ impl Run<'_, '_> {
                                         self.reach_checked = true;
                                         // A piece at a time, before the next ant.
                                         let grid = self.grid;
-                                        match grid.reach_begin(self.start, self.goal, tabu, links) {
+                                        match grid.reach_begin(
+                                            self.start,
+                                            self.goal,
+                                            tabu.lend(),
+                                            links,
+                                        ) {
                                             Ok(fill) => w.filling = Some(fill),
                                             Err(reach) => w.it.no_path |= reach == Reach::No,
                                         }
@@ -557,7 +575,7 @@ impl Run<'_, '_> {
                                 r,
                                 n,
                                 &mut w.again,
-                                tabu,
+                                &mut tabu,
                                 buf,
                                 idx,
                                 &mut left,
@@ -592,7 +610,7 @@ impl Run<'_, '_> {
                                 &w.it.best_replay,
                                 b.steps,
                                 &mut w.again,
-                                tabu,
+                                &mut tabu,
                                 best,
                                 idx,
                                 &mut left,

@@ -145,7 +145,12 @@ impl Run<'_, '_> {
                 Phase::Polish(match refiner {
                     Some(r) => Polish::Refine(r),
                     None => Polish::Smooth(noted(
-                        Smoother::new(kind, n, ws.delta.as_flattened_mut(), ws.idle.smoothing(n)),
+                        Smoother::new(
+                            kind,
+                            n,
+                            ws.delta.as_flattened_mut(),
+                            &mut ws.idle.smoothing(n),
+                        ),
                         kind,
                         &mut self.short,
                     )),
@@ -197,8 +202,12 @@ impl Run<'_, '_> {
                         diagonal,
                     });
                     // The refined path is locally shortest: the smoothing's bounded scan.
-                    let sm =
-                        Smoother::new(kind, n, ws.delta.as_flattened_mut(), ws.idle.smoothing(n));
+                    let sm = Smoother::new(
+                        kind,
+                        n,
+                        ws.delta.as_flattened_mut(),
+                        &mut ws.idle.smoothing(n),
+                    );
                     Phase::Polish(Polish::Smooth(noted(sm, kind, &mut self.short).bounded()))
                 } else {
                     Phase::Polish(Polish::Refine(r))
@@ -206,8 +215,8 @@ impl Run<'_, '_> {
             }
             Polish::Smooth(mut sm) => {
                 let dist = ws.delta.as_flattened_mut();
-                let links = ws.idle.smoothing(sm.cells());
-                if sm.resume(grid, ws.points, dist, links, SMOOTH_SLICE) {
+                let mut links = ws.idle.smoothing(sm.cells());
+                if sm.resume(grid, ws.points, dist, &mut links, SMOOTH_SLICE) {
                     Phase::Polish(Polish::Smooth(sm))
                 } else {
                     Phase::Polish(Polish::Tail(sm))
@@ -215,8 +224,8 @@ impl Run<'_, '_> {
             }
             Polish::Tail(mut sm) => {
                 let dist = ws.delta.as_flattened_mut();
-                let links = ws.idle.smoothing(sm.cells());
-                match sm.finish_piece(grid, ws.points, dist, links, TAIL_UNITS) {
+                let mut links = ws.idle.smoothing(sm.cells());
+                match sm.finish_piece(grid, ws.points, dist, &mut links, TAIL_UNITS) {
                     None => Phase::Polish(Polish::Tail(sm)),
                     Some(k) => {
                         let waypoints = if corridor {

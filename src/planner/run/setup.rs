@@ -153,7 +153,7 @@ impl Run<'_, '_> {
                         .route_words(&mut ws.guide, count)
                         .map(|pair| (pair, None))
                 };
-                let Some(((words, heap), out)) = bufs else {
+                let Some(((words, mut heap), out)) = bufs else {
                     self.routed(Err(route::Short));
                     return;
                 };
@@ -161,16 +161,19 @@ impl Run<'_, '_> {
                     Some(at) => at,
                     // The last run's links, forgotten where the map or the marks changed.
                     None if relink && !packed => {
-                        match route::begin_repair(&moves, blocks, ends, ws.dead, words, heap, area)
-                        {
+                        match route::begin_repair(
+                            &moves, blocks, ends, ws.dead, words, &mut heap, area,
+                        ) {
                             Ok(at) => at,
                             Err(e) => return self.routed(Err(e)),
                         }
                     }
-                    None => match route::begin_build(&moves, blocks, ends, ws.dead, words, heap) {
-                        Ok(at) => at,
-                        Err(e) => return self.routed(Err(e)),
-                    },
+                    None => {
+                        match route::begin_build(&moves, blocks, ends, ws.dead, words, &mut heap) {
+                            Ok(at) => at,
+                            Err(e) => return self.routed(Err(e)),
+                        }
+                    }
                 };
                 let bound = route::Bound::Plan;
                 let dead = &*ws.dead;
@@ -180,7 +183,7 @@ impl Run<'_, '_> {
                     ends,
                     dead,
                     words,
-                    heap,
+                    &mut heap,
                     bound,
                     &mut at,
                     ROUTE_BLOCKS,
