@@ -214,7 +214,7 @@ impl Ant<'_, '_, '_> {
         cells: bool,
         trail: &mut Trail,
         rng: &mut Xoshiro128pp,
-        tabu: &mut [u32],
+        tabu: &mut TabuSet<'_>,
         tour: &mut [Dir],
         left: &mut u32,
     ) -> Result<Option<Walk>, Lost> {
@@ -445,7 +445,7 @@ impl Ant<'_, '_, '_> {
         &self,
         trail: &mut Trail,
         rng: &mut Xoshiro128pp,
-        tabu: &mut [u32],
+        tabu: &mut TabuSet<'_>,
         tour: &mut [Dir],
         limit: &mut u32,
         pow: impl Fn(f32) -> f32,
@@ -464,7 +464,7 @@ impl Ant<'_, '_, '_> {
         &self,
         trail: &mut Trail,
         rng: &mut Xoshiro128pp,
-        tabu: &mut [u32],
+        tabu: &mut TabuSet<'_>,
         tour: &mut [Dir],
         limit: &mut u32,
         pow: impl Fn(f32) -> f32,
@@ -504,7 +504,7 @@ impl Ant<'_, '_, '_> {
             let allowed = self.moves.at(ci, cur);
             let (x, y) = (usize::from(cur.x), usize::from(cur.y));
             let tabu_moves = if x > 0 && y > 0 && x.wrapping_add(1) < width && y < last_row {
-                bitmap::around(tabu, ci, width) & allowed
+                tabu.around(ci, width) & allowed
             } else {
                 let mut t = 0u8;
                 let mut m = allowed;
@@ -512,7 +512,7 @@ impl Ant<'_, '_, '_> {
                     let di = m.trailing_zeros() as usize & 7;
                     m &= m.wrapping_sub(1);
                     let ni = ci.wrapping_add_signed(step(di));
-                    if bitmap::get(tabu, ni) {
+                    if tabu.contains(ni) {
                         t |= 1 << di;
                     }
                 }
@@ -605,7 +605,7 @@ impl Ant<'_, '_, '_> {
                     }
                     DeadEnd::Backtrack => {
                         let ni = ci.wrapping_add_signed(step(usize::from(d)));
-                        bitmap::set(tabu, ni);
+                        tabu.insert(ni);
                         moves = moves.wrapping_sub(1); // counted above: at least 1
                         continue;
                     }
@@ -615,7 +615,7 @@ impl Ant<'_, '_, '_> {
             steps = steps.wrapping_add(1); // < tour.len() + 1: the slot existed
             ci = ci.wrapping_add_signed(step(usize::from(d)));
             cur = neighbour(cur, d);
-            bitmap::set(tabu, ci);
+            tabu.insert(ci);
         }
         *limit = limit.saturating_sub(moves.wrapping_sub(first));
         self.arrived(tabu, tour, steps, moves, may_tighten)
@@ -625,7 +625,7 @@ impl Ant<'_, '_, '_> {
     #[inline(always)]
     fn arrived(
         &self,
-        tabu: &[u32],
+        tabu: &TabuSet<'_>,
         tour: &[Dir],
         steps: usize,
         moves: u32,
@@ -814,11 +814,12 @@ mod tests {
         let mut tabu = vec![0u32; bitmap::words(cells_n)];
         let mut tour = vec![0u8; tour_len];
         let mut rng = Xoshiro128pp::from_u64(seed);
-        let mut trail = ant.begin(&mut tabu, &mut tour);
+        let mut set = TabuSet::new(&mut tabu);
+        let mut trail = ant.begin(&mut set, &mut tour);
         let mut out = Vec::new();
         loop {
             let mut left = piece;
-            let r = ant.resume_by(cells, &mut trail, &mut rng, &mut tabu, &mut tour, &mut left);
+            let r = ant.resume_by(cells, &mut trail, &mut rng, &mut set, &mut tour, &mut left);
             out.push(r);
             if !matches!(r, Ok(None)) {
                 break;
