@@ -108,7 +108,12 @@ pub fn three(bits: &[u32], i: usize) -> u32 {
 #[inline]
 pub fn around(bits: &[u32], i: usize, width: usize) -> u8 {
     // Border cells are excluded by the caller, so `i - width - 1` does not wrap.
-    let top = i.wrapping_sub(width).wrapping_sub(1);
+    around_top(bits, i.wrapping_sub(width).wrapping_sub(1), width)
+}
+
+/// [`around`] of the cell whose 3 x 3 neighbourhood's top-left cell is `top`.
+#[inline(always)]
+pub fn around_top(bits: &[u32], top: usize, width: usize) -> u8 {
     let mid = top.wrapping_add(width);
     let bottom = mid.wrapping_add(width);
     let nb = three(bits, top) | three(bits, mid) << 3 | three(bits, bottom) << 6;

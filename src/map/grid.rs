@@ -266,6 +266,14 @@ impl<'a> Grid<'a> {
             .wrapping_mul(w)
             .wrapping_add(x)
             .wrapping_sub(1);
+        self.interior_mask(top)
+    }
+
+    /// [`Grid::mask_at`] of a cell off the map's border whose 3 x 3 neighbourhood's top-left
+    /// cell has index `top` (the caller has checked the border): for the loops that know it.
+    #[inline(always)]
+    pub(crate) fn interior_mask(&self, top: usize) -> u8 {
+        let w = usize::from(self.width);
         let mid = top.wrapping_add(w);
         let bottom = mid.wrapping_add(w);
         let nb = self.three(top) | self.three(mid) << 3 | self.three(bottom) << 6;
@@ -590,6 +598,12 @@ impl<'g> Moves<'g> {
             Some(&m) => m,
             None => self.grid.mask_at(p),
         }
+    }
+
+    /// The table's mask of cell `ci` (`None`: no table; [`Moves::at`] works it out).
+    #[inline(always)]
+    pub(crate) fn table_at(&self, ci: usize) -> Option<u8> {
+        self.table.get(ci).copied()
     }
 
     /// The grid.

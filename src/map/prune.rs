@@ -117,7 +117,6 @@ pub fn resume(
     let (w, h) = (usize::from(grid.width()), usize::from(grid.height()));
     // Each try: the local rule at a cell, then depth-first over the neighbours whose
     // neighbourhood just shrank (as `repair`'s re-pruning does); `touched` is not needed here.
-    let mut touched = Bounds::default();
     let mut settle = Settle {
         moves,
         offsets: &offsets,
@@ -125,7 +124,7 @@ pub fn resume(
         gi,
         stack,
         full: at.full,
-        touched: &mut touched,
+        touched: None,
         tried: 0,
     };
     let mut next = at.next as usize;
@@ -337,7 +336,7 @@ pub fn repair(
         gi,
         stack: rest,
         full: false,
-        touched: &mut touched,
+        touched: Some(&mut touched),
         tried: 0,
     };
     for &ci in list.iter() {
@@ -392,7 +391,8 @@ struct Settle<'m, 's> {
     stack: &'s mut [u32],
     /// The stack was too short for some neighbours.
     full: bool,
-    touched: &'s mut Bounds,
+    /// The bounds of the cells pruned ([`repair`]'s; `None`: not kept).
+    touched: Option<&'s mut Bounds>,
     /// Cells tried so far by the settling of pruned cells' neighbours (the callers count the
     /// cells they try: the budget of [`resume`]).
     tried: u32,
@@ -400,29 +400,44 @@ struct Settle<'m, 's> {
 
 impl Settle<'_, '_> {
     fn at(&mut self, dead: &mut [u32], ci: usize) {
-        let grid = *self.moves.grid();
         let (m, o, si, gi) = (self.moves, self.offsets, self.si, self.gi);
-        if !try_prune(m, o, si, gi, dead, ci, grid.point(ci)) {
+        let Some(live) = try_prune(m, o, si, gi, dead, ci) else {
             return;
-        }
-        self.touched.add(grid.point(ci));
+        };
+        self.mark(ci);
         let mut top = 0usize;
-        self.full |= push_neighbours(m, o, ci, self.stack, &mut top);
+        self.full |= push_neighbours(o, ci, live, self.stack, &mut top);
         while top > 0 {
             top = top.wrapping_sub(1);
             let Some(&u) = self.stack.get(top) else { break };
             let u = u as usize;
             self.tried = self.tried.wrapping_add(1);
-            if try_prune(m, o, si, gi, dead, u, grid.point(u)) {
-                self.touched.add(grid.point(u));
-                self.full |= push_neighbours(m, o, u, self.stack, &mut top);
+            if let Some(live) = try_prune(m, o, si, gi, dead, u) {
+                self.mark(u);
+                self.full |= push_neighbours(o, u, live, self.stack, &mut top);
             }
+        }
+    }
+
+    /// Cell `ci` was pruned now: grow the bounds of what moved, if they are kept.
+    #[inline]
+    fn mark(&mut self, ci: usize) {
+        if let Some(t) = self.touched.as_deref_mut() {
+            t.add(self.moves.grid().point(ci));
         }
     }
 }
 
-/// Prune cell `ci` (at `p`) if it is prunable; true if it was pruned now.
-#[inline]
+/// Prune cell `ci` if it is prunable: `Some(its live neighbours)` (a direction mask: the
+/// neighbours one allowed move away that are not pruned, whose neighbourhoods shrink now) if it
+/// was pruned now, `None` if not.
+///
+/// Inlined into the settling's loop, with one border test: a cell off the border reads its
+/// allowed moves ([`crate::map::grid::Grid::interior_mask`]) and its pruned neighbours ([`bitmap::around_top`])
+/// from the same 3 x 3 corner, where [`Moves::at`] and [`bitmap::around`] each tested the
+/// border and worked the corner out again (a try is most of the pruning's cost: 14,800 of them
+/// on Boston_0_256, `docs/bench/boston-issue36.md`).
+#[inline(always)]
 fn try_prune(
     moves: &Moves<'_>,
     offsets: &[isize; 8],
@@ -430,26 +445,35 @@ fn try_prune(
     gi: usize,
     dead: &mut [u32],
     ci: usize,
-    p: Point,
-) -> bool {
+) -> Option<u8> {
     if ci == si || ci == gi || bitmap::get(dead, ci) {
-        return false;
-    }
-    let all = moves.at(ci, p);
-    if all == 0 {
-        return false; // blocked (or isolated: nothing to gain)
+        return None;
     }
     let grid = moves.grid();
     let w = usize::from(grid.width());
-    let (x, y) = (usize::from(p.x), usize::from(p.y));
-    let live = if x > 0
-        && y > 0
-        && x.wrapping_add(1) < w
-        && y.wrapping_add(1) < usize::from(grid.height())
-    {
-        // Away from the border: the dead neighbours in one 3 x 3 read.
-        all & !bitmap::around(dead, ci, w)
+    // `w > 0` (a grid's sides are): the checked forms never fail.
+    let (x, y) = (
+        ci.checked_rem(w).unwrap_or(0),
+        ci.checked_div(w).unwrap_or(0),
+    );
+    let interior =
+        x > 0 && y > 0 && x.wrapping_add(1) < w && y.wrapping_add(1) < usize::from(grid.height());
+    let (all, live) = if interior {
+        // Off the border: `ci - w - 1` does not wrap.
+        let top = ci.wrapping_sub(w).wrapping_sub(1);
+        let all = match moves.table_at(ci) {
+            Some(m) => m,
+            None => grid.interior_mask(top),
+        };
+        if all == 0 {
+            return None; // blocked (or isolated: nothing to gain)
+        }
+        (all, all & !bitmap::around_top(dead, top, w))
     } else {
+        let all = moves.at(ci, grid.point(ci));
+        if all == 0 {
+            return None;
+        }
         let mut live = all;
         let mut m = all;
         while m != 0 {
@@ -460,29 +484,31 @@ fn try_prune(
                 live &= !(1 << d);
             }
         }
-        live
+        (all, live)
     };
     let ok = match CLIQUE.get(usize::from(live)).copied().unwrap_or(0) {
         0 => false,
         1 => true,
         t => (all >> (t.wrapping_sub(2) & 7)) & 1 == 1,
     };
-    if ok {
-        bitmap::set(dead, ci);
+    if !ok {
+        return None;
     }
-    ok
+    bitmap::set(dead, ci);
+    Some(live)
 }
 
-/// Push the free neighbours of `ci`; true if the stack was full for some.
+/// Push the neighbours of `ci` in `live` (the pruned neighbours' neighbourhoods do not change,
+/// and a neighbour one allowed move away is one the other way too); true if the stack was full
+/// for some.
 fn push_neighbours(
-    moves: &Moves<'_>,
     offsets: &[isize; 8],
     ci: usize,
+    live: u8,
     stack: &mut [u32],
     top: &mut usize,
 ) -> bool {
-    let grid = moves.grid();
-    let mut m = moves.at(ci, grid.point(ci));
+    let mut m = live;
     let mut full = false;
     while m != 0 {
         let d = m.trailing_zeros() as usize & 7;
@@ -705,6 +731,68 @@ mod tests {
                     let z = prune(&moves, st, go, &mut none, &mut []);
                     assert_eq!((a, &long), (z, &none), "{w} x {h}, density {density}");
                     marked += a;
+                }
+            }
+        }
+        assert!(marked > 1000, "the maps had little to prune: {marked}");
+    }
+
+    /// The module's rule read literally, to a fixed point: a free cell (not `s` or `t`, with
+    /// some allowed move) goes when every two of its remaining neighbours are one allowed move
+    /// apart ([`Grid::move_mask`] and [`Grid::step`] only: no table, no 3 x 3 reads).
+    fn by_the_rule(g: &Grid<'_>, s: Point, t: Point) -> Vec<bool> {
+        let n = g.cells();
+        let mut dead = vec![false; n];
+        let apart = |a: Point, b: Point| (0..8u8).any(|d| g.step(a, d) == Some(b));
+        loop {
+            let mut changed = false;
+            for i in 0..n {
+                let p = g.point(i);
+                if dead[i] || p == s || p == t || !g.is_free(p) || g.move_mask(p) == 0 {
+                    continue;
+                }
+                let live: Vec<Point> = (0..8u8)
+                    .filter_map(|d| g.step(p, d))
+                    .filter(|&q| !dead[g.index(q)])
+                    .collect();
+                let clique = live
+                    .iter()
+                    .enumerate()
+                    .all(|(k, &a)| live[k + 1..].iter().all(|&b| apart(a, b)));
+                if clique {
+                    dead[i] = true;
+                    changed = true;
+                }
+            }
+            if !changed {
+                return dead;
+            }
+        }
+    }
+
+    #[test]
+    fn pruning_marks_the_rules_fixed_point_on_random_maps() {
+        // The settling's try (one 3 x 3 read of the map and one of the marks off the border,
+        // the neighbours pushed only when live) against the rule applied literally until
+        // nothing changes, with a move table and without, on maps of many widths and
+        // densities (breaking the try's reads or its pushes fails it).
+        let mut rng = crate::rng::Xoshiro128pp::from_u64(36);
+        let mut marked = 0;
+        for &(w, h) in &[(3u16, 3u16), (9, 4), (33, 12), (40, 37), (70, 9)] {
+            for density in [2u32, 4, 6, 8] {
+                for _ in 0..3 {
+                    let cells = usize::from(w) * usize::from(h);
+                    let (b, st, go) = corner_to_corner(&mut rng, w, h, density);
+                    let grid = Grid::new(w, h, &b).unwrap();
+                    let want = by_the_rule(&grid, st, go);
+                    let mut table = vec![0u8; cells];
+                    assert!(Moves::fill(&grid, &mut table));
+                    for moves in [Moves::new(grid, &[]), Moves::new(grid, &table)] {
+                        let mut dead = vec![0u32; bitmap::words(cells)];
+                        marked += prune(&moves, st, go, &mut dead, &mut vec![0u32; 64]);
+                        let got: Vec<bool> = (0..cells).map(|i| bitmap::get(&dead, i)).collect();
+                        assert_eq!(got, want, "{w} x {h}, density {density}");
+                    }
                 }
             }
         }

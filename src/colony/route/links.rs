@@ -165,7 +165,9 @@ pub(super) fn links(
         ((r.y1.wrapping_add(1) << s).wrapping_sub(1)).min(h.wrapping_sub(1)),
     );
     // The links of the block of cell (x, y) gain `d`, and the neighbour block's `d + 4`, if
-    // they are in the region.
+    // they are in the region. On the whole map both are: a move's two ends are cells of the
+    // map (the windows read cells off it as blocked), so their blocks are on it too.
+    let all = r.x0 == 0 && r.y0 == 0 && r.x1 == whole.x1 && r.y1 == whole.y1;
     let mut link = |x: usize, y: usize, d: u32| {
         let (dx, dy) = match d {
             0 => (1isize, 0usize),
@@ -174,13 +176,13 @@ pub(super) fn links(
             _ => (-1, 1),
         };
         let (bx, by) = (x >> s, y >> s);
-        if r.holds(bx, by) {
+        if all || r.holds(bx, by) {
             if let Some(wd) = words.get_mut(by.wrapping_mul(across).wrapping_add(bx)) {
                 *wd |= 1 << d;
             }
         }
         let (nx, ny) = (bx.wrapping_add_signed(dx), by.wrapping_add(dy));
-        if r.holds(nx, ny) {
+        if all || r.holds(nx, ny) {
             if let Some(wd) = words.get_mut(ny.wrapping_mul(across).wrapping_add(nx)) {
                 *wd |= 1 << (d.wrapping_add(4) & 7);
             }
@@ -205,23 +207,18 @@ pub(super) fn links(
         .get(s as usize)
         .copied()
         .unwrap_or_else(|| block_columns(0, last));
-    for y in y_lo..=y_hi {
-        let below = y.wrapping_add(1) < h;
-        let y_crosses = below && y & last == last;
+    // Block row by block row (the first may be the one row north of the region: the last row
+    // of the block row above), and in each, run by run, its rows top to bottom: each row's
+    // windows are read once (row `y + 1`'s serve as row `y`'s next), and a block's east and
+    // west links, one bit a block in `ends` and `starts`, are gathered over the block row's
+    // rows and set once (a move across a block's side sets the same link from any of them).
+    let mut ya = y_lo;
+    while ya <= y_hi {
+        // The block row's last row (`ya | last`), within the cells scanned.
+        let yb = (ya | last).min(y_hi);
         // Runs start at multiples of 32 (where `columns` holds).
         let mut x0 = x_lo & !31;
         while x0 <= x_hi {
-            let (free, live) = window(y, x0);
-            let (free1, live1) = if below {
-                window(y.wrapping_add(1), x0)
-            } else {
-                (0, 0)
-            };
-            // Bit j (1..=32) of each: the move from cell x0 - 1 + j exists.
-            let east = live & (live >> 1);
-            let south = live & live1;
-            let south_east = live & (live1 >> 1) & (free >> 1) & free1;
-            let south_west = live & (live1 << 1) & (free << 1) & free1;
             let run = grid.run_bits(x0) & span_bits(x0, x_lo, x_hi);
             // The cell of bit j: x0 - 1 + j (j >= 1).
             let cell = |j: usize| x0.wrapping_add(j).wrapping_sub(1);
@@ -232,44 +229,67 @@ pub(super) fn links(
             } else {
                 block_columns(x0, last)
             };
-            // Moves across a block's east side: east, and south-east from its last column when
-            // they stay in the block row.
-            let across_east = (east | if y_crosses { 0 } else { south_east }) & ends & run;
-            for x in Ones(across_east).map(cell) {
-                link(x, y, 0);
-            }
-            // South-west from a block's first column within the block row: the west link, i.e.
-            // the east link of the block to the left, from its last column.
-            if !y_crosses {
-                for x in Ones(south_west & starts & run).map(cell) {
-                    link(x.wrapping_sub(1), y, 0);
-                }
-            } else {
-                // The block row's last row: south, and the diagonals that stay in the block
-                // column, give the south link; one bit a block is enough, so each block's bits
-                // are folded onto its first column before the loop (a first column outside
-                // the cells scanned is one of a block outside the region: no link to set).
-                let mut down = (south | south_east & !ends | south_west & !starts) & run;
-                if last < 32 {
-                    let mut k = 1usize;
-                    while k <= last {
-                        down |= down >> k;
-                        k = k.wrapping_mul(2);
+            let (mut east_side, mut west_side) = (0u64, 0u64);
+            let mut here = window(ya, x0);
+            let mut y = ya;
+            while y <= yb {
+                let below = y.wrapping_add(1) < h;
+                let y_crosses = below && y & last == last;
+                let (free, live) = here;
+                let (free1, live1) = if below {
+                    window(y.wrapping_add(1), x0)
+                } else {
+                    (0, 0)
+                };
+                here = (free1, live1);
+                // Bit j (1..=32) of each: the move from cell x0 - 1 + j exists.
+                let east = live & (live >> 1);
+                let south_east = live & (live1 >> 1) & (free >> 1) & free1;
+                let south_west = live & (live1 << 1) & (free << 1) & free1;
+                // Moves across a block's east side: east, and south-east from its last column
+                // when they stay in the block row.
+                east_side |= east | if y_crosses { 0 } else { south_east };
+                if !y_crosses {
+                    // South-west from a block's first column within the block row: the west
+                    // link, i.e. the east link of the block to the left, from its last column.
+                    west_side |= south_west;
+                } else {
+                    // The block row's last row: south, and the diagonals that stay in the block
+                    // column, give the south link; one bit a block is enough, so each block's
+                    // bits are folded onto its first column before the loop (a first column
+                    // outside the cells scanned is one of a block outside the region: no link
+                    // to set).
+                    let south = live & live1;
+                    let mut down = (south | south_east & !ends | south_west & !starts) & run;
+                    if last < 32 {
+                        let mut k = 1usize;
+                        while k <= last {
+                            down |= down >> k;
+                            k = k.wrapping_mul(2);
+                        }
+                        down &= starts;
                     }
-                    down &= starts;
+                    for x in Ones(down).map(cell) {
+                        link(x, y, 2);
+                    }
+                    for x in Ones(south_east & ends & run).map(cell) {
+                        link(x, y, 1);
+                    }
+                    for x in Ones(south_west & starts & run).map(cell) {
+                        link(x, y, 3);
+                    }
                 }
-                for x in Ones(down).map(cell) {
-                    link(x, y, 2);
-                }
-                for x in Ones(south_east & ends & run).map(cell) {
-                    link(x, y, 1);
-                }
-                for x in Ones(south_west & starts & run).map(cell) {
-                    link(x, y, 3);
-                }
+                y = y.wrapping_add(1);
+            }
+            for x in Ones(east_side & ends & run).map(cell) {
+                link(x, ya, 0);
+            }
+            for x in Ones(west_side & starts & run).map(cell) {
+                link(x.wrapping_sub(1), ya, 0);
             }
             x0 = x0.wrapping_add(32);
         }
+        ya = yb.wrapping_add(1);
     }
 }
 

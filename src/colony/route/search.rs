@@ -7,7 +7,7 @@
 //! the goal), led by the octile block distance to the start's block (10 / 14 per straight /
 //! diagonal block step, the coarse scale [`BLOCKS`] of `search::cost`, which says why not the
 //! exact one: the steps' own costs, so the estimate is consistent and a closed block's
-//! distance is exact), ties broken towards the straight line between the ends ([`Heap::tie`]).
+//! distance is exact), ties broken towards the straight line between the ends ([`Heap::tied_before`]).
 //! It runs until it closes the start's block, at `F`, the length of the shortest block route;
 //! by then it has closed every block whose shortest block route through it is shorter than `F`
 //! (the blocks a detour round a wall passes) and some as short. Then it widens
@@ -159,12 +159,17 @@ fn heap_of<'h>(
     len: usize,
 ) -> Heap<'h> {
     let s = blocks.shift();
+    let start = (usize::from(start.x >> s), usize::from(start.y >> s));
+    let goal = (usize::from(goal.x >> s), usize::from(goal.y >> s));
+    // Block coordinates are below 2^16.
+    let d = |a: usize, z: usize| (a as i32).wrapping_sub(z as i32);
     Heap {
         w: heap.words(),
         len,
         across: blocks.across().max(1),
-        start: (usize::from(start.x >> s), usize::from(start.y >> s)),
-        goal: (usize::from(goal.x >> s), usize::from(goal.y >> s)),
+        start,
+        goal,
+        line: (d(start.0, goal.0), d(start.1, goal.1)),
     }
 }
 
@@ -303,7 +308,7 @@ pub(super) fn resume(
 
 /// Whether block `(nx, ny)`, reached as short through its next block (in `wn`) as through the
 /// closed block `b`, takes `b` instead: the one nearer the straight line between the ends
-/// ([`Heap::tie`]), so that the next blocks do not depend on the order the search closed its
+/// ([`Heap::tied_before`]), so that the next blocks do not depend on the order the search closed its
 /// blocks in. Measured on the 20 longest scenarios x 3 seeds of four large maps against the
 /// first block to reach it (`ht_chantry` 1.0033 -> 1.0017 of the optimum, `Paris_1_256`
 /// 1.0005 -> 1.0011, the others the same) and against preferring a diagonal step as Dijkstra
@@ -313,7 +318,7 @@ fn prefer(heap: &Heap<'_>, wn: u32, (nx, ny): (usize, usize), b: usize) -> bool 
     let cx = nx.wrapping_add_signed(DX.get(d).copied().unwrap_or(0) as isize);
     let cy = ny.wrapping_add_signed(DY.get(d).copied().unwrap_or(0) as isize);
     let current = cy.wrapping_mul(heap.across).wrapping_add(cx);
-    (wn >> NEXT_SHIFT) & 15 < 8 && heap.tie(b) < heap.tie(current)
+    (wn >> NEXT_SHIFT) & 15 < 8 && heap.tied_before(b, current)
 }
 
 /// A closed block's slot in the heap.
@@ -329,39 +334,70 @@ pub(super) struct Heap<'a> {
     across: usize,
     start: (usize, usize),
     goal: (usize, usize),
+    /// The start's block less the goal's: the line's direction (worked out once, not in every
+    /// comparison).
+    line: (i32, i32),
 }
 
 impl Heap<'_> {
     /// Whether block `a` comes before block `b`: the smaller key `f` (the distance field of
-    /// their words), ties broken by [`Heap::tie`].
+    /// their words), ties broken by [`Heap::tied_before`].
     #[inline]
     fn before(&self, words: &[u32], a: usize, b: usize) -> bool {
         let fa = words.get(a).map_or(u32::MAX, |&w| dist(w));
         let fb = words.get(b).map_or(u32::MAX, |&w| dist(w));
-        fa < fb || fa == fb && self.tie(a) < self.tie(b)
+        fa < fb || fa == fb && self.tied_before(a, b)
     }
 
-    /// Among blocks of the same `f`, nearer the straight line between the goal's block and the
-    /// start's first, then the smaller estimate `h` (deeper first). On a map without walls
-    /// every block of the parallelogram between the ends lies on a shortest block route in the
-    /// octile distance; this order runs the search along the one nearest the straight line, so
-    /// it closes a band about a block wide and the sub-goals lie along the line, where the
-    /// paper's straight pull would lead (other orders gave routes along the parallelogram's
-    /// sides, and the ants made twice the moves on Nav2's depot).
+    /// Among blocks of the same `f`, whether `a` comes first: nearer the straight line between
+    /// the goal's block and the start's, then the smaller estimate `h` (deeper first). On a map
+    /// without walls every block of the parallelogram between the ends lies on a shortest block
+    /// route in the octile distance; this order runs the search along the one nearest the
+    /// straight line, so it closes a band about a block wide and the sub-goals lie along the
+    /// line, where the paper's straight pull would lead (other orders gave routes along the
+    /// parallelogram's sides, and the ants made twice the moves on Nav2's depot).
+    ///
+    /// The pair `(distance from the line, h)` compares as the one word `cross << 24 | h` did
+    /// (`h` < 2^24; `tie_order_is_the_one_words`), in 32-bit arithmetic: both factors of each
+    /// product are block coordinate differences, below `across` and `down`, whose product (the
+    /// blocks) is below 2^16, so the products and their difference fit an `i32`; and `h` is
+    /// worked out only when the two distances from the line are equal. The order runs in
+    /// every comparison of the heap's sifts, and 64-bit products and shifts take several
+    /// Cortex-M4 instructions each (the word's order cost 0.97 M of Boston_0_256's 16.9 M on
+    /// the device, `docs/bench/boston-issue36.md`).
     #[inline]
-    fn tie(&self, b: usize) -> u64 {
+    fn tied_before(&self, a: usize, b: usize) -> bool {
+        let (ca, cb) = (self.cross(a), self.cross(b));
+        ca < cb || ca == cb && self.h(a) < self.h(b)
+    }
+
+    /// Block `b`'s coordinates.
+    #[inline(always)]
+    fn xy(&self, b: usize) -> (usize, usize) {
         // `across >= 1`: the checked forms never fail.
-        let bx = b.checked_rem(self.across).unwrap_or(0) as i64;
-        let by = b.checked_div(self.across).unwrap_or(0) as i64;
-        let (sx, sy) = (self.start.0 as i64, self.start.1 as i64);
-        let (gx, gy) = (self.goal.0 as i64, self.goal.1 as i64);
-        // Block coordinates are below 2^16: the products fit.
-        let cross = (bx.wrapping_sub(gx))
-            .wrapping_mul(sy.wrapping_sub(gy))
-            .wrapping_sub(by.wrapping_sub(gy).wrapping_mul(sx.wrapping_sub(gx)))
-            .unsigned_abs();
-        let h = octile(bx as usize, by as usize, self.start.0, self.start.1);
-        cross << 24 | u64::from(h)
+        (
+            b.checked_rem(self.across).unwrap_or(0),
+            b.checked_div(self.across).unwrap_or(0),
+        )
+    }
+
+    /// The first of [`Heap::tied_before`]'s pair: how far block `b` lies from the line (its cross
+    /// product with the line's direction).
+    #[inline(always)]
+    fn cross(&self, b: usize) -> u32 {
+        let (bx, by) = self.xy(b);
+        let d = |a: usize, z: usize| (a as i32).wrapping_sub(z as i32); // coordinates < 2^16
+        d(bx, self.goal.0)
+            .wrapping_mul(self.line.1)
+            .wrapping_sub(d(by, self.goal.1).wrapping_mul(self.line.0))
+            .unsigned_abs()
+    }
+
+    /// The second of [`Heap::tied_before`]'s pair: block `b`'s estimate to the start's block.
+    #[inline(always)]
+    fn h(&self, b: usize) -> u32 {
+        let (bx, by) = self.xy(b);
+        octile(bx, by, self.start.0, self.start.1)
     }
 
     fn block_at(&self, i: usize) -> usize {
@@ -397,6 +433,7 @@ impl Heap<'_> {
                 across: self.across,
                 start: self.start,
                 goal: self.goal,
+                line: self.line,
             },
             words,
         }
@@ -487,6 +524,48 @@ mod tests {
 
     fn closed(heap: &[u32], b: usize) -> bool {
         heap[b] >> 16 == DONE
+    }
+
+    /// The tie order as it was first written: one 64-bit word, the distance from the line
+    /// (64-bit products) above `h`.
+    fn one_word(across: usize, start: (usize, usize), goal: (usize, usize), b: usize) -> u64 {
+        let (bx, by) = ((b % across) as i64, (b / across) as i64);
+        let (sx, sy, gx, gy) = (start.0 as i64, start.1 as i64, goal.0 as i64, goal.1 as i64);
+        let cross = ((bx - gx) * (sy - gy) - (by - gy) * (sx - gx)).unsigned_abs();
+        cross << 24 | u64::from(octile(bx as usize, by as usize, start.0, start.1))
+    }
+
+    #[test]
+    fn tie_order_is_the_one_words() {
+        // Random block layouts up to the largest (blocks below 2^16, one side up to 4,096),
+        // random ends and blocks: the 32-bit pair orders every two blocks as the word did
+        // (breaking either half of the pair, or the lazy `h`, fails it).
+        let mut rng = crate::rng::Xoshiro128pp::from_u64(3636);
+        let mut pick = |n: u32| rng.next_word() % n.max(1);
+        let mut buf = vec![0u32; 4];
+        for case in 0..2_000 {
+            let across = 1 + pick(if case % 2 == 0 { 64 } else { 4_096 }) as usize;
+            let down = 1 + pick((65_000 / across as u32).min(4_096)) as usize;
+            let blocks = across * down;
+            let mut block = || pick(blocks as u32) as usize;
+            let (s, g) = (block(), block());
+            let start = (s % across, s / across);
+            let goal = (g % across, g / across);
+            let d = |a: usize, z: usize| a as i32 - z as i32;
+            let heap = Heap {
+                w: &mut buf,
+                len: 0,
+                across,
+                start,
+                goal,
+                line: (d(start.0, goal.0), d(start.1, goal.1)),
+            };
+            for _ in 0..50 {
+                let (a, b) = (block(), block());
+                let want = one_word(across, start, goal, a) < one_word(across, start, goal, b);
+                assert_eq!(heap.tied_before(a, b), want, "{across} x {down}, {a} {b}");
+            }
+        }
     }
 
     #[test]
