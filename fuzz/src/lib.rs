@@ -283,7 +283,8 @@ fn check_result(
         Err(e @ (Error::NoPath | Error::NoAntArrived)) => {
             let mut m = vec![0u32; ohaca::bitmap::words(cells)];
             let mut q = vec![0u32; cells];
-            let reachable = grid.reachable(start, goal, &mut m, &mut q) == ohaca::grid::Reach::Yes;
+            let scratch = ohaca::grid::FillScratch::new(&mut m, &mut q);
+            let reachable = grid.reachable(start, goal, scratch) == ohaca::grid::Reach::Yes;
             if e == Error::NoPath {
                 assert!(!reachable, "NoPath on a reachable goal");
             } else {

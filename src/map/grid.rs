@@ -350,27 +350,21 @@ impl<'a> Grid<'a> {
 
     /// Flood fill from `start` over allowed moves: is `goal` reachable?
     ///
-    /// `mark` is a bit set of at least [`crate::map::bitmap::words`]`(cells)` words; `queue` is a ring
-    /// of cell indices of any length. A breadth-first frontier longer than the ring cannot be
-    /// held, and the answer is then [`Reach::Unknown`] (the planner's first backtracking ant
-    /// decides instead).
+    /// `scratch` ([`FillScratch`]) holds the marks, a bit set of at least
+    /// [`crate::map::bitmap::words`]`(cells)` words, and the queue, a ring of cell indices of any
+    /// length. A breadth-first frontier longer than the ring cannot be held, and the answer is
+    /// then [`Reach::Unknown`] (the planner's first backtracking ant decides instead).
     ///
     /// The fill follows the four straight moves only: a diagonal move is allowed only when both
     /// cells beside it are free, and then the two straight moves through either of them reach the
     /// same cell, so the cells reachable with the eight moves are exactly those reachable with the
     /// four. The marks start as a copy of the map's blocked bits (the same bit order), so one
     /// test-and-set per neighbour both skips obstacles and marks the cell.
-    pub fn reachable(
-        &self,
-        start: Point,
-        goal: Point,
-        mark: &mut [u32],
-        queue: &mut [u32],
-    ) -> Reach {
-        match self.reach_begin(start, goal, mark, queue) {
+    pub fn reachable(&self, start: Point, goal: Point, mut scratch: FillScratch<'_>) -> Reach {
+        match self.reach_begin(start, goal, &mut scratch) {
             Err(decided) => decided,
             Ok(mut fill) => loop {
-                if let Some(r) = self.reach_resume(goal, mark, queue, &mut fill, usize::MAX) {
+                if let Some(r) = self.reach_resume(goal, &mut scratch, &mut fill, usize::MAX) {
                     return r;
                 }
             },
@@ -384,9 +378,12 @@ impl<'a> Grid<'a> {
         &self,
         start: Point,
         goal: Point,
-        mark: &mut [u32],
-        queue: &mut [u32],
+        scratch: &mut FillScratch<'_>,
     ) -> Result<Filling, Reach> {
+        let FillScratch {
+            marks: mark,
+            ring: queue,
+        } = scratch;
         let cells = self.cells();
         if !self.is_free(start) || !self.is_free(goal) {
             return Err(Reach::No);
@@ -424,11 +421,14 @@ impl<'a> Grid<'a> {
     pub fn reach_resume(
         &self,
         goal: Point,
-        mark: &mut [u32],
-        queue: &mut [u32],
+        scratch: &mut FillScratch<'_>,
         fill: &mut Filling,
         limit: usize,
     ) -> Option<Reach> {
+        let FillScratch {
+            marks: mark,
+            ring: queue,
+        } = scratch;
         if !self.is_free(goal) {
             return Some(Reach::No);
         }
@@ -488,6 +488,23 @@ impl<'a> Grid<'a> {
             }
         }
         Some(Reach::No)
+    }
+}
+
+/// A flood fill's scratch over lent words: the marks (a bit a cell, the map's blocked cells and
+/// the cells reached) and the ring of queued cell indices (a cell a word, any length). Two
+/// buffers of the same element type, named here so that a caller cannot swap them.
+#[derive(Debug)]
+pub struct FillScratch<'a> {
+    marks: &'a mut [u32],
+    ring: &'a mut [u32],
+}
+
+impl<'a> FillScratch<'a> {
+    /// The scratch over `marks` and `ring` ([`Grid::reachable`] says what each must hold).
+    #[inline]
+    pub fn new(marks: &'a mut [u32], ring: &'a mut [u32]) -> Self {
+        Self { marks, ring }
     }
 }
 
@@ -699,11 +716,19 @@ mod tests {
         let mut m = [0u32; 1];
         let mut q = [0u32; 9];
         assert_eq!(
-            g.reachable(Point::new(0, 0), Point::new(2, 2), &mut m, &mut q),
+            g.reachable(
+                Point::new(0, 0),
+                Point::new(2, 2),
+                FillScratch::new(&mut m, &mut q)
+            ),
             Reach::No
         );
         assert_eq!(
-            g.reachable(Point::new(0, 0), Point::new(0, 1), &mut m, &mut q),
+            g.reachable(
+                Point::new(0, 0),
+                Point::new(0, 1),
+                FillScratch::new(&mut m, &mut q)
+            ),
             Reach::Yes
         );
         // A ring too short for the frontier cannot decide.
@@ -711,7 +736,11 @@ mod tests {
         let mut m = [0u32; 2];
         let mut q = [0u32; 2];
         assert_eq!(
-            open.reachable(Point::new(0, 0), Point::new(7, 7), &mut m, &mut q),
+            open.reachable(
+                Point::new(0, 0),
+                Point::new(7, 7),
+                FillScratch::new(&mut m, &mut q)
+            ),
             Reach::Unknown
         );
     }
@@ -760,7 +789,11 @@ mod tests {
                         } else {
                             Reach::No
                         };
-                        let got = g.reachable(g.point(s), g.point(t), &mut mark, &mut queue);
+                        let got = g.reachable(
+                            g.point(s),
+                            g.point(t),
+                            FillScratch::new(&mut mark, &mut queue),
+                        );
                         assert_eq!(got, want, "{w}x{h} {:?} -> {:?}", g.point(s), g.point(t));
                     }
                 }

@@ -47,7 +47,7 @@
 use crate::colony::route;
 use crate::colony::route::RouteHeap;
 use crate::colony::tabu::TabuSet;
-use crate::map::grid::{Dir, Point};
+use crate::map::grid::{Dir, FillScratch, Point};
 use crate::polish::links::PathLinks;
 
 use super::needs::{detour_take, Ask, Lent, Need, Pair};
@@ -100,9 +100,9 @@ pub(super) struct Idle<'w> {
 }
 
 impl Idle<'_> {
-    /// The flood fill's visited set and ring.
-    pub(super) fn reach(&mut self) -> (&mut [u32], &mut [u32]) {
-        (self.tabu, self.links)
+    /// The flood fill's scratch: the tabu set's words as its marks, the links as its ring.
+    pub(super) fn reach(&mut self) -> FillScratch<'_> {
+        FillScratch::new(self.tabu, self.links)
     }
 
     /// The pruning's stack.

@@ -9,7 +9,7 @@ use crate::colony::tabu::TabuSet;
 use crate::colony::tighten::Tightening;
 use crate::colony::update::{deposit, wolves_amounts};
 use crate::geometry::steps_length;
-use crate::map::grid::{Dir, Filling, Moves, Point, Reach};
+use crate::map::grid::{Dir, FillScratch, Filling, Moves, Point, Reach};
 use crate::rng::Xoshiro128pp;
 
 use crate::planner::lend::Colony;
@@ -389,7 +389,8 @@ impl Run<'_, '_> {
                     if let Some(mut fill) = w.filling.take() {
                         let cells = (left as usize).saturating_mul(FILL_CELLS);
                         let grid = self.grid;
-                        match grid.reach_resume(self.goal, tabu.lend(), links, &mut fill, cells) {
+                        let mut scratch = FillScratch::new(tabu.lend(), links);
+                        match grid.reach_resume(self.goal, &mut scratch, &mut fill, cells) {
                             None => {
                                 w.filling = Some(fill);
                                 left = 0;
@@ -464,12 +465,9 @@ impl Run<'_, '_> {
                                         self.reach_checked = true;
                                         // A piece at a time, before the next ant.
                                         let grid = self.grid;
-                                        match grid.reach_begin(
-                                            self.start,
-                                            self.goal,
-                                            tabu.lend(),
-                                            links,
-                                        ) {
+                                        let mut scratch = FillScratch::new(tabu.lend(), links);
+                                        match grid.reach_begin(self.start, self.goal, &mut scratch)
+                                        {
                                             Ok(fill) => w.filling = Some(fill),
                                             Err(reach) => w.it.no_path |= reach == Reach::No,
                                         }

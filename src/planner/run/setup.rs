@@ -70,9 +70,8 @@ impl Run<'_, '_> {
                 // prove anything, still need it.
                 let proved_by_ants = p.dead_end == DeadEnd::Backtrack;
                 self.reach_checked = !proved_by_ants;
-                let (visited, ring) = ws.idle.reach();
                 if !proved_by_ants
-                    && grid.reachable(self.start, self.goal, visited, ring) == Reach::No
+                    && grid.reachable(self.start, self.goal, ws.idle.reach()) == Reach::No
                 {
                     self.phase = Phase::Ended(End::NoPath);
                     return;
