@@ -28,11 +28,13 @@
 //! | `mod.rs` | [`Run`]'s state and [`Phase`], its constructors (cold, warm), the accessors, [`Run::poll`] and `finish` |
 //! | `setup.rs` | the setup before the first iteration: flood fill, pruning, the coarse route |
 //! | `colony.rs` | one iteration: every ant's walk, the pheromone update, the record and early stop |
+//! | `walk.rs` | a walk within the pieces' budget: the budget, the walk in progress and its tightening, the walk again for the wolves rule |
 //! | `polish.rs` | the work after the last iteration: the local search and the smoothing |
 
 mod colony;
 mod polish;
 mod setup;
+mod walk;
 
 pub use colony::{settled, REFINE_GAIN};
 pub(crate) use polish::{REFINE_WORDS, SHORT_REFINE_WORDS};

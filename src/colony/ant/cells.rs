@@ -1,0 +1,240 @@
+//! The walk loop for maps whose pheromone has an entry a cell and no route ([`Ant::walk_cells`]):
+//! the general loop's moves and draws ([`Ant::walk_general`](super::Ant)), bit for bit, at fewer
+//! instructions a move. What it owns: that loop and its roulette over the open moves' bits. What
+//! it guarantees: the same results, tours, tabu sets and generator states as the general loop
+//! (`the_loop_for_an_entry_a_cell_walks_as_the_general_one` in the parent's tests), and no panic
+//! (every read is checked, the lints deny indexing).
+
+use super::*;
+
+impl Ant<'_, '_, '_> {
+    /// [`Ant::walk_general`] where the pheromone has an entry per cell (a map of at most
+    /// [`crate::colony::pheromone::BLOCKS`] cells) and the potential field pulls toward the goal
+    /// (no route): the same moves and draws, bit for bit, at fewer instructions a move. An edge's
+    /// entry is `4 * cell` plus a slot offset fixed for the map ([`slot_offsets`]); the weights
+    /// are kept by direction, so the roulette walks the open moves' bits again instead of a
+    /// list of candidates. The same sums in the same order: the candidates are the set bits of
+    /// the open mask, lowest first, as in the general loop.
+    // Not inlined: the general loop's function stays as it was (its registers, its count of
+    // instructions on the device).
+    #[inline(never)]
+    pub(super) fn walk_cells(
+        &self,
+        trail: &mut Trail,
+        rng: &mut Xoshiro128pp,
+        tabu: &mut TabuSet<'_>,
+        tour: &mut [Dir],
+        limit: &mut u32,
+        pow: impl Fn(f32) -> f32,
+    ) -> Result<Option<Walk>, Lost> {
+        // The generator as a local: the loop keeps its state in registers (through `rng` it
+        // would store it at every draw, since the tour and tabu writes might alias it).
+        let mut gen = rng.clone();
+        let r = self.cells_loop(trail, &mut gen, tabu, tour, limit, pow);
+        *rng = gen;
+        r
+    }
+
+    /// The loop of [`Ant::walk_cells`].
+    #[inline(always)]
+    fn cells_loop(
+        &self,
+        trail: &mut Trail,
+        rng: &mut Xoshiro128pp,
+        tabu: &mut TabuSet<'_>,
+        tour: &mut [Dir],
+        limit: &mut u32,
+        pow: impl Fn(f32) -> f32,
+    ) -> Result<Option<Walk>, Lost> {
+        let grid = self.moves.grid();
+        // The offset of a step, computed where it is needed: a table of them would be one
+        // more array on the stack, whose depth the device's RAM budget counts.
+        let w_off = grid.width() as isize;
+        let step = |d: usize| {
+            let (dx, dy) = (
+                DX.get(d & 7).copied().unwrap_or(0),
+                DY.get(d & 7).copied().unwrap_or(0),
+            );
+            // |dy|, |dx| <= 1 and the width <= 65535: no overflow.
+            (dy as isize).wrapping_mul(w_off).wrapping_add(dx as isize)
+        };
+        let slots = slot_offsets(&grid.offsets());
+        let tau = self.tau.flat();
+        let goal = grid.index(self.goal);
+        let Trail {
+            mut cur,
+            mut ci,
+            mut steps,
+            mut moves,
+            mut may_tighten,
+            block,
+            target,
+        } = *trail;
+        // By direction; only the open moves' entries are read, each written first in the same
+        // step.
+        let mut weight = [0.0f32; 8];
+        let width = usize::from(grid.width());
+        let last_row = usize::from(grid.height()).wrapping_sub(1);
+        let first = moves;
+        let stop = self.budget.min(moves.saturating_add(*limit));
+        while ci != goal {
+            let allowed = self.moves.at(ci, cur);
+            let (x, y) = (usize::from(cur.x), usize::from(cur.y));
+            let tabu_moves = if x > 0 && y > 0 && x.wrapping_add(1) < width && y < last_row {
+                tabu.around(ci, width) & allowed
+            } else {
+                let mut t = 0u8;
+                let mut m = allowed;
+                while m != 0 {
+                    let di = m.trailing_zeros() as usize & 7;
+                    m &= m.wrapping_sub(1);
+                    let ni = ci.wrapping_add_signed(step(di));
+                    if tabu.contains(ni) {
+                        t |= 1 << di;
+                    }
+                }
+                t
+            };
+            // As in the general loop.
+            if !may_tighten && tabu_moves & tabu_moves.wrapping_sub(1) != 0 {
+                let mut seen = 0u32;
+                let mut m = tabu_moves;
+                while m != 0 {
+                    let di = m.trailing_zeros() as usize & 7;
+                    m &= m.wrapping_sub(1);
+                    let ni = ci.wrapping_add_signed(step(di));
+                    seen = seen.wrapping_add(u32::from(!bitmap::marked(self.dead, ni)));
+                }
+                may_tighten = seen > 1;
+            }
+            let open = allowed & !tabu_moves;
+            moves = moves.saturating_add(1);
+            if moves > stop {
+                if moves > self.budget {
+                    *limit = limit.saturating_sub(moves.wrapping_sub(first));
+                    return Err(Lost::Budget);
+                }
+                // The piece is over: the next one makes this move (nothing above changed the
+                // walk but `may_tighten`, which it sets again).
+                *trail = Trail {
+                    cur,
+                    ci,
+                    steps,
+                    moves: moves.wrapping_sub(1),
+                    may_tighten,
+                    block,
+                    target,
+                };
+                *limit = 0;
+                return Ok(None);
+            }
+            let d = if open == 0 {
+                match self.dead_end {
+                    DeadEnd::Die => {
+                        *limit = limit.saturating_sub(moves.wrapping_sub(first));
+                        return Err(Lost::Died);
+                    }
+                    DeadEnd::Backtrack => {
+                        // As in the general loop.
+                        let Some(s) = steps.checked_sub(1) else {
+                            let filled = tour.last().is_none_or(|&d| d != UNFILLED);
+                            *limit = limit.saturating_sub(moves.wrapping_sub(first));
+                            return Err(if filled {
+                                Lost::Overflow
+                            } else {
+                                Lost::Exhausted
+                            });
+                        };
+                        steps = s;
+                        let back = opposite(tour.get(steps).copied().ok_or(Lost::Overflow)?);
+                        ci = ci.wrapping_add_signed(step(usize::from(back)));
+                        cur = neighbour(cur, back);
+                        continue;
+                    }
+                }
+            } else if open & open.wrapping_sub(1) == 0 {
+                // One open move: taken without a draw.
+                open.trailing_zeros() as u8 & 7
+            } else {
+                let eta = self.heuristic.row(cur);
+                // `4 * ci` fits: the table holds 4 entries a cell.
+                let c4 = ci.wrapping_mul(4);
+                let mut total = 0.0f32;
+                let mut m = open;
+                while m != 0 {
+                    let di = m.trailing_zeros() as usize & 7;
+                    m &= m.wrapping_sub(1);
+                    let ti = c4.wrapping_add_signed(slots.get(di).copied().unwrap_or(0));
+                    let w = pow(tau.get(ti).copied().unwrap_or(0.0)) * eta.get(di);
+                    if let Some(slot) = weight.get_mut(di) {
+                        *slot = w;
+                    }
+                    total += w;
+                }
+                roulette_open(rng, &weight, open, total)
+            };
+            let Some(slot) = tour.get_mut(steps) else {
+                // As in the general loop: not a move.
+                match self.dead_end {
+                    DeadEnd::Die => {
+                        *limit = limit.saturating_sub(moves.wrapping_sub(first));
+                        return Err(Lost::Overflow);
+                    }
+                    DeadEnd::Backtrack => {
+                        let ni = ci.wrapping_add_signed(step(usize::from(d)));
+                        tabu.insert(ni);
+                        moves = moves.wrapping_sub(1); // counted above: at least 1
+                        continue;
+                    }
+                }
+            };
+            *slot = d;
+            steps = steps.wrapping_add(1); // < tour.len() + 1: the slot existed
+            ci = ci.wrapping_add_signed(step(usize::from(d)));
+            cur = neighbour(cur, d);
+            tabu.insert(ci);
+        }
+        *limit = limit.saturating_sub(moves.wrapping_sub(first));
+        self.arrived(tabu, tour, steps, moves, may_tighten)
+    }
+}
+
+/// [`roulette`] over the open moves (the set bits of `open`, at least two, lowest first) with
+/// their weights by direction in `weight`: the direction [`roulette`] picks from the list of
+/// those moves' weights, with the same draw and the same running sums (so bit for bit the same
+/// choice).
+#[inline]
+fn roulette_open(rng: &mut Xoshiro128pp, weight: &[f32; 8], open: u8, total: f32) -> Dir {
+    if !(total > 0.0 && total <= f32::MAX) {
+        return uniform_open(rng, open);
+    }
+    let r = rng.next_unit() * total;
+    let mut acc = 0.0f32;
+    let mut m = open;
+    let mut last = 0u8;
+    while m != 0 {
+        let di = m.trailing_zeros() as u8 & 7;
+        m &= m.wrapping_sub(1);
+        acc += weight.get(usize::from(di)).copied().unwrap_or(0.0);
+        if r < acc {
+            return di;
+        }
+        last = di;
+    }
+    // Rounding can leave r just above the running sum: the last open move.
+    last
+}
+
+/// [`roulette`]'s uniform choice among the open moves (every weight underflowed, or the sum
+/// overflowed: rare, so out of the loop): the k-th of the set bits of `open`.
+#[cold]
+#[inline(never)]
+fn uniform_open(rng: &mut Xoshiro128pp, open: u8) -> Dir {
+    let n = u64::from(open.count_ones());
+    let k = (u64::from(rng.next_word()).wrapping_mul(n) >> 32) as u32;
+    let mut m = open;
+    for _ in 0..k {
+        m &= m.wrapping_sub(1);
+    }
+    m.trailing_zeros() as u8 & 7
+}
