@@ -123,10 +123,10 @@ pub mod search;
 // Every phase's modules at the crate root as well: `ohaca::grid`, `ohaca::ant`, ... are the paths
 // the host, the tests, the examples and the fuzz targets use, and the ones the code inside the
 // crate uses (`crate::map::grid`); the folders above are where the files live.
-pub use colony::{ant, heuristic, pheromone, route, tighten, update};
+pub use colony::{ant, heuristic, pheromone, route, tabu, tighten, update};
 pub use map::{bitmap, dir, grid, prune};
 pub use planner::quorum;
-pub use polish::{corridor, refine, smoothing, taut};
+pub use polish::{corridor, links, refine, smoothing, taut};
 pub use search::astar;
 
 #[cfg(test)]

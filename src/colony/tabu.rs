@@ -8,7 +8,8 @@
 //!
 //! **Guarantees.** A cell beyond the words reads as in the set (a walk never enters it) and
 //! entering one is ignored, so a short buffer never makes an ant leave the map or write past
-//! its words; a set shorter than its map is refused where the map is known ([`TabuSet::of`]).
+//! its words; a set shorter than its map is refused: the planner's by the workspace's capacity
+//! check (`Workspace::new`), a caller's bare words by [`TabuSet::of`].
 //! Every method is `#[inline]` over the bitmap's: the machine code is the slice's. No panic.
 
 use crate::map::bitmap;

@@ -53,7 +53,8 @@ pub fn deposit(table: &mut Table<'_>, grid: &Grid<'_>, start: Point, tour: &[Dir
     let mut c = grid.index(start);
     let flat = table.flat_mut();
     for &d in tour {
-        // `& 7`: in range of both 8-entry tables, which the compiler sees.
+        // A tour holds directions 0..=7 only (the walk writes them); `& 7` keeps any byte in
+        // range of both 8-entry tables without a branch, which the compiler sees.
         let d = usize::from(d & 7);
         let slot = slots.get(d).copied().unwrap_or(0);
         // `c` is a cell index (< cells, and the table's 16 bytes a cell fit in memory), so `4 * c`

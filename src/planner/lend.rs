@@ -36,8 +36,11 @@
 //! [`TabuSet`], the route search's [`RouteHeap`], the smoothing's [`PathLinks`], the local
 //! search's [`crate::polish::refine::Scratch`].
 //!
-//! Every choice depends only on the buffers' lengths (never on their contents or addresses), so
-//! a host that lays out a device's arena plans exactly what the device plans, and a choice made
+//! Every choice depends only on the buffers' lengths (never on their contents), so a host that
+//! lays out a device's arena plans exactly what the device plans (one exception, which no arena
+//! meets: tightening's keyed index reads the path cells as words, so path cells that a workspace
+//! laid by hand leaves unaligned lend none, and a walk left untightened is counted,
+//! `Shortfalls::TIGHTEN`; `carve` and every board's storage align them), and a choice made
 //! at the start of a phase is the same at each of its pieces. None of these buffers is kept
 //! between runs except the answer's (`best`, `points`) and the pheromone: the tabu set, the links
 //! and the route's words are scratch once the colony is done ([`super::Memory`] keeps nothing of

@@ -18,7 +18,8 @@
 //! | --- | --- |
 //! | `params` | [`Algorithm`], [`Params`] and their ranges |
 //! | `workspace` | [`Workspace`], [`Buffers`], [`Storage`]: every buffer, one layout |
-//! | `lend` | one typed view of the workspace per phase (setup, colony, polish) and what a buffer idle in a phase lends to it |
+//! | `needs` | the phases' buffer needs, declared once (`SETUP`, `COLONY`, `POLISH` in `PHASES`), and each need's lending rule; the compact arena's links and its capacity cuts (`next_cut`) derive from them |
+//! | `lend` | one typed view of the workspace per phase (setup, colony, polish), lending what a phase's needs take from the buffers idle in it |
 //! | `run` | [`Run`]: the loop as a state machine ([`Run::poll`]: setup, walk + update + record, polish) |
 //! | `plan` | [`Plan`], [`RawPath`], [`CurvePoint`]: the result |
 //! | [`session`] | one replan's dispatch for the firmware and the host: the last answer ([`session::answer`]), else a warm or cold run ([`session::start`]), and what it leaves ([`session::end`]) |

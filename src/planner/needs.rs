@@ -18,8 +18,9 @@
 //! the local search, the smoothing, the corridor), never a silent fallback; the arena and the
 //! boards' storages have none.
 //!
-//! Guarantees: every choice depends only on the buffers' lengths, never on their contents or
-//! addresses; two slices lent at once never overlap (by type: each buffer is handed out at most
+//! Guarantees: every choice depends only on the buffers' lengths, never on their contents (the
+//! path cells' words are lent only when aligned, which every arena and board storage is: see
+//! [`super::lend`]); two slices lent at once never overlap (by type: each buffer is handed out at most
 //! once, [`Lent`]); no panics (the const fns walk their lists by slice patterns).
 
 /// Two slices of scratch words.

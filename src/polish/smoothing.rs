@@ -570,8 +570,9 @@ fn scan_cells(
 fn trace(pts: &mut [Point], n: usize, prev: &mut PathLinks<'_>) -> usize {
     // Follow prev from the goal back to the start, reversing the links into "next" links.
     prev.reverse(n.wrapping_sub(1)); // n >= 3 (see `smooth`)
-                                     // Walk forward, compacting the chosen cells to the front (indices only grow, so reading
-                                     // index i after writing slot k <= i is safe).
+
+    // Walk forward, compacting the chosen cells to the front (indices only grow, so reading
+    // index i after writing slot k <= i is safe).
     let mut k = 0usize;
     let mut i = 0usize;
     while let Some(&p) = pts.get(i) {

@@ -9,7 +9,7 @@ use super::*;
 
 impl Ant<'_, '_, '_> {
     /// [`Ant::walk_general`] where the pheromone has an entry per cell (a map of at most
-    /// [`crate::colony::pheromone::BLOCKS`] cells) and the potential field pulls toward the goal
+    /// [`crate::colony::pheromone::BLOCKS`] cells in the planner's workspaces: the block shift 0) and the potential field pulls toward the goal
     /// (no route): the same moves and draws, bit for bit, at fewer instructions a move. An edge's
     /// entry is `4 * cell` plus a slot offset fixed for the map ([`slot_offsets`]); the weights
     /// are kept by direction, so the roulette walks the open moves' bits again instead of a

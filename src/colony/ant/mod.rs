@@ -22,8 +22,8 @@
 //! make the same moves with the same draws as one [`Ant::walk`], bit for bit.
 //!
 //! Two loops make the moves: a general one, and one for maps whose pheromone has an entry a cell
-//! and no route (every map of at most [`crate::colony::pheromone::BLOCKS`] cells, the paper
-//! preset's), which finds a move's pheromone at a fixed offset from its cell's and keeps the
+//! and no route (the pheromone's block shift 0: in the planner's workspaces every map of at most
+//! [`crate::colony::pheromone::BLOCKS`] cells, the paper preset's), which finds a move's pheromone at a fixed offset from its cell's and keeps the
 //! weights by direction. Both make the same moves with the same draws, bit for bit (the same
 //! products, summed in the same order; a test compares them on random maps, pheromone, budgets
 //! and pieces).
