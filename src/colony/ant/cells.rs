@@ -79,33 +79,10 @@ impl Ant<'_, '_, '_> {
         let stop = self.budget.min(moves.saturating_add(*limit));
         while ci != goal {
             let allowed = self.moves.at(ci, cur);
-            let (x, y) = (usize::from(cur.x), usize::from(cur.y));
-            let tabu_moves = if x > 0 && y > 0 && x.wrapping_add(1) < width && y < last_row {
-                tabu.around(ci, width) & allowed
-            } else {
-                let mut t = 0u8;
-                let mut m = allowed;
-                while m != 0 {
-                    let di = m.trailing_zeros() as usize & 7;
-                    m &= m.wrapping_sub(1);
-                    let ni = ci.wrapping_add_signed(step(di));
-                    if tabu.contains(ni) {
-                        t |= 1 << di;
-                    }
-                }
-                t
-            };
+            let tabu_moves = visited_moves(tabu, (ci, cur), allowed, (width, last_row), step);
             // As in the general loop.
             if !may_tighten && tabu_moves & tabu_moves.wrapping_sub(1) != 0 {
-                let mut seen = 0u32;
-                let mut m = tabu_moves;
-                while m != 0 {
-                    let di = m.trailing_zeros() as usize & 7;
-                    m &= m.wrapping_sub(1);
-                    let ni = ci.wrapping_add_signed(step(di));
-                    seen = seen.wrapping_add(u32::from(!bitmap::marked(self.dead, ni)));
-                }
-                may_tighten = seen > 1;
+                may_tighten = self.shortcut_seen(ci, tabu_moves, step);
             }
             let open = allowed & !tabu_moves;
             moves = moves.saturating_add(1);

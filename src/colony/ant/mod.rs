@@ -271,36 +271,13 @@ impl Ant<'_, '_, '_> {
             let allowed = self.moves.at(ci, cur);
             // The allowed moves into visited (or pruned) cells: from a 3 x 3 read of the tabu
             // set away from the border, one test a move on it.
-            let (x, y) = (usize::from(cur.x), usize::from(cur.y));
-            let tabu_moves = if x > 0 && y > 0 && x.wrapping_add(1) < width && y < last_row {
-                tabu.around(ci, width) & allowed
-            } else {
-                let mut t = 0u8;
-                let mut m = allowed;
-                while m != 0 {
-                    let di = m.trailing_zeros() as usize & 7;
-                    m &= m.wrapping_sub(1);
-                    let ni = ci.wrapping_add_signed(offsets.get(di).copied().unwrap_or(0));
-                    if tabu.contains(ni) {
-                        t |= 1 << di;
-                    }
-                }
-                t
-            };
+            let step = |d: usize| offsets.get(d).copied().unwrap_or(0);
+            let tabu_moves = visited_moves(tabu, (ci, cur), allowed, (width, last_row), step);
             // A visited neighbour (not a pruned one) may offer a shortcut: one of them is the
             // cell we came from, a second one may be a shortcut. Once one walk cell had two, the
             // answer is known and the test is skipped.
             if !may_tighten && tabu_moves & tabu_moves.wrapping_sub(1) != 0 {
-                let mut seen = 0u32;
-                let mut m = tabu_moves;
-                while m != 0 {
-                    let di = m.trailing_zeros() as usize & 7;
-                    m &= m.wrapping_sub(1);
-                    let ni = ci.wrapping_add_signed(offsets.get(di).copied().unwrap_or(0));
-                    // At most 8: one per bit of the mask.
-                    seen = seen.wrapping_add(u32::from(!bitmap::marked(self.dead, ni)));
-                }
-                may_tighten = seen > 1;
+                may_tighten = self.shortcut_seen(ci, tabu_moves, step);
             }
             let mut mask = allowed & !tabu_moves;
             let mut n = 0usize;
@@ -433,6 +410,23 @@ impl Ant<'_, '_, '_> {
         self.arrived(tabu, tour, steps, moves, may_tighten)
     }
 
+    /// Whether more than one of the visited neighbours in `tabu_moves` (directions; `step` gives
+    /// a direction's index offset) of cell `ci` is a walk cell, not a pruned one: the walk may
+    /// then have a shortcut for its tightening.
+    #[inline(always)]
+    fn shortcut_seen(&self, ci: usize, tabu_moves: u8, step: impl Fn(usize) -> isize) -> bool {
+        let mut seen = 0u32;
+        let mut m = tabu_moves;
+        while m != 0 {
+            let di = m.trailing_zeros() as usize & 7;
+            m &= m.wrapping_sub(1);
+            let ni = ci.wrapping_add_signed(step(di));
+            // At most 8: one per bit of the mask.
+            seen = seen.wrapping_add(u32::from(!bitmap::marked(self.dead, ni)));
+        }
+        seen > 1
+    }
+
     /// The walk that reached the goal with `steps` steps in `tour` after `moves` moves.
     #[inline(always)]
     fn arrived(
@@ -473,6 +467,33 @@ impl Ant<'_, '_, '_> {
             may_tighten,
         }))
     }
+}
+
+/// The `allowed` moves of cell `ci` at `cur` into cells of the tabu set (visited or pruned), as a
+/// direction mask: a 3 x 3 read of the set away from the map's border (`width`, `last_row`), one
+/// test a move on it (`step` gives a direction's index offset).
+#[inline(always)]
+fn visited_moves(
+    tabu: &TabuSet<'_>,
+    (ci, cur): (usize, Point),
+    allowed: u8,
+    (width, last_row): (usize, usize),
+    step: impl Fn(usize) -> isize,
+) -> u8 {
+    let (x, y) = (usize::from(cur.x), usize::from(cur.y));
+    if x > 0 && y > 0 && x.wrapping_add(1) < width && y < last_row {
+        return tabu.around(ci, width) & allowed;
+    }
+    let mut t = 0u8;
+    let mut m = allowed;
+    while m != 0 {
+        let di = m.trailing_zeros() as usize & 7;
+        m &= m.wrapping_sub(1);
+        if tabu.contains(ci.wrapping_add_signed(step(di))) {
+            t |= 1 << di;
+        }
+    }
+    t
 }
 
 /// Roulette-wheel choice: index `i` with probability `w[i] / total` (one uniform draw). If every
