@@ -120,13 +120,8 @@ pub(super) fn answer(
     if answer.params != (Params { seed: 0, ..*params }) {
         return Err(NoAnswer);
     }
-    let (
-        core::ops::Range {
-            start: from,
-            end: steps,
-        },
-        core::ops::Range { start: first, end },
-    ) = answer.ranges();
+    let (raw, waypoints) = answer.ranges();
+    let (from, steps, first, end) = (raw.start, raw.end, waypoints.start, waypoints.end);
     // 1. The robot's cell on the raw path.
     let tour: &[Dir] = ws.best.get(from..steps).ok_or(NoAnswer)?;
     let mut p = answer.start;

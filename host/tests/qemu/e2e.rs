@@ -99,6 +99,19 @@ fn load(name: &str) -> Map {
     Map::load(maps().join(name)).unwrap_or_else(|e| panic!("{e}"))
 }
 
+/// `map` on the device with parameters that keep a plan running (60,000 iterations, no early
+/// stop), for the tests that act while a plan runs.
+fn slow_plans_on<T: Transport>(link: &mut Link<T>, map: &Map) {
+    link.set_map(map).expect("set map");
+    let slow = Params {
+        iterations: 60_000,
+        patience: 0,
+        refine_patience: 0,
+        ..Params::default()
+    };
+    link.set_params(&slow).expect("set params");
+}
+
 /// The device's path must be the host core's, bit for bit.
 fn assert_same(what: &str, host: &PlanReport, start: Point, dev: &Result<DevicePath, ErrorReply>) {
     let dev = match dev {
@@ -575,14 +588,7 @@ fn refusals_no_map_map_too_large_busy_and_cancel() {
 
     // A slow plan, the queue filled behind it, one more refused with Busy, then Cancel.
     let map = load("complex-26.map");
-    link.set_map(&map).expect("set map");
-    let slow = Params {
-        iterations: 60_000,
-        patience: 0,
-        refine_patience: 0,
-        ..Params::default()
-    };
-    link.set_params(&slow).expect("set params");
+    slow_plans_on(&mut link, &map);
     let (s, g) = (Point::new(0, 0), Point::new(25, 25));
     let running = link
         .send(&Request::Plan {
@@ -667,14 +673,7 @@ fn a_new_map_cancels_running_and_queued_plans_and_later_plans_use_it() {
     let mut link = q.link();
     link.hello().expect("hello");
     let old = load("complex-26.map");
-    link.set_map(&old).expect("set map");
-    let slow = Params {
-        iterations: 60_000,
-        patience: 0,
-        refine_patience: 0,
-        ..Params::default()
-    };
-    link.set_params(&slow).expect("set params");
+    slow_plans_on(&mut link, &old);
     let (s, g) = (Point::new(0, 0), Point::new(25, 25));
     let plan = |link: &mut Link<_>, seed: u64| {
         link.send(&Request::Plan {
@@ -1598,14 +1597,7 @@ fn a_cell_update_during_a_plan_cancels_it() {
     let mut link = q.link();
     link.hello().expect("hello");
     let map = load("complex-26.map");
-    link.set_map(&map).expect("set map");
-    let slow = Params {
-        iterations: 60_000,
-        patience: 0,
-        refine_patience: 0,
-        ..Params::default()
-    };
-    link.set_params(&slow).expect("set params");
+    slow_plans_on(&mut link, &map);
     let (s, g) = (Point::new(0, 0), Point::new(25, 25));
     let plan = |link: &mut Link<_>| {
         link.send(&Request::Plan {

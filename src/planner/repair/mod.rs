@@ -168,13 +168,8 @@ pub(super) fn repair(
     entry: usize,
 ) -> Result<Reused, GiveUp> {
     use GiveUp::{NoRoom, StillBlocked, Unplaced};
-    let (
-        core::ops::Range {
-            start: from,
-            end: steps,
-        },
-        core::ops::Range { start: first, end },
-    ) = answer.ranges();
+    let (raw, waypoints) = answer.ranges();
+    let (from, steps, first, end) = (raw.start, raw.end, waypoints.start, waypoints.end);
     // The robot's direction in `best`.
     let base = from.checked_add(at).ok_or(Unplaced)?;
     // The answer, the increments and the buffers idle between plans (`lend::Polishing`).
