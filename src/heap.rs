@@ -31,6 +31,7 @@ type Vecs = OwnedBuffers<
     Vec<u32>,
     Vec<CurvePoint>,
     Vec<u32>,
+    Vec<u32>,
 >;
 
 /// The planner's buffers, on the heap. See the module docs.
@@ -39,6 +40,8 @@ pub struct HeapStorage {
     cells: usize,
     /// No buffers for the iteration's best and worst paths ([`HeapStorage::replaying`]).
     replay: bool,
+    /// No weight table ([`HeapStorage::unweighted`]).
+    unweighted: bool,
     buffers: Vecs,
 }
 
@@ -94,6 +97,7 @@ impl HeapStorage {
             return usize::MAX;
         }
         Workspace::bytes(cells, cells, true, iterations)
+            .saturating_add(Workspace::weight_words(cells).saturating_mul(4))
     }
 
     /// Storage like [`HeapStorage::new`] whose ant paths are bounded to `steps` steps (the
@@ -146,6 +150,15 @@ impl HeapStorage {
         self
     }
 
+    /// Drop the colony's weight table, as the device's storages have none
+    /// ([`Workspace::with_weights`]): the walks compute their weights at each move instead, with
+    /// the same paths bit for bit.
+    pub fn unweighted(mut self) -> Self {
+        self.unweighted = true;
+        self.buffers.weights = Vec::new();
+        self
+    }
+
     /// Grow the buffers (never shrink) to hold at least `cells` cells and `iterations` curve
     /// entries.
     pub fn ensure(&mut self, cells: usize, iterations: usize) -> Result<(), AllocError> {
@@ -180,6 +193,9 @@ impl HeapStorage {
         grow(&mut b.curve, iterations, CurvePoint::default()).map_err(e)?;
         if cells > BLOCKS {
             grow(&mut b.guide, GUIDE_BLOCKS, 0).map_err(e)?;
+        }
+        if !self.unweighted {
+            grow(&mut b.weights, Workspace::weight_words(cells), 0).map_err(e)?;
         }
         Ok(())
     }
@@ -222,6 +238,7 @@ impl HeapStorage {
             .chain(b.dead.iter_mut())
             .chain(b.links.iter_mut())
             .chain(b.guide.iter_mut())
+            .chain(b.weights.iter_mut())
         {
             *w = next();
         }

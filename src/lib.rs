@@ -123,7 +123,7 @@ pub mod search;
 // Every phase's modules at the crate root as well: `ohaca::grid`, `ohaca::ant`, ... are the paths
 // the host, the tests, the examples and the fuzz targets use, and the ones the code inside the
 // crate uses (`crate::map::grid`); the folders above are where the files live.
-pub use colony::{ant, heuristic, pheromone, route, tabu, tighten, update};
+pub use colony::{ant, heuristic, pheromone, route, tabu, tighten, update, weights};
 pub use map::{bitmap, dir, grid, prune};
 pub use planner::quorum;
 pub use polish::{corridor, links, refine, smoothing, taut};

@@ -59,6 +59,7 @@ fn first_iteration_arrivals(prep: &Prepared, params: &Params, seeds: &[u64]) -> 
         dead_end: params.dead_end,
         dead: &dead,
         route: None,
+        weights: None,
         budget: u32::MAX,
     };
     let (mut arrived, mut total) = (0u64, 0u64);

@@ -731,6 +731,7 @@ mod tests {
             dead_end: DeadEnd::Backtrack,
             dead: &[],
             route: None,
+            weights: None,
             budget: u32::MAX,
         };
         let mut tabu = vec![0u32; crate::map::bitmap::words(cells)];

@@ -86,6 +86,7 @@ const fn full_links_hold(links: usize) -> bool {
             tabu: words(cells),
             points: 0,
             guide: GUIDE_BLOCKS,
+            weights: 0,
         };
         if needs::links(idle, ask(cells, FULL_STEPS, false)) > links {
             return false;
@@ -228,6 +229,8 @@ const fn ask(cells: usize, steps: usize, packed: bool) -> needs::Ask {
         cells: n,
         table,
         refine: (REFINE_WORDS, SHORT_REFINE_WORDS),
+        // No weight table in an arena: its walks compute their weights at each move.
+        weights: 0,
     }
 }
 
@@ -239,6 +242,7 @@ const fn idle(cells: usize, steps: usize) -> needs::Lengths {
         tabu: words(cells),
         points: steps.saturating_add(1),
         guide: 0,
+        weights: 0,
     }
 }
 

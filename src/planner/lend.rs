@@ -50,6 +50,7 @@
 use crate::colony::route;
 use crate::colony::route::RouteHeap;
 use crate::colony::tabu::TabuSet;
+use crate::colony::weights::{self, WeightTable};
 use crate::map::grid::{Dir, FillScratch, Point};
 use crate::polish::links::PathLinks;
 
@@ -162,6 +163,9 @@ pub(super) struct Colony<'w> {
     pub(super) index: (&'w mut [Point], &'w mut [u32]),
     /// The coarse route the ants read.
     pub(super) guide: &'w Guide<'w>,
+    /// The iteration's weight table ([`Need::Weights`]), when the walks read one and the
+    /// workspace has room for it; `None`: the walks compute their weights at each move.
+    pub(super) weights: Option<WeightTable<'w>>,
 }
 
 /// What the work after the last iteration borrows (and a reused answer's repair): the answer it
@@ -244,9 +248,21 @@ impl<'a> Workspace<'a> {
         }
     }
 
-    /// The colony's view.
-    pub(super) fn colony(&mut self) -> Colony<'_> {
+    /// The colony's view; `table`: the map's cells when its walks read a weight table (the loop
+    /// for an entry a cell, [`crate::colony::ant`]), lent when the workspace holds one for them.
+    pub(super) fn colony(&mut self, table: Option<usize>) -> Colony<'_> {
+        let cells = table.unwrap_or(0);
+        let ask = Ask::weights(if table.is_some() {
+            weights::words(cells)
+        } else {
+            0
+        });
+        let lent = Lent::new(&mut [], &mut [], &mut [], &mut []).and_weights(self.weights);
+        let words = Need::Weights
+            .take(lent.lengths(), ask)
+            .and_then(|take| lent.take(take));
         Colony {
+            weights: words.and_then(|(w, _)| WeightTable::of(w, cells)),
             tau: self.tau,
             delta: self.delta,
             tabu: TabuSet::new(self.tabu),

@@ -37,6 +37,8 @@ pub(super) enum Buf {
     Points,
     /// The route's words (scratch after the colony).
     Guide,
+    /// The weight table's words (the colony's alone; none in the arenas).
+    Weights,
 }
 
 /// The lengths, in words, of the idle buffers a rule chooses among.
@@ -46,6 +48,7 @@ pub(super) struct Lengths {
     pub(super) tabu: usize,
     pub(super) points: usize,
     pub(super) guide: usize,
+    pub(super) weights: usize,
 }
 
 /// What a phase takes of the idle buffers: each lending rule below chooses one from the
@@ -69,6 +72,7 @@ impl Lengths {
             Buf::Tabu => self.tabu,
             Buf::Points => self.points,
             Buf::Guide => self.guide,
+            Buf::Weights => self.weights,
         }
     }
 }
@@ -84,6 +88,7 @@ impl Take {
                         | (Buf::Tabu, Buf::Tabu)
                         | (Buf::Points, Buf::Points)
                         | (Buf::Guide, Buf::Guide)
+                        | (Buf::Weights, Buf::Weights)
                 ) && l.of(a) >= words
                     && l.of(b) >= words
             }
@@ -113,7 +118,7 @@ impl Take {
 /// The idle buffers themselves, to lend what a [`Take`] says.
 pub(super) struct Lent<'x> {
     /// Indexed by [`Buf`]: each is handed out at most once.
-    bufs: [Option<&'x mut [u32]>; 4],
+    bufs: [Option<&'x mut [u32]>; 5],
 }
 
 impl<'x> Lent<'x> {
@@ -124,8 +129,16 @@ impl<'x> Lent<'x> {
         guide: &'x mut [u32],
     ) -> Self {
         Self {
-            bufs: [Some(links), Some(tabu), Some(points), Some(guide)],
+            bufs: [Some(links), Some(tabu), Some(points), Some(guide), None],
         }
+    }
+
+    /// The same buffers and the weight table's words.
+    pub(super) fn and_weights(mut self, weights: &'x mut [u32]) -> Self {
+        if let Some(slot) = self.bufs.get_mut(Buf::Weights as usize) {
+            *slot = Some(weights);
+        }
+        self
     }
 
     /// Their lengths.
@@ -141,6 +154,7 @@ impl<'x> Lent<'x> {
             tabu: len(Buf::Tabu),
             points: len(Buf::Points),
             guide: len(Buf::Guide),
+            weights: len(Buf::Weights),
         }
     }
 
@@ -263,6 +277,17 @@ pub(super) const fn smoothing_take(l: Lengths, n: usize) -> Take {
     }
 }
 
+/// The colony's weight table for a map whose walks read one ([`Ask::weights`] words,
+/// [`crate::colony::weights::words`]; 0: the walks read none): the weight table's words whole
+/// when they hold that many; `None`: none (the walks compute their weights at each move).
+pub(super) const fn weights_take(l: Lengths, words: usize) -> Option<Take> {
+    if words > 0 && l.weights >= words {
+        Some(Take::Whole(Buf::Weights))
+    } else {
+        None
+    }
+}
+
 /// One buffer need of a phase: what it borrows of the idle buffers, by which lending rule, and
 /// how much of it is enough. A phase's needs are a const list ([`SETUP`], [`COLONY`], [`POLISH`],
 /// all of them in [`PHASES`]); the slices a view lends ([`Need::take`], through [`Lent::take`]),
@@ -282,13 +307,17 @@ pub(super) enum Need {
     Refine,
     /// The smoothing's links for [`Ask::cells`] path cells ([`smoothing_take`]).
     Smoothing,
+    /// The iteration's weight table, [`Ask::weights`] words ([`weights_take`]): a buffer of its
+    /// own, never the links (a walk without it computes its weights at each move, the same
+    /// walk), so it asks the arena for nothing.
+    Weights,
 }
 
 /// The setup's needs (before the first ant): the coarse route. (Its flood fill and pruning
 /// stack take the tabu set and the links whole, whatever their lengths.)
 pub(super) const SETUP: &[Need] = &[Need::Route];
-/// The colony's needs: tightening's index.
-pub(super) const COLONY: &[Need] = &[Need::Tighten];
+/// The colony's needs: tightening's index, the weight table.
+pub(super) const COLONY: &[Need] = &[Need::Tighten, Need::Weights];
 /// The polish's needs: the local search's slices, the smoothing's links. (A repair's detour
 /// takes what it gets: [`detour_take`].)
 pub(super) const POLISH: &[Need] = &[Need::Refine, Need::Smoothing];
@@ -307,6 +336,8 @@ pub(super) struct Ask {
     pub(super) table: usize,
     /// Words of each of the local search's slices, and the fewest it takes.
     pub(super) refine: (usize, usize),
+    /// Words of the colony's weight table (0: its walks read none).
+    pub(super) weights: usize,
 }
 
 impl Ask {
@@ -317,6 +348,15 @@ impl Ask {
             cells: 0,
             table: 0,
             refine: (0, 0),
+            weights: 0,
+        }
+    }
+
+    /// The colony's weight table of `words` words (0: none).
+    pub(super) const fn weights(words: usize) -> Self {
+        Self {
+            weights: words,
+            ..Self::route(0, false)
         }
     }
 
@@ -346,6 +386,7 @@ impl Need {
             Need::Tighten => Some(Take::Whole(Buf::Links)),
             Need::Refine => refine_take(l, a.refine.0, a.refine.1),
             Need::Smoothing => Some(smoothing_take(l, a.cells)),
+            Need::Weights => weights_take(l, a.weights),
         }
     }
 
@@ -356,6 +397,7 @@ impl Need {
             Need::Tighten => a.table,
             Need::Refine => a.refine.1,
             Need::Smoothing => a.cells,
+            Need::Weights => a.weights,
         }
     }
 
@@ -375,6 +417,7 @@ impl Need {
             Need::Route | Need::Smoothing => [0, w, w],
             Need::Tighten => [w, w, w],
             Need::Refine => [0, a.refine.0, a.refine.0.saturating_mul(2)],
+            Need::Weights => [0, 0, 0],
         }
     }
 
@@ -397,7 +440,7 @@ impl Need {
         match self {
             Need::Route if a.route.1 => [w, w.saturating_mul(2), 0],
             Need::Route | Need::Smoothing => [w, 0, 0],
-            Need::Tighten => [0, 0, 0],
+            Need::Tighten | Need::Weights => [0, 0, 0],
             Need::Refine => [
                 a.refine.0,
                 a.refine.0.saturating_mul(2),
@@ -464,6 +507,7 @@ mod tests {
             tabu,
             points,
             guide,
+            weights: 0,
         }
     }
 
@@ -475,7 +519,8 @@ mod tests {
             vec![0u32; l.points],
             vec![0u32; l.guide],
         );
-        let lent = Lent::new(&mut a, &mut b, &mut c, &mut d);
+        let mut e = vec![0u32; l.weights];
+        let lent = Lent::new(&mut a, &mut b, &mut c, &mut d).and_weights(&mut e);
         assert_eq!(lent.lengths(), l);
         lent.take(take).map(|(x, y)| (x.len(), y.len()))
     }
@@ -488,6 +533,7 @@ mod tests {
             cells,
             table: 0,
             refine: (words, fewest),
+            weights: 0,
         }
     }
 
@@ -544,6 +590,29 @@ mod tests {
         // which lends the route, the local search and the smoothing theirs, tightening's table.
         assert_eq!(links(l, a), 200);
         assert_eq!(links(lengths(0, 200, 0, 0), a), 50);
+    }
+
+    #[test]
+    fn the_weight_table_is_lent_whole_or_not_at_all() {
+        // Its own words, whole, when they hold the table; never when the walks read none; and
+        // it asks the arena for no links (the arenas have no table: their walks compute the
+        // weights at each move).
+        let a = Ask::weights(322);
+        for w in [0usize, 1, 321, 322, 500] {
+            let l = Lengths {
+                weights: w,
+                ..lengths(1000, 1000, 1000, 1000)
+            };
+            let take = Need::Weights.take(l, a);
+            assert_eq!(take.is_some(), w >= 322, "{w}");
+            assert_eq!(Need::Weights.enough(l, a), w >= 322, "{w}");
+            if let Some(take) = take {
+                assert_eq!(lend(l, take), Some((w, 0)));
+            }
+            assert_eq!(Need::Weights.links(l, a), 0);
+            assert_eq!(Need::Weights.take(l, Ask::weights(0)), None);
+        }
+        assert_eq!(links(lengths(0, 0, 0, 0), a), 0);
     }
 
     #[test]

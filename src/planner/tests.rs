@@ -1111,3 +1111,60 @@ fn a_short_workspace_says_which_steps_ran_short() {
             .all(|s| crate::geometry::segment_clear(&g, s[0], s[1])));
     }
 }
+
+#[test]
+fn a_weight_table_plans_what_computing_the_weights_at_each_move_does() {
+    use crate::colony::ant::DeadEnd;
+    use crate::heap::HeapStorage;
+    // The iteration's weight table (the heap storage's; the device's storages have none) on
+    // random maps of at most `BLOCKS` cells (the walks' loop for an entry a cell), every
+    // algorithm, exponents, dead-end rules, with and without tightening: the same plans bit for
+    // bit, curves included (they follow every iteration's pheromone, so a row left from the
+    // iteration before the update shows), from storages left dirty by other runs.
+    let mut r = crate::rng::Xoshiro128pp::from_u64(3636);
+    let mut filled = 0;
+    for case in 0..24u32 {
+        let (w, h) = (
+            8 + (r.next_word() % 25) as u16,
+            8 + (r.next_word() % 24) as u16,
+        );
+        let bits = crate::testutil::random_bits(&mut r, w, h, 0.25);
+        let g = Grid::new(w, h, &bits).unwrap();
+        assert!(g.cells() <= crate::colony::pheromone::BLOCKS);
+        let free: Vec<usize> = (0..g.cells()).filter(|&i| !g.blocked_at(i)).collect();
+        let at = |i: usize| Point::new((i % usize::from(w)) as u16, (i / usize::from(w)) as u16);
+        let (s, goal) = (at(free[0]), at(free[free.len() - 1]));
+        let p = Params {
+            seed: u64::from(case),
+            algorithm: [
+                Algorithm::Aca,
+                Algorithm::Paca,
+                Algorithm::Haca,
+                Algorithm::Ohaca,
+            ][case as usize % 4],
+            alpha: [1.0, 0.7, 2.0][case as usize % 3],
+            dead_end: if case % 5 == 4 {
+                DeadEnd::Die
+            } else {
+                DeadEnd::Backtrack
+            },
+            tighten: case % 2 == 0,
+            patience: 0,
+            iterations: 12,
+            ants: 16,
+            ..Params::default()
+        };
+        let mut table = HeapStorage::new(g.cells(), 12).unwrap();
+        table.scramble(case);
+        let mut none = HeapStorage::new(g.cells(), 12).unwrap().unweighted();
+        none.scramble(case);
+        let with = fingerprint(&g, s, goal, &p, &mut table);
+        assert_eq!(with, fingerprint(&g, s, goal, &p, &mut none), "case {case}");
+        // The table was there and read.
+        let ws = table.workspace();
+        let cells = g.cells();
+        let t = crate::colony::weights::WeightTable::of(ws.weights, cells).unwrap();
+        filled += (0..cells).filter(|&i| t.is_filled(i)).count();
+    }
+    assert!(filled > 1000, "{filled}");
+}

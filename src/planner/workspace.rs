@@ -60,6 +60,8 @@ pub struct Workspace<'a> {
     pub(super) curve: &'a mut [CurvePoint],
     /// The coarse route: a word a block, or packed ([`Workspace::with_packed_route`]).
     pub(super) guide: Guide<'a>,
+    /// The colony's weight table ([`Workspace::with_weights`]; empty: none).
+    pub(super) weights: &'a mut [u32],
 }
 
 /// The caller's buffers, by name, for [`Workspace::new`].
@@ -139,7 +141,25 @@ impl<'a> Workspace<'a> {
             links: b.links,
             curve: b.curve,
             guide: Guide::Words(b.guide),
+            weights: &mut [],
         }
+    }
+
+    /// Words of the colony's weight table ([`Workspace::with_weights`]) for maps of up to `cells`
+    /// cells: [`crate::colony::weights::words`] for the maps whose walks read one (at most
+    /// [`BLOCKS`] cells: the pheromone has an entry a cell), none for larger ones (saturating).
+    pub const fn weight_words(cells: usize) -> usize {
+        crate::colony::weights::words(if cells < BLOCKS { cells } else { BLOCKS })
+    }
+
+    /// The same workspace with a weight table in `weights` ([`crate::colony::weights`]: the
+    /// iteration's `tau^alpha * eta^beta` by cell and direction, filled as the ants first stand on
+    /// a cell): the walks on a map of at most [`BLOCKS`] cells read their weights from it when it
+    /// holds [`Workspace::weight_words`]`(cells)` words, at fewer instructions a move; otherwise
+    /// they compute them at each move. The same plan bit for bit either way. The heap storage
+    /// gives one; the device arenas none.
+    pub fn with_weights(self, weights: &'a mut [u32]) -> Self {
+        Workspace { weights, ..self }
     }
 
     /// The same workspace keeping its coarse route packed in `guide`, four bits a block
@@ -234,6 +254,7 @@ impl<'a> Workspace<'a> {
             links,
             curve,
             guide,
+            weights,
         } = self;
         let (tau, _) = tau.split_at_mut(n.min(tau.len()));
         let (delta, _) = delta.split_at_mut(n.min(delta.len()));
@@ -256,6 +277,7 @@ impl<'a> Workspace<'a> {
             links,
             curve,
             guide,
+            weights,
         })
     }
 
@@ -270,7 +292,7 @@ impl<'a> Workspace<'a> {
 /// sized at run time by `heap::HeapStorage`. The one place that lends them to a [`Workspace`],
 /// so both storages follow whatever buffers the workspace takes.
 #[derive(Clone, Debug, Default)]
-pub(crate) struct OwnedBuffers<Tau, Bits, Moves, Tour, Kept, Points, Links, Curve, Guide> {
+pub(crate) struct OwnedBuffers<Tau, Bits, Moves, Tour, Kept, Points, Links, Curve, Guide, Weights> {
     pub(crate) tau: Tau,
     pub(crate) delta: Tau,
     pub(crate) tabu: Bits,
@@ -284,10 +306,12 @@ pub(crate) struct OwnedBuffers<Tau, Bits, Moves, Tour, Kept, Points, Links, Curv
     pub(crate) links: Links,
     pub(crate) curve: Curve,
     pub(crate) guide: Guide,
+    /// The colony's weight table (empty: none).
+    pub(crate) weights: Weights,
 }
 
-impl<Tau, Bits, Moves, Tour, Kept, Points, Links, Curve, Guide>
-    OwnedBuffers<Tau, Bits, Moves, Tour, Kept, Points, Links, Curve, Guide>
+impl<Tau, Bits, Moves, Tour, Kept, Points, Links, Curve, Guide, Weights>
+    OwnedBuffers<Tau, Bits, Moves, Tour, Kept, Points, Links, Curve, Guide, Weights>
 where
     Tau: AsMut<[[f32; 4]]>,
     Bits: AsMut<[u32]>,
@@ -298,6 +322,7 @@ where
     Links: AsMut<[u32]>,
     Curve: AsMut<[CurvePoint]>,
     Guide: AsMut<[u32]>,
+    Weights: AsMut<[u32]>,
 {
     /// Borrow the buffers as a workspace for one run.
     pub(crate) fn workspace(&mut self) -> Workspace<'_> {
@@ -320,6 +345,7 @@ where
             curve: self.curve.as_mut(),
             guide: self.guide.as_mut(),
         })
+        .with_weights(self.weights.as_mut())
     }
 }
 
@@ -371,6 +397,7 @@ type Arrays<
     [u32; LINKS],
     [CurvePoint; CURVE],
     [u32; GUIDE_BLOCKS],
+    [u32; 0],
 >;
 
 impl<
@@ -406,6 +433,7 @@ impl<
                     walked: 0,
                 }; CURVE],
                 guide: [0; GUIDE_BLOCKS],
+                weights: [],
             },
         }
     }

@@ -6,6 +6,7 @@
 //! (every read is checked, the lints deny indexing).
 
 use super::*;
+use crate::colony::weights;
 
 impl Ant<'_, '_, '_> {
     /// [`Ant::walk_general`] where the pheromone has an entry per cell (a map of at most
@@ -30,15 +31,40 @@ impl Ant<'_, '_, '_> {
         // The generator as a local: the loop keeps its state in registers (through `rng` it
         // would store it at every draw, since the tour and tabu writes might alias it).
         let mut gen = rng.clone();
-        let r = self.cells_loop(trail, &mut gen, tabu, tour, limit, pow);
+        let r = self.cells_loop(None, trail, &mut gen, tabu, tour, limit, pow);
         *rng = gen;
         r
     }
 
-    /// The loop of [`Ant::walk_cells`].
+    /// [`Ant::walk_cells`] reading the weights from the iteration's `table`
+    /// ([`crate::colony::weights`]): a cell's row is filled, with the products the loop without
+    /// a table computes at a move, when an ant first has a choice on it in the iteration; a move
+    /// then sums the open moves' weights from the row, in the same order. So the same moves and
+    /// draws, bit for bit, as [`Ant::walk_cells`] (a test compares them on random maps).
+    #[inline(never)]
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn walk_table(
+        &self,
+        table: &WeightTable<'_>,
+        trail: &mut Trail,
+        rng: &mut Xoshiro128pp,
+        tabu: &mut TabuSet<'_>,
+        tour: &mut [Dir],
+        limit: &mut u32,
+        pow: impl Fn(f32) -> f32,
+    ) -> Result<Option<Walk>, Lost> {
+        let mut gen = rng.clone();
+        let r = self.cells_loop(Some(table), trail, &mut gen, tabu, tour, limit, pow);
+        *rng = gen;
+        r
+    }
+
+    /// The loop of [`Ant::walk_cells`] (`table` `None`) and [`Ant::walk_table`].
     #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
     fn cells_loop(
         &self,
+        table: Option<&WeightTable<'_>>,
         trail: &mut Trail,
         rng: &mut Xoshiro128pp,
         tabu: &mut TabuSet<'_>,
@@ -132,6 +158,27 @@ impl Ant<'_, '_, '_> {
             } else if open & open.wrapping_sub(1) == 0 {
                 // One open move: taken without a draw.
                 open.trailing_zeros() as u8 & 7
+            } else if let Some(row) = table.and_then(|t| {
+                t.row(ci, || {
+                    // Every direction's weight as the loop below computes an open move's
+                    // (a closed move's is never read: its entry may be another edge's, or 0).
+                    let eta = self.heuristic.row(cur);
+                    let c4 = ci.wrapping_mul(4);
+                    core::array::from_fn(|di| {
+                        let ti = c4.wrapping_add_signed(slots.get(di).copied().unwrap_or(0));
+                        pow(tau.get(ti).copied().unwrap_or(0.0)) * eta.get(di)
+                    })
+                })
+            }) {
+                // The same running sum, in the same order, as below.
+                let mut total = 0.0f32;
+                let mut m = open;
+                while m != 0 {
+                    let di = m.trailing_zeros() as usize & 7;
+                    m &= m.wrapping_sub(1);
+                    total += weights::weight(row, di);
+                }
+                roulette_open(rng, |di| weights::weight(row, di), open, total)
             } else {
                 let eta = self.heuristic.row(cur);
                 // `4 * ci` fits: the table holds 4 entries a cell.
@@ -148,7 +195,12 @@ impl Ant<'_, '_, '_> {
                     }
                     total += w;
                 }
-                roulette_open(rng, &weight, open, total)
+                roulette_open(
+                    rng,
+                    |di| weight.get(di).copied().unwrap_or(0.0),
+                    open,
+                    total,
+                )
             };
             let Some(slot) = tour.get_mut(steps) else {
                 // As in the general loop: not a move.
@@ -177,11 +229,16 @@ impl Ant<'_, '_, '_> {
 }
 
 /// [`roulette`] over the open moves (the set bits of `open`, at least two, lowest first) with
-/// their weights by direction in `weight`: the direction [`roulette`] picks from the list of
+/// their weights by direction from `weight`: the direction [`roulette`] picks from the list of
 /// those moves' weights, with the same draw and the same running sums (so bit for bit the same
 /// choice).
 #[inline]
-fn roulette_open(rng: &mut Xoshiro128pp, weight: &[f32; 8], open: u8, total: f32) -> Dir {
+fn roulette_open(
+    rng: &mut Xoshiro128pp,
+    weight: impl Fn(usize) -> f32,
+    open: u8,
+    total: f32,
+) -> Dir {
     if !(total > 0.0 && total <= f32::MAX) {
         return uniform_open(rng, open);
     }
@@ -192,7 +249,7 @@ fn roulette_open(rng: &mut Xoshiro128pp, weight: &[f32; 8], open: u8, total: f32
     while m != 0 {
         let di = m.trailing_zeros() as u8 & 7;
         m &= m.wrapping_sub(1);
-        acc += weight.get(usize::from(di)).copied().unwrap_or(0.0);
+        acc += weight(usize::from(di));
         if r < acc {
             return di;
         }

@@ -32,6 +32,7 @@ use crate::colony::heuristic::Heuristic;
 use crate::colony::pheromone::{slot_offsets, Table};
 use crate::colony::route::Route;
 use crate::colony::tabu::TabuSet;
+use crate::colony::weights::WeightTable;
 use crate::map::bitmap;
 use crate::map::grid::{is_diagonal, neighbour, opposite, Dir, Moves, Point, DX, DY};
 use crate::named::named;
@@ -128,6 +129,11 @@ pub struct Ant<'g, 't, 'h> {
     pub dead: &'t [u32],
     /// Sub-goals of the potential field on large maps ([`crate::colony::route`]); `None`: the goal.
     pub route: Option<&'t Route<'t>>,
+    /// The iteration's weights by cell and direction ([`crate::colony::weights`]), filled as the
+    /// ants first have a choice on a cell, read by the loop for an entry a cell (the pheromone's
+    /// block shift 0, no route; ignored elsewhere); `None`: each move computes its weights. The
+    /// same walks either way, bit for bit.
+    pub weights: Option<&'t WeightTable<'t>>,
     /// Most moves (forward and back) the walk may make; one that needs more is abandoned
     /// ([`Lost::Budget`]). `u32::MAX`: no bound, the walk goes on until it arrives or exhausts.
     pub budget: u32,
@@ -224,6 +230,13 @@ impl Ant<'_, '_, '_> {
         // `pow_alpha(t, 1.0)` is `t`, so both give the same weights. Each loop is a function of
         // its own, so this one's stack frame is small and the deeper of them is the stack's need.
         let alpha = self.alpha;
+        if let (true, Some(table)) = (cells, self.weights) {
+            return if alpha == 1.0 {
+                self.walk_table(table, trail, rng, tabu, tour, left, |t| t)
+            } else {
+                self.walk_table(table, trail, rng, tabu, tour, left, |t| pow_alpha(t, alpha))
+            };
+        }
         match (cells, alpha == 1.0) {
             (true, true) => self.walk_cells(trail, rng, tabu, tour, left, |t| t),
             (true, false) => self.walk_cells(trail, rng, tabu, tour, left, |t| pow_alpha(t, alpha)),
@@ -579,6 +592,7 @@ mod tests {
             dead_end,
             dead: &dead,
             route: None,
+            weights: None,
             budget,
         };
         let mut tabu = vec![0u32; bitmap::words(g.cells())];
@@ -628,7 +642,7 @@ mod tests {
         // budgets, tour lengths and pieces: the same results, tours, tabu sets and generators.
         let mut r = Xoshiro128pp::from_u64(36);
         let taus = [0.0f32, 1e-30, 0.01, 0.5, 1.0, 3.0, 1e30, f32::MAX];
-        let mut compared = (0, 0, 0);
+        let mut compared = (0, 0, 0, 0);
         for case in 0..400u64 {
             let (w, h) = (
                 3 + (r.next_word() % 14) as u16,
@@ -689,6 +703,7 @@ mod tests {
                 },
                 dead: if case % 7 == 0 { &[] } else { &dead },
                 route: None,
+                weights: None,
                 budget: if case % 4 == 0 {
                     r.next_word() % 60
                 } else {
@@ -708,6 +723,30 @@ mod tests {
             assert_eq!(cells.1, general.1, "case {case}: tour");
             assert_eq!(cells.2, general.2, "case {case}: tabu");
             assert_eq!(cells.3, general.3, "case {case}: generator");
+            // The same loop reading a weight table (its words junk until cleared): three ants of
+            // one iteration, so that rows another ant filled are read, walk as the general loop.
+            let mut words = vec![0x7FC0_0001u32; crate::colony::weights::words(g.cells())];
+            let t = WeightTable::of(&mut words, g.cells()).unwrap();
+            t.clear();
+            let tabled = Ant {
+                weights: Some(&t),
+                ..ant
+            };
+            for (k, seed) in [seed, seed ^ 0x5A5A, seed.wrapping_add(7)]
+                .into_iter()
+                .enumerate()
+            {
+                let table = pieces(&tabled, true, seed, piece, tour_len);
+                let general = pieces(&ant, false, seed, piece, tour_len);
+                assert_eq!(table.0, general.0, "case {case}, ant {k}: table");
+                assert_eq!(table.1, general.1, "case {case}, ant {k}: table's tour");
+                assert_eq!(table.2, general.2, "case {case}, ant {k}: table's tabu");
+                assert_eq!(
+                    table.3, general.3,
+                    "case {case}, ant {k}: table's generator"
+                );
+            }
+            compared.3 += (0..g.cells()).filter(|&i| t.is_filled(i)).count();
             match cells.0.last() {
                 Some(Ok(Some(_))) => compared.0 += 1,
                 Some(Err(_)) => compared.1 += 1,
@@ -715,8 +754,12 @@ mod tests {
             }
             compared.2 += cells.0.len();
         }
-        // Both kinds of ending, and walks cut into pieces, were compared.
-        assert!(compared.0 > 100 && compared.1 > 20, "{compared:?}");
+        // Both kinds of ending, and walks cut into pieces, were compared; the tables' rows
+        // were filled and read.
+        assert!(
+            compared.0 > 100 && compared.1 > 20 && compared.3 > 1000,
+            "{compared:?}"
+        );
     }
 
     #[test]

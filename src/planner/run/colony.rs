@@ -182,6 +182,9 @@ impl Run<'_, '_> {
     /// The ants walk in the same order with the same draws however the pieces cut them.
     pub(super) fn colony_piece(&mut self, mut w: Walking, on_tour: &mut dyn FnMut(&[Dir])) {
         let p = self.params;
+        // The walks read a weight table where they walk by the loop for an entry a cell (the
+        // pheromone's block shift 0, no route: `Ant::resume`).
+        let table = (self.blocks.shift() == 0 && !self.routed).then_some(self.grid.cells());
         // Every buffer an ant reads or writes (`lend::Colony`).
         let Colony {
             tau,
@@ -192,12 +195,18 @@ impl Run<'_, '_> {
             tours: [tour, iter_best, iter_worst, best],
             index: (points, links),
             guide,
-        } = self.ws.colony();
+            weights,
+        } = self.ws.colony(table);
         let moves = Moves::new(*self.grid, moves);
         let (width, height) = (self.grid.width(), self.grid.height());
         let route = guide.route(self.guide_blocks, self.goal, width, height);
         let tau = Table::new(self.blocks, tau);
         let mut delta = Table::new(self.blocks, delta);
+        if let (Some(t), false) = (&weights, w.started()) {
+            // A new iteration (the pheromone changed at the update before it, or the run began):
+            // every row is filled again from it.
+            t.clear();
+        }
         let mut ant = Ant {
             moves: &moves,
             start: self.start,
@@ -208,6 +217,7 @@ impl Run<'_, '_> {
             dead_end: p.dead_end,
             dead,
             route: self.routed.then_some(&route),
+            weights: weights.as_ref(),
             budget: u32::MAX,
         };
         let (keep_best, keep_worst) = (!iter_best.is_empty(), !iter_worst.is_empty());
