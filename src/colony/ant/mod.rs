@@ -212,7 +212,30 @@ impl Ant<'_, '_, '_> {
         left: &mut u32,
     ) -> Result<Option<Walk>, Lost> {
         let cells = self.route.is_none() && self.tau.blocks().shift() == 0;
+        if let (true, Some(table)) = (cells, self.weights) {
+            return self.resume_table(table, trail, rng, tabu, tour, left);
+        }
         self.resume_by(cells, trail, rng, tabu, tour, left)
+    }
+
+    /// [`Ant::resume`] by the loop for an entry a cell reading the weights from `table`
+    /// ([`Ant::walk_table`]).
+    #[inline(never)]
+    fn resume_table(
+        &self,
+        table: &WeightTable<'_>,
+        trail: &mut Trail,
+        rng: &mut Xoshiro128pp,
+        tabu: &mut TabuSet<'_>,
+        tour: &mut [Dir],
+        left: &mut u32,
+    ) -> Result<Option<Walk>, Lost> {
+        let alpha = self.alpha;
+        if alpha == 1.0 {
+            self.walk_table(table, trail, rng, tabu, tour, left, |t| t)
+        } else {
+            self.walk_table(table, trail, rng, tabu, tour, left, |t| pow_alpha(t, alpha))
+        }
     }
 
     /// [`Ant::resume`] by the loop for an entry a cell ([`Ant::walk_cells`], `cells`: only
@@ -230,13 +253,6 @@ impl Ant<'_, '_, '_> {
         // `pow_alpha(t, 1.0)` is `t`, so both give the same weights. Each loop is a function of
         // its own, so this one's stack frame is small and the deeper of them is the stack's need.
         let alpha = self.alpha;
-        if let (true, Some(table)) = (cells, self.weights) {
-            return if alpha == 1.0 {
-                self.walk_table(table, trail, rng, tabu, tour, left, |t| t)
-            } else {
-                self.walk_table(table, trail, rng, tabu, tour, left, |t| pow_alpha(t, alpha))
-            };
-        }
         match (cells, alpha == 1.0) {
             (true, true) => self.walk_cells(trail, rng, tabu, tour, left, |t| t),
             (true, false) => self.walk_cells(trail, rng, tabu, tour, left, |t| pow_alpha(t, alpha)),
@@ -602,7 +618,8 @@ mod tests {
         (walk, tour)
     }
 
-    /// Walk the ant in pieces of `piece` moves by one loop (`cells`: [`Ant::walk_cells`]): every
+    /// Walk the ant in pieces of `piece` moves by one loop (`cells`: [`Ant::walk_cells`], or
+    /// [`Ant::walk_table`] for an ant with a weight table; else the general one): every
     /// piece's result, the tour, the tabu set and the generator's state at the end.
     #[allow(clippy::type_complexity)]
     fn pieces(
@@ -626,7 +643,12 @@ mod tests {
         let mut out = Vec::new();
         loop {
             let mut left = piece;
-            let r = ant.resume_by(cells, &mut trail, &mut rng, &mut set, &mut tour, &mut left);
+            let r = if cells && ant.weights.is_some() {
+                // The loop reading the table (an entry a cell, no route: `resume` takes it).
+                ant.resume(&mut trail, &mut rng, &mut set, &mut tour, &mut left)
+            } else {
+                ant.resume_by(cells, &mut trail, &mut rng, &mut set, &mut tour, &mut left)
+            };
             out.push(r);
             if !matches!(r, Ok(None)) {
                 break;
