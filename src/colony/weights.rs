@@ -4,34 +4,36 @@
 //! once computed, hold for every ant of the iteration that stands on it.
 //!
 //! **What it owns.** A borrow of the words, read as eight weights a cell (an `f32`'s bits a
-//! word, row-major by cell, [`crate::map::grid::Dir`] order in a row) and then one bit a cell
-//! ([`crate::map::bitmap`]'s layout): whether the cell's row is filled. A row is filled lazily,
+//! word, row-major by cell, [`crate::map::grid::Dir`] order in a row); a row whose first word is
+//! [`UNFILLED`] (a signalling NaN, which no float operation returns) is not filled yet, so the
+//! test is one load from the row itself. A row is filled lazily,
 //! when an ant first has a choice on that cell in the iteration ([`WeightTable::row`]), by the
 //! walk loop for an entry a cell ([`crate::colony::ant`]), with exactly the float operations the
 //! loop without a table does at a move; so the walks are the same bit for bit with or without
 //! a table. [`WeightTable::clear`] forgets every row: the colony calls it when an iteration
 //! begins (the pheromone changed at the update before it, or a run began).
 //!
-//! **Guarantees.** A table is refused when its words do not hold a row and a bit for every cell
-//! of its map ([`WeightTable::of`], [`words`]); a cell beyond the table has no row (`None`: the
+//! **Guarantees.** A table is refused when its words do not hold a row for every cell of its
+//! map ([`WeightTable::of`], [`words`]); a cell beyond the table has no row (`None`: the
 //! caller computes the weights as without a table). The words are shared through [`Cell`]s, so
 //! the ant, which reads everything else by shared reference, can fill a row; nothing is
 //! allocated, no `unsafe`, no panic.
 
 use core::cell::Cell;
 
-use crate::map::bitmap;
-
 /// Weights a row holds: one a direction.
 pub const ROW: usize = 8;
 
-/// Words a table for a map of `cells` cells needs: [`ROW`] weights a cell and a bit a cell
-/// (saturating).
+/// Words a table for a map of `cells` cells needs: [`ROW`] weights a cell (saturating).
 pub const fn words(cells: usize) -> usize {
-    cells
-        .saturating_mul(ROW)
-        .saturating_add(bitmap::words(cells))
+    cells.saturating_mul(ROW)
 }
+
+/// The first word of a row not filled in this iteration: a signalling NaN's bits. A float
+/// operation never returns one (a NaN it returns is quiet), and a weight is a product, so a
+/// filled row never starts with it; were one to, the row would only be filled again with the
+/// same weights.
+pub const UNFILLED: u32 = 0x7F80_0001;
 
 /// A cell's eight weights, by direction.
 pub type Row = [Cell<u32>; ROW];
@@ -39,10 +41,8 @@ pub type Row = [Cell<u32>; ROW];
 /// The iteration's weights over lent words (see the module docs).
 #[derive(Debug)]
 pub struct WeightTable<'a> {
-    /// [`ROW`] words a cell: the weights' bits.
+    /// [`ROW`] words a cell: the weights' bits ([`UNFILLED`] first: not filled).
     rows: &'a [Cell<u32>],
-    /// A bit a cell: its row is filled.
-    filled: &'a [Cell<u32>],
 }
 
 impl<'a> WeightTable<'a> {
@@ -51,16 +51,14 @@ impl<'a> WeightTable<'a> {
     /// before the first walk.
     pub fn of(words: &'a mut [u32], cells: usize) -> Option<Self> {
         let n = cells.checked_mul(ROW)?;
-        let all = Cell::from_mut(words).as_slice_of_cells();
-        let (rows, rest) = all.split_at_checked(n)?;
-        let filled = rest.get(..bitmap::words(cells))?;
-        Some(Self { rows, filled })
+        let rows = Cell::from_mut(words).as_slice_of_cells().get(..n)?;
+        Some(Self { rows })
     }
 
     /// Forget every row (the pheromone changed): each is filled again at its next use.
     pub fn clear(&self) {
-        for w in self.filled {
-            w.set(0);
+        for first in self.rows.iter().step_by(ROW) {
+            first.set(UNFILLED);
         }
     }
 
@@ -74,23 +72,20 @@ impl<'a> WeightTable<'a> {
             .get(start..start.checked_add(ROW)?)?
             .try_into()
             .ok()?;
-        let word = self.filled.get(ci / 32)?;
-        let bit = 1u32 << (ci % 32);
-        let bits = word.get();
-        if bits & bit == 0 {
+        let [first, ..] = row;
+        if first.get() == UNFILLED {
             for (slot, w) in row.iter().zip(fill()) {
                 slot.set(w.to_bits());
             }
-            word.set(bits | bit);
         }
         Some(row)
     }
 
     /// Whether cell `ci`'s row is filled in this iteration.
     pub fn is_filled(&self, ci: usize) -> bool {
-        self.filled
-            .get(ci / 32)
-            .is_some_and(|w| w.get() & (1u32 << (ci % 32)) != 0)
+        self.rows
+            .get(ci.saturating_mul(ROW))
+            .is_some_and(|w| w.get() != UNFILLED)
     }
 }
 
@@ -106,12 +101,12 @@ mod tests {
 
     #[test]
     fn a_short_buffer_is_refused() {
-        // 40 cells: 320 weights and 2 words of bits.
-        assert_eq!(words(40), 322);
-        let mut buf = vec![0u32; 322];
+        // 40 cells: 320 weights.
+        assert_eq!(words(40), 320);
+        let mut buf = vec![0u32; 320];
         assert!(WeightTable::of(&mut buf, 40).is_some());
-        assert!(WeightTable::of(&mut buf[..321], 40).is_none());
-        assert!(WeightTable::of(&mut buf[..320], 40).is_none());
+        assert!(WeightTable::of(&mut buf[..319], 40).is_none());
+        assert!(WeightTable::of(&mut buf[..312], 40).is_none());
         assert!(WeightTable::of(&mut [], 0).is_some());
         assert!(WeightTable::of(&mut [], 1).is_none());
         assert_eq!(words(usize::MAX), usize::MAX);
@@ -119,7 +114,7 @@ mod tests {
 
     #[test]
     fn a_row_is_filled_once_an_iteration() {
-        let mut buf = vec![0xFFFF_FFFFu32; words(40)];
+        let mut buf = vec![0u32; words(40)];
         let t = WeightTable::of(&mut buf, 40).unwrap();
         t.clear();
         let mut calls = 0;

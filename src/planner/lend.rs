@@ -50,10 +50,13 @@
 use crate::colony::route;
 use crate::colony::route::RouteHeap;
 use crate::colony::tabu::TabuSet;
+#[cfg(any(feature = "alloc", test))]
 use crate::colony::weights::{self, WeightTable};
 use crate::map::grid::{Dir, FillScratch, Point};
 use crate::polish::links::PathLinks;
 
+#[cfg(any(feature = "alloc", test))]
+use super::needs::lend_weights;
 use super::needs::{detour_take, Ask, Lent, Need, Pair};
 #[cfg(doc)]
 use super::needs::{refine_take, route_take, smoothing_take, Take};
@@ -165,6 +168,7 @@ pub(super) struct Colony<'w> {
     pub(super) guide: &'w Guide<'w>,
     /// The iteration's weight table ([`Need::Weights`]), when the walks read one and the
     /// workspace has room for it; `None`: the walks compute their weights at each move.
+    #[cfg(any(feature = "alloc", test))]
     pub(super) weights: Option<WeightTable<'w>>,
 }
 
@@ -233,6 +237,15 @@ impl Spent<'_> {
     }
 }
 
+/// The colony's weight table over `words` for a map of `cells` cells, lent by
+/// [`Need::Weights`]'s rule ([`lend_weights`]). Not inlined: the colony's frame, on the device's
+/// deepest path, keeps its size (the device has no table).
+#[cfg(any(feature = "alloc", test))]
+#[inline(never)]
+fn weight_table(words: &mut [u32], ask: Ask, cells: usize) -> Option<WeightTable<'_>> {
+    WeightTable::of(lend_weights(words, ask)?, cells)
+}
+
 impl<'a> Workspace<'a> {
     /// The setup's view.
     pub(super) fn setting(&mut self) -> Setting<'_> {
@@ -251,18 +264,17 @@ impl<'a> Workspace<'a> {
     /// The colony's view; `table`: the map's cells when its walks read a weight table (the loop
     /// for an entry a cell, [`crate::colony::ant`]), lent when the workspace holds one for them.
     pub(super) fn colony(&mut self, table: Option<usize>) -> Colony<'_> {
-        let cells = table.unwrap_or(0);
-        let ask = Ask::weights(if table.is_some() {
-            weights::words(cells)
-        } else {
-            0
-        });
-        let lent = Lent::new(&mut [], &mut [], &mut [], &mut []).and_weights(self.weights);
-        let words = Need::Weights
-            .take(lent.lengths(), ask)
-            .and_then(|take| lent.take(take));
+        #[cfg(any(feature = "alloc", test))]
+        let weights = {
+            let cells = table.unwrap_or(0);
+            let words = table.map_or(0, |_| weights::words(cells));
+            weight_table(self.weights, Ask::weights(words), cells)
+        };
+        #[cfg(not(any(feature = "alloc", test)))]
+        let _ = table;
         Colony {
-            weights: words.and_then(|(w, _)| WeightTable::of(w, cells)),
+            #[cfg(any(feature = "alloc", test))]
+            weights,
             tau: self.tau,
             delta: self.delta,
             tabu: TabuSet::new(self.tabu),

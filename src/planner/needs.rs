@@ -118,7 +118,7 @@ impl Take {
 /// The idle buffers themselves, to lend what a [`Take`] says.
 pub(super) struct Lent<'x> {
     /// Indexed by [`Buf`]: each is handed out at most once.
-    bufs: [Option<&'x mut [u32]>; 5],
+    bufs: [Option<&'x mut [u32]>; 4],
 }
 
 impl<'x> Lent<'x> {
@@ -129,16 +129,8 @@ impl<'x> Lent<'x> {
         guide: &'x mut [u32],
     ) -> Self {
         Self {
-            bufs: [Some(links), Some(tabu), Some(points), Some(guide), None],
+            bufs: [Some(links), Some(tabu), Some(points), Some(guide)],
         }
-    }
-
-    /// The same buffers and the weight table's words.
-    pub(super) fn and_weights(mut self, weights: &'x mut [u32]) -> Self {
-        if let Some(slot) = self.bufs.get_mut(Buf::Weights as usize) {
-            *slot = Some(weights);
-        }
-        self
     }
 
     /// Their lengths.
@@ -154,7 +146,8 @@ impl<'x> Lent<'x> {
             tabu: len(Buf::Tabu),
             points: len(Buf::Points),
             guide: len(Buf::Guide),
-            weights: len(Buf::Weights),
+            // The weight table's words are lent by `lend_weights` alone.
+            weights: 0,
         }
     }
 
@@ -288,6 +281,25 @@ pub(super) const fn weights_take(l: Lengths, words: usize) -> Option<Take> {
     }
 }
 
+/// The weight table's `words`, lent by [`Need::Weights`]'s rule ([`weights_take`]) for
+/// [`Ask::weights`]: all of them, or `None`. Apart from [`Lent`], which lends the idle buffers of
+/// the other needs: the table is a buffer of its own, and the views that lend those (on the
+/// device's deepest frames) keep their size.
+#[cfg(any(feature = "alloc", test))]
+pub(super) fn lend_weights(words: &mut [u32], a: Ask) -> Option<&mut [u32]> {
+    let l = Lengths {
+        links: 0,
+        tabu: 0,
+        points: 0,
+        guide: 0,
+        weights: words.len(),
+    };
+    match Need::Weights.take(l, a)? {
+        Take::Whole(Buf::Weights) => Some(words),
+        _ => None,
+    }
+}
+
 /// One buffer need of a phase: what it borrows of the idle buffers, by which lending rule, and
 /// how much of it is enough. A phase's needs are a const list ([`SETUP`], [`COLONY`], [`POLISH`],
 /// all of them in [`PHASES`]); the slices a view lends ([`Need::take`], through [`Lent::take`]),
@@ -353,6 +365,7 @@ impl Ask {
     }
 
     /// The colony's weight table of `words` words (0: none).
+    #[cfg(any(feature = "alloc", test))]
     pub(super) const fn weights(words: usize) -> Self {
         Self {
             weights: words,
@@ -519,9 +532,8 @@ mod tests {
             vec![0u32; l.points],
             vec![0u32; l.guide],
         );
-        let mut e = vec![0u32; l.weights];
-        let lent = Lent::new(&mut a, &mut b, &mut c, &mut d).and_weights(&mut e);
-        assert_eq!(lent.lengths(), l);
+        let lent = Lent::new(&mut a, &mut b, &mut c, &mut d);
+        assert_eq!(lent.lengths(), Lengths { weights: 0, ..l });
         lent.take(take).map(|(x, y)| (x.len(), y.len()))
     }
 
@@ -606,9 +618,11 @@ mod tests {
             let take = Need::Weights.take(l, a);
             assert_eq!(take.is_some(), w >= 322, "{w}");
             assert_eq!(Need::Weights.enough(l, a), w >= 322, "{w}");
-            if let Some(take) = take {
-                assert_eq!(lend(l, take), Some((w, 0)));
-            }
+            assert_eq!(take, (w >= 322).then_some(Take::Whole(Buf::Weights)));
+            let mut words = vec![0u32; w];
+            let lent = lend_weights(&mut words, a).map(|x| x.len());
+            assert_eq!(lent, (w >= 322).then_some(w));
+            assert_eq!(lend_weights(&mut words, Ask::weights(0)), None);
             assert_eq!(Need::Weights.links(l, a), 0);
             assert_eq!(Need::Weights.take(l, Ask::weights(0)), None);
         }

@@ -60,7 +60,9 @@ pub struct Workspace<'a> {
     pub(super) curve: &'a mut [CurvePoint],
     /// The coarse route: a word a block, or packed ([`Workspace::with_packed_route`]).
     pub(super) guide: Guide<'a>,
-    /// The colony's weight table ([`Workspace::with_weights`]; empty: none).
+    /// The colony's weight table ([`Workspace::with_weights`]; empty: none). Only where a heap
+    /// storage can give one (feature `alloc`): a device's workspaces keep their size.
+    #[cfg(any(feature = "alloc", test))]
     pub(super) weights: &'a mut [u32],
 }
 
@@ -141,6 +143,7 @@ impl<'a> Workspace<'a> {
             links: b.links,
             curve: b.curve,
             guide: Guide::Words(b.guide),
+            #[cfg(any(feature = "alloc", test))]
             weights: &mut [],
         }
     }
@@ -158,6 +161,7 @@ impl<'a> Workspace<'a> {
     /// holds [`Workspace::weight_words`]`(cells)` words, at fewer instructions a move; otherwise
     /// they compute them at each move. The same plan bit for bit either way. The heap storage
     /// gives one; the device arenas none.
+    #[cfg(any(feature = "alloc", test))]
     pub fn with_weights(self, weights: &'a mut [u32]) -> Self {
         Workspace { weights, ..self }
     }
@@ -254,6 +258,7 @@ impl<'a> Workspace<'a> {
             links,
             curve,
             guide,
+            #[cfg(any(feature = "alloc", test))]
             weights,
         } = self;
         let (tau, _) = tau.split_at_mut(n.min(tau.len()));
@@ -277,6 +282,7 @@ impl<'a> Workspace<'a> {
             links,
             curve,
             guide,
+            #[cfg(any(feature = "alloc", test))]
             weights,
         })
     }
@@ -306,7 +312,9 @@ pub(crate) struct OwnedBuffers<Tau, Bits, Moves, Tour, Kept, Points, Links, Curv
     pub(crate) links: Links,
     pub(crate) curve: Curve,
     pub(crate) guide: Guide,
-    /// The colony's weight table (empty: none).
+    /// The colony's weight table (empty: none; lent only where a heap storage can give one,
+    /// feature `alloc`).
+    #[cfg_attr(not(any(feature = "alloc", test)), allow(dead_code))]
     pub(crate) weights: Weights,
 }
 
@@ -328,7 +336,7 @@ where
     pub(crate) fn workspace(&mut self) -> Workspace<'_> {
         let [tour, best] = &mut self.tours;
         let [iter_best, iter_worst] = &mut self.kept;
-        Workspace::new(Buffers {
+        let ws = Workspace::new(Buffers {
             tau: self.tau.as_mut(),
             delta: self.delta.as_mut(),
             tabu: self.tabu.as_mut(),
@@ -344,8 +352,10 @@ where
             links: self.links.as_mut(),
             curve: self.curve.as_mut(),
             guide: self.guide.as_mut(),
-        })
-        .with_weights(self.weights.as_mut())
+        });
+        #[cfg(any(feature = "alloc", test))]
+        let ws = ws.with_weights(self.weights.as_mut());
+        ws
     }
 }
 

@@ -6,7 +6,7 @@
 //! (every read is checked, the lints deny indexing).
 
 use super::*;
-use crate::colony::weights;
+use crate::colony::weights::{self, WeightTable};
 
 impl Ant<'_, '_, '_> {
     /// [`Ant::walk_general`] where the pheromone has an entry per cell (a map of at most
@@ -41,6 +41,7 @@ impl Ant<'_, '_, '_> {
     /// a table computes at a move, when an ant first has a choice on it in the iteration; a move
     /// then sums the open moves' weights from the row, in the same order. So the same moves and
     /// draws, bit for bit, as [`Ant::walk_cells`] (a test compares them on random maps).
+    #[cfg(any(feature = "alloc", test))]
     #[inline(never)]
     #[allow(clippy::too_many_arguments)]
     pub(super) fn walk_table(

@@ -32,6 +32,7 @@ use crate::colony::heuristic::Heuristic;
 use crate::colony::pheromone::{slot_offsets, Table};
 use crate::colony::route::Route;
 use crate::colony::tabu::TabuSet;
+#[cfg(any(feature = "alloc", test))]
 use crate::colony::weights::WeightTable;
 use crate::map::bitmap;
 use crate::map::grid::{is_diagonal, neighbour, opposite, Dir, Moves, Point, DX, DY};
@@ -132,7 +133,9 @@ pub struct Ant<'g, 't, 'h> {
     /// The iteration's weights by cell and direction ([`crate::colony::weights`]), filled as the
     /// ants first have a choice on a cell, read by the loop for an entry a cell (the pheromone's
     /// block shift 0, no route; ignored elsewhere); `None`: each move computes its weights. The
-    /// same walks either way, bit for bit.
+    /// same walks either way, bit for bit. Where a heap storage can lend one (feature `alloc`):
+    /// the device's builds carry no table, and their frames and code are as without it.
+    #[cfg(any(feature = "alloc", test))]
     pub weights: Option<&'t WeightTable<'t>>,
     /// Most moves (forward and back) the walk may make; one that needs more is abandoned
     /// ([`Lost::Budget`]). `u32::MAX`: no bound, the walk goes on until it arrives or exhausts.
@@ -212,6 +215,7 @@ impl Ant<'_, '_, '_> {
         left: &mut u32,
     ) -> Result<Option<Walk>, Lost> {
         let cells = self.route.is_none() && self.tau.blocks().shift() == 0;
+        #[cfg(any(feature = "alloc", test))]
         if let (true, Some(table)) = (cells, self.weights) {
             return self.resume_table(table, trail, rng, tabu, tour, left);
         }
@@ -220,6 +224,7 @@ impl Ant<'_, '_, '_> {
 
     /// [`Ant::resume`] by the loop for an entry a cell reading the weights from `table`
     /// ([`Ant::walk_table`]).
+    #[cfg(any(feature = "alloc", test))]
     #[inline(never)]
     fn resume_table(
         &self,

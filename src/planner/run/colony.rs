@@ -195,6 +195,7 @@ impl Run<'_, '_> {
             tours: [tour, iter_best, iter_worst, best],
             index: (points, links),
             guide,
+            #[cfg(any(feature = "alloc", test))]
             weights,
         } = self.ws.colony(table);
         let moves = Moves::new(*self.grid, moves);
@@ -202,6 +203,7 @@ impl Run<'_, '_> {
         let route = guide.route(self.guide_blocks, self.goal, width, height);
         let tau = Table::new(self.blocks, tau);
         let mut delta = Table::new(self.blocks, delta);
+        #[cfg(any(feature = "alloc", test))]
         if let (Some(t), false) = (&weights, w.started()) {
             // A new iteration (the pheromone changed at the update before it, or the run began):
             // every row is filled again from it.
@@ -217,6 +219,7 @@ impl Run<'_, '_> {
             dead_end: p.dead_end,
             dead,
             route: self.routed.then_some(&route),
+            #[cfg(any(feature = "alloc", test))]
             weights: weights.as_ref(),
             budget: u32::MAX,
         };
