@@ -3,8 +3,10 @@
 //! deposit into the increments) and the heuristic not during a plan, so a cell's eight weights,
 //! once computed, hold for every ant of the iteration that stands on it.
 //!
-//! **What it owns.** A borrow of the words, read as eight weights a cell (an `f32`'s bits a
-//! word, row-major by cell, [`crate::map::grid::Dir`] order in a row); a row whose first word is
+//! **What it owns.** A borrow of the words, read as a row of [`STRIDE`] words a cell, row-major:
+//! the cell's eight weights (an `f32`'s bits a word, [`crate::map::grid::Dir`] order), then the
+//! open-move mask of the last sum asked of the row and that sum ([`total`]: ants that stand on a
+//! cell with the same open moves, most of them, skip the sum); a row whose first word is
 //! [`UNFILLED`] (a signalling NaN, which no float operation returns) is not filled yet, so the
 //! test is one load from the row itself. A row is filled lazily,
 //! when an ant first has a choice on that cell in the iteration ([`WeightTable::row`]), by the
@@ -24,10 +26,17 @@ use core::cell::Cell;
 /// Weights a row holds: one a direction.
 pub const ROW: usize = 8;
 
-/// Words a table for a map of `cells` cells needs: [`ROW`] weights a cell (saturating).
+/// Words a row takes: its [`ROW`] weights, then the open-move mask whose sum it keeps and that
+/// sum's bits ([`total`]).
+pub const STRIDE: usize = ROW + 2;
+
+/// Words a table for a map of `cells` cells needs: [`STRIDE`] a cell (saturating).
 pub const fn words(cells: usize) -> usize {
-    cells.saturating_mul(ROW)
+    cells.saturating_mul(STRIDE)
 }
+
+/// A kept mask no open-move mask (a byte) equals: no sum kept.
+const NO_SUM: u32 = u32::MAX;
 
 /// The first word of a row not filled in this iteration: a signalling NaN's bits. A float
 /// operation never returns one (a NaN it returns is quiet), and a weight is a product, so a
@@ -36,7 +45,7 @@ pub const fn words(cells: usize) -> usize {
 pub const UNFILLED: u32 = 0x7F80_0001;
 
 /// A cell's eight weights, by direction.
-pub type Row = [Cell<u32>; ROW];
+pub type Row = [Cell<u32>; STRIDE];
 
 /// The iteration's weights over lent words (see the module docs).
 #[derive(Debug)]
@@ -50,14 +59,14 @@ impl<'a> WeightTable<'a> {
     /// hold [`words`]`(cells)`. Its rows are whatever the words held: [`WeightTable::clear`]
     /// before the first walk.
     pub fn of(words: &'a mut [u32], cells: usize) -> Option<Self> {
-        let n = cells.checked_mul(ROW)?;
+        let n = cells.checked_mul(STRIDE)?;
         let rows = Cell::from_mut(words).as_slice_of_cells().get(..n)?;
         Some(Self { rows })
     }
 
     /// Forget every row (the pheromone changed): each is filled again at its next use.
     pub fn clear(&self) {
-        for first in self.rows.iter().step_by(ROW) {
+        for first in self.rows.iter().step_by(STRIDE) {
             first.set(UNFILLED);
         }
     }
@@ -66,16 +75,19 @@ impl<'a> WeightTable<'a> {
     /// iteration has not yet; `None` beyond the table.
     #[inline(always)]
     pub fn row(&self, ci: usize, fill: impl FnOnce() -> [f32; ROW]) -> Option<&Row> {
-        let start = ci.checked_mul(ROW)?;
+        let start = ci.checked_mul(STRIDE)?;
         let row: &Row = self
             .rows
-            .get(start..start.checked_add(ROW)?)?
+            .get(start..start.checked_add(STRIDE)?)?
             .try_into()
             .ok()?;
         let [first, ..] = row;
         if first.get() == UNFILLED {
             for (slot, w) in row.iter().zip(fill()) {
                 slot.set(w.to_bits());
+            }
+            if let Some(mask) = row.get(ROW) {
+                mask.set(NO_SUM);
             }
         }
         Some(row)
@@ -84,7 +96,7 @@ impl<'a> WeightTable<'a> {
     /// Whether cell `ci`'s row is filled in this iteration.
     pub fn is_filled(&self, ci: usize) -> bool {
         self.rows
-            .get(ci.saturating_mul(ROW))
+            .get(ci.saturating_mul(STRIDE))
             .is_some_and(|w| w.get() != UNFILLED)
     }
 }
@@ -95,18 +107,33 @@ pub fn weight(row: &Row, d: usize) -> f32 {
     row.get(d & 7).map_or(0.0, |w| f32::from_bits(w.get()))
 }
 
+/// The sum of the weights of `open`'s directions in a row, lowest first: the sum the row keeps
+/// for that mask, else `sum()`'s (the running sum of those weights, lowest first), then kept.
+/// The same weights summed in the same order give the same bits, so a kept sum is the sum.
+#[inline(always)]
+pub fn total(row: &Row, open: u8, sum: impl FnOnce() -> f32) -> f32 {
+    let [.., mask, kept] = row;
+    if mask.get() == u32::from(open) {
+        return f32::from_bits(kept.get());
+    }
+    let t = sum();
+    mask.set(u32::from(open));
+    kept.set(t.to_bits());
+    t
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
     #[test]
     fn a_short_buffer_is_refused() {
-        // 40 cells: 320 weights.
-        assert_eq!(words(40), 320);
-        let mut buf = vec![0u32; 320];
+        // 40 cells: 400 words.
+        assert_eq!(words(40), 400);
+        let mut buf = vec![0u32; 400];
         assert!(WeightTable::of(&mut buf, 40).is_some());
-        assert!(WeightTable::of(&mut buf[..319], 40).is_none());
-        assert!(WeightTable::of(&mut buf[..312], 40).is_none());
+        assert!(WeightTable::of(&mut buf[..399], 40).is_none());
+        assert!(WeightTable::of(&mut buf[..390], 40).is_none());
         assert!(WeightTable::of(&mut [], 0).is_some());
         assert!(WeightTable::of(&mut [], 1).is_none());
         assert_eq!(words(usize::MAX), usize::MAX);
@@ -134,7 +161,16 @@ mod tests {
         assert_eq!(calls, 2);
         assert!(t.is_filled(33) && t.is_filled(32) && !t.is_filled(34));
         assert!(t.row(40, || [0.0; ROW]).is_none());
+        // The sum of a mask is kept until another mask is asked for, and forgotten at a refill.
+        let row = t.row(32, || [0.0; ROW]).unwrap();
+        assert_eq!(total(row, 0b11, || 5.0), 5.0);
+        assert_eq!(total(row, 0b11, || 6.0), 5.0);
+        assert_eq!(total(row, 0b101, || 7.0), 7.0);
+        assert_eq!(total(row, 0b11, || 8.0), 8.0);
         // A new iteration fills again.
+        t.clear();
+        let row = t.row(32, || [1.0; ROW]).unwrap();
+        assert_eq!(total(row, 0b11, || 9.0), 9.0);
         t.clear();
         assert!(!t.is_filled(33));
         assert_eq!(weight(t.row(33, || [4.0; ROW]).unwrap(), 7), 4.0);

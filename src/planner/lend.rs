@@ -21,7 +21,7 @@
 //! | setup: the coarse route, full words (a [`route::Route::new`] workspace) | a heap of a word a block | the links, else the tabu bit set (free until the first ant) |
 //! | setup: the coarse route, packed ([`route::pack`], the compact arena) | the route's words and its heap, a word a block each | the tabu bit set halved, else the tabu set and the links, else the links halved |
 //! | colony: tightening ([`crate::colony::tighten`]) | a cell -> position index | the links (a per-cell array or a hash table), else the links and the path cells' words together (packed keys) |
-//! | colony: the weight table (`crate::colony::weights`), where the walks read one (an entry a cell, no route) | 8 words a cell | its own buffer, whole, when it holds them (`needs::lend_weights`); else none: the walks compute their weights at each move |
+//! | colony: the weight table (`crate::colony::weights`), where the walks read one (an entry a cell, no route) | 10 words a cell | its own buffer, whole, when it holds them (`needs::lend_weights`); else none: the walks compute their weights at each move |
 //! | polish: the local search ([`crate::polish::refine`]) | two slices of [`super::run::REFINE_WORDS`] | the links and the route's words, the links and the tabu set, the tabu set and the route's words, the tabu set halved, the links halved |
 //! | polish: the local search's memo ([`crate::polish::refine::Memo`]) | [`MEMO_RECORDS`] records | the front of the pheromone increments (the smoothing's ring later, the route's stash at the far end) |
 //! | polish: the smoothing ([`crate::polish::smoothing`]) | `n` links for its shortest-path rule (fewer: the greedy rule) | the links, else the tabu set (free after the last ant and the local search) |

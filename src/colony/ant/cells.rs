@@ -171,14 +171,18 @@ impl Ant<'_, '_, '_> {
                     })
                 })
             }) {
-                // The same running sum, in the same order, as below.
-                let mut total = 0.0f32;
-                let mut m = open;
-                while m != 0 {
-                    let di = m.trailing_zeros() as usize & 7;
-                    m &= m.wrapping_sub(1);
-                    total += weights::weight(row, di);
-                }
+                // The same running sum, in the same order, as below (kept by the row for the
+                // last mask it was asked for).
+                let total = weights::total(row, open, || {
+                    let mut total = 0.0f32;
+                    let mut m = open;
+                    while m != 0 {
+                        let di = m.trailing_zeros() as usize & 7;
+                        m &= m.wrapping_sub(1);
+                        total += weights::weight(row, di);
+                    }
+                    total
+                });
                 roulette_open(rng, |di| weights::weight(row, di), open, total)
             } else {
                 let eta = self.heuristic.row(cur);

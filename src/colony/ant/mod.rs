@@ -750,9 +750,11 @@ mod tests {
             assert_eq!(cells.1, general.1, "case {case}: tour");
             assert_eq!(cells.2, general.2, "case {case}: tabu");
             assert_eq!(cells.3, general.3, "case {case}: generator");
-            // The same loop reading a weight table (its words junk until cleared): three ants of
-            // one iteration, so that rows another ant filled are read, walk as the general loop.
-            let mut words = vec![0x7FC0_0001u32; crate::colony::weights::words(g.cells())];
+            // The same loop reading a weight table (its words junk until cleared, small numbers
+            // that an open-move mask may equal): three ants of one iteration, so that rows and
+            // sums another ant filled are read, walk as the general loop.
+            let n = crate::colony::weights::words(g.cells());
+            let mut words: Vec<u32> = (0..n as u32).map(|i| i.wrapping_mul(37) % 256).collect();
             let t = WeightTable::of(&mut words, g.cells()).unwrap();
             t.clear();
             let tabled = Ant {
