@@ -8,11 +8,10 @@
 //! open-move mask of the last sum asked of the row and that sum ([`total`]: ants that stand on a
 //! cell with the same open moves, most of them, skip the sum); a row whose first word is
 //! [`UNFILLED`] (a signalling NaN, which no float operation returns) is not filled yet, so the
-//! test is one load from the row itself. A row is filled lazily,
-//! when an ant first has a choice on that cell in the iteration ([`WeightTable::row`]), by the
-//! walk loop for an entry a cell ([`crate::colony::ant`]), with exactly the float operations the
-//! loop without a table does at a move; so the walks are the same bit for bit with or without
-//! a table. [`WeightTable::clear`] forgets every row: the colony calls it when an iteration
+//! test is one load from the row itself. A row is filled lazily, when an ant first has a choice
+//! on that cell in the iteration ([`WeightTable::row`]), by the walk loop for an entry a cell
+//! ([`crate::colony::ant`]), with exactly the float operations the loop without a table does at a
+//! move; so the walks are the same bit for bit with or without a table. [`WeightTable::clear`] forgets every row: the colony calls it when an iteration
 //! begins (the pheromone changed at the update before it, or a run began).
 //!
 //! **Guarantees.** A table is refused when its words do not hold a row for every cell of its
@@ -44,13 +43,14 @@ const NO_SUM: u32 = u32::MAX;
 /// same weights.
 pub const UNFILLED: u32 = 0x7F80_0001;
 
-/// A cell's eight weights, by direction.
+/// A cell's row: its eight weights by direction, then the kept mask and sum ([`total`]).
 pub type Row = [Cell<u32>; STRIDE];
 
 /// The iteration's weights over lent words (see the module docs).
 #[derive(Debug)]
 pub struct WeightTable<'a> {
-    /// [`ROW`] words a cell: the weights' bits ([`UNFILLED`] first: not filled).
+    /// [`STRIDE`] words a cell: the weights' bits ([`UNFILLED`] first: not filled), the kept mask
+    /// and sum.
     rows: &'a [Cell<u32>],
 }
 
