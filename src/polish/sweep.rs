@@ -311,22 +311,17 @@ mod tests {
         assert!(seen > 10_000 && hidden > 10_000, "{seen} {hidden}");
     }
 
-    /// A stack too short says so.
+    /// A stack too short says so: one blocked cell splits an octant's interval in two (the
+    /// square at depth 3, column 1 hides `[1/7, 3/5]`), so the second piece has no room.
     #[test]
     fn a_short_stack_says_so() {
-        let b =
-            crate::testutil::random_bits(&mut crate::rng::Xoshiro128pp::from_u64(1), 20, 20, 0.3);
-        let g = Grid::new(20, 20, &b).unwrap();
-        let (lo, hi) = (Point::new(0, 0), Point::new(19, 19));
+        let rows = [".......", ".......", ".......", "...#...", "......."];
+        let (b, w, h) = crate::testutil::bits(&rows);
+        let g = Grid::new(w, h, &b).unwrap();
+        let (u, lo, hi) = (Point::new(0, 2), Point::new(0, 0), Point::new(w - 1, h - 1));
         let mut stack = [0u32; FRAME];
-        assert!(!sweep(
-            &g,
-            Point::new(10, 10),
-            lo,
-            hi,
-            u16::MAX,
-            &mut stack,
-            |_| ()
-        ));
+        assert!(!sweep(&g, u, lo, hi, u16::MAX, &mut stack, |_| ()));
+        let mut stack = [0u32; 2 * FRAME];
+        assert!(sweep(&g, u, lo, hi, u16::MAX, &mut stack, |_| ()));
     }
 }
