@@ -42,12 +42,18 @@ use crate::map::grid::{Grid, Point};
 /// Words a pending interval takes on [`sweep`]'s stack.
 pub const FRAME: usize = 3;
 
+/// A fraction `n / d` (`d > 0`): an end of a pending interval or of a blocked square's.
+type Frac = (i32, i32);
+
 /// Depths up to which the fractions' products fit in `i32`.
 const MAX_DEPTH: i32 = 1 << 13;
 
 /// Call `mark(i)` for every map index `i` of a free cell `v` in the box `lo..=hi` (inclusive,
-/// on the map, holding `u`), `v != u`, at depth `max(|dx|, |dy|)` at most `depth` from `u`, with
-/// `segment_clear(grid, u, v)`; and for no other index. `stack` holds the pending intervals
+/// on the map, holding `u`), `v != u`, with `segment_clear(grid, u, v)` and within the depth
+/// bound of its side; and for no other index. `depth` bounds the depth `|dx|` of the cells with
+/// `|dx| >= |dy|` (`depth[0]` those right of `u`, `depth[1]` left) and `|dy|` of those with
+/// `|dy| >= |dx|` (`depth[2]` below, `depth[3]` above); a cell on a diagonal is marked if either
+/// of its two bounds allows it. `stack` holds the pending intervals
 /// ([`FRAME`] words each); `false` when it was too short (then some visible cells may be
 /// missing) or the box is not on the map or does not hold `u`.
 pub fn sweep(
@@ -55,7 +61,7 @@ pub fn sweep(
     u: Point,
     lo: Point,
     hi: Point,
-    depth: u16,
+    depth: [u16; 4],
     stack: &mut [u32],
     mut mark: impl FnMut(usize),
 ) -> bool {
@@ -70,28 +76,33 @@ pub fn sweep(
     if x0 > ux || ux > x1 || y0 > uy || uy > y1 || x1 >= w || y1 >= h {
         return false;
     }
-    let depth = i32::from(depth).min(MAX_DEPTH);
+    let [dr_, dl_, dd_, du_] = depth.map(|d| i32::from(d).min(MAX_DEPTH));
     let base = uy.wrapping_mul(w).wrapping_add(ux);
     // Room in the box beyond `u` on each side: right, left, down, up.
-    let (right, left, down, up) = (x1 - ux, ux - x0, y1 - uy, uy - y0);
+    let (right, left, down, up) = (
+        x1.wrapping_sub(ux),
+        ux.wrapping_sub(x0),
+        y1.wrapping_sub(uy),
+        uy.wrapping_sub(y0),
+    );
     let mut ok = true;
     for (rows, cols, dr, dc) in [
         // Depth along x (columns along y), then depth along y.
-        (right, down, 1, w),
-        (right, up, 1, -w),
-        (left, down, -1, w),
-        (left, up, -1, -w),
-        (down, right, w, 1),
-        (down, left, w, -1),
-        (up, right, -w, 1),
-        (up, left, -w, -1),
+        (right.min(dr_), down, 1, w),
+        (right.min(dr_), up, 1, w.wrapping_neg()),
+        (left.min(dl_), down, -1, w),
+        (left.min(dl_), up, -1, w.wrapping_neg()),
+        (down.min(dd_), right, w, 1),
+        (down.min(dd_), left, w, -1),
+        (up.min(du_), right, w.wrapping_neg(), 1),
+        (up.min(du_), left, w.wrapping_neg(), -1),
     ] {
         let oct = Octant {
             grid,
             base,
             dr,
             dc,
-            rows: rows.min(depth),
+            rows,
             cols,
         };
         ok &= oct.sweep(stack, &mut mark);
@@ -140,19 +151,31 @@ impl Octant<'_, '_> {
             let cmin = if ln == 0 {
                 0
             } else {
-                (ln.wrapping_mul(r) / ld).wrapping_add(1)
+                ln.wrapping_mul(r)
+                    .checked_div(ld)
+                    .unwrap_or(0)
+                    .wrapping_add(1)
             };
             let cmax = if hd == 1 {
                 r
             } else {
-                (hn.wrapping_mul(r).wrapping_sub(1)) / hd
+                hn.wrapping_mul(r)
+                    .wrapping_sub(1)
+                    .checked_div(hd)
+                    .unwrap_or(0)
             };
             let row = self.base.wrapping_add(r.wrapping_mul(self.dr));
             // Blocked squares of this row whose closed interval meets the pending one lie in
             // columns `cmin - 1 ..= cmax + 1` (see the module doc: a square's interval reaches
             // less than a column beyond its own), and at most `r + 1`.
-            let (a, b) = ((cmin - 1).max(0), (cmax + 1).min(r + 1));
-            let (d_lo, d_hi) = (r.wrapping_mul(2).wrapping_add(1), r.wrapping_mul(2) - 1);
+            let (a, b) = (
+                cmin.wrapping_sub(1).max(0),
+                cmax.wrapping_add(1).min(r.wrapping_add(1)),
+            );
+            let (d_lo, d_hi) = (
+                r.wrapping_mul(2).wrapping_add(1),
+                r.wrapping_mul(2).wrapping_sub(1),
+            );
             let next = r.wrapping_add(1);
             let deeper = next <= self.rows;
             // The part of the interval not cut yet starts at `cur` (open unless 0).
@@ -161,8 +184,8 @@ impl Octant<'_, '_> {
             for c in a..=b {
                 if self.blocked(row, c) {
                     // This square hides `[(2c - 1) / (2r + 1), (2c + 1) / (2r - 1)]`.
-                    let (sn, sd) = (c.wrapping_mul(2) - 1, d_lo);
-                    let (en, ed) = (c.wrapping_mul(2) + 1, d_hi);
+                    let (sn, sd) = (c.wrapping_mul(2).wrapping_sub(1), d_lo);
+                    let (en, ed) = (c.wrapping_mul(2).wrapping_add(1), d_hi);
                     // The piece before it (its upper end open: the square's lower end), up to
                     // the interval's own upper end if that comes first.
                     let upper = if less_eq((sn, sd), (hn, hd)) {
@@ -195,19 +218,19 @@ impl Octant<'_, '_> {
 
 /// `a < b` for fractions with positive denominators.
 #[inline(always)]
-fn less(a: (i32, i32), b: (i32, i32)) -> bool {
+fn less(a: Frac, b: Frac) -> bool {
     a.0.wrapping_mul(b.1) < b.0.wrapping_mul(a.1)
 }
 
 /// `a <= b` for fractions with positive denominators.
 #[inline(always)]
-fn less_eq(a: (i32, i32), b: (i32, i32)) -> bool {
+fn less_eq(a: Frac, b: Frac) -> bool {
     a.0.wrapping_mul(b.1) <= b.0.wrapping_mul(a.1)
 }
 
 /// Push a pending interval (ends non-negative and below 2^16); `false` when `stack` is full.
 #[inline(always)]
-fn push(stack: &mut [u32], top: &mut usize, r: i32, lo: (i32, i32), hi: (i32, i32)) -> bool {
+fn push(stack: &mut [u32], top: &mut usize, r: i32, lo: Frac, hi: Frac) -> bool {
     let Some(slot) = stack.get_mut(*top..top.wrapping_add(FRAME)) else {
         return false;
     };
@@ -222,7 +245,7 @@ fn push(stack: &mut [u32], top: &mut usize, r: i32, lo: (i32, i32), hi: (i32, i3
 
 /// The last pending interval pushed, taken off `stack`.
 #[inline(always)]
-fn pop(stack: &[u32], top: &mut usize) -> Option<(i32, (i32, i32), (i32, i32))> {
+fn pop(stack: &[u32], top: &mut usize) -> Option<(i32, Frac, Frac)> {
     let from = top.checked_sub(FRAME)?;
     let [a, b, c] = *stack.get(from..*top)? else {
         return None;
@@ -269,37 +292,24 @@ mod tests {
                 )
             };
             let depth = if round % 2 == 0 {
-                u16::MAX
+                [u16::MAX; 4]
             } else {
-                pick(&mut rng, 45)
+                [0; 4].map(|_| pick(&mut rng, 45))
             };
             let mut got = vec![false; g.cells()];
             assert!(sweep(&g, u, lo, hi, depth, &mut stack, |i| got[i] = true));
-            for i in 0..g.cells() {
+            for (i, &got) in got.iter().enumerate() {
                 let v = g.point(i);
                 let inside = v.x >= lo.x && v.x <= hi.x && v.y >= lo.y && v.y <= hi.y;
-                let d = v.x.abs_diff(u.x).max(v.y.abs_diff(u.y));
-                let want =
-                    inside && v != u && d <= depth && g.is_free(v) && segment_clear(&g, u, v);
-                if got[i] != want {
-                    for y in 0..h {
-                        let row: String = (0..w)
-                            .map(|x| {
-                                if g.is_free(Point::new(x, y)) {
-                                    '.'
-                                } else {
-                                    '#'
-                                }
-                            })
-                            .collect();
-                        eprintln!("{row}");
-                    }
-                }
+                let (dx, dy) = (v.x.abs_diff(u.x), v.y.abs_diff(u.y));
+                let near = (dx >= dy && dx <= depth[usize::from(v.x < u.x)])
+                    || (dy >= dx && dy <= depth[2 + usize::from(v.y < u.y)]);
+                let want = inside && v != u && near && g.is_free(v) && segment_clear(&g, u, v);
                 assert_eq!(
-                    got[i], want,
-                    "{w}x{h} {u:?} -> {v:?} box {lo:?}..{hi:?} depth {depth}"
+                    got, want,
+                    "{w}x{h} {u:?} -> {v:?} box {lo:?}..{hi:?} depth {depth:?}"
                 );
-                if inside && v != u && d <= depth && g.is_free(v) {
+                if inside && v != u && near && g.is_free(v) {
                     if want {
                         seen += 1;
                     } else {
@@ -320,8 +330,8 @@ mod tests {
         let g = Grid::new(w, h, &b).unwrap();
         let (u, lo, hi) = (Point::new(0, 2), Point::new(0, 0), Point::new(w - 1, h - 1));
         let mut stack = [0u32; FRAME];
-        assert!(!sweep(&g, u, lo, hi, u16::MAX, &mut stack, |_| ()));
+        assert!(!sweep(&g, u, lo, hi, [u16::MAX; 4], &mut stack, |_| ()));
         let mut stack = [0u32; 2 * FRAME];
-        assert!(sweep(&g, u, lo, hi, u16::MAX, &mut stack, |_| ()));
+        assert!(sweep(&g, u, lo, hi, [u16::MAX; 4], &mut stack, |_| ()));
     }
 }
