@@ -246,7 +246,11 @@ pub fn try_shortest(
         // Mark the cells `p` sees: those a relaxation may reach. Beyond `depth` rows no cell
         // can improve: its length is at least its depth, and `gi + depth >= limit`.
         let depth = reaches(gi, limit, p, goal);
-        let swept = crate::polish::sweep::sweep(grid, p, lo, hi, depth, stack, |k| {
+        let near = crate::polish::sweep::Near {
+            goal,
+            reach: limit - gi + SLACK,
+        };
+        let swept = crate::polish::sweep::sweep(grid, p, lo, hi, depth, Some(near), stack, |k| {
             if let Some(e) = cell.get_mut(k) {
                 e.seen = stamp;
             }

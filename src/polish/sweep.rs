@@ -37,6 +37,7 @@
 //! [`FRAME`] words each (no allocation); when it is full, [`sweep`] says so (`false`) and the
 //! caller must not trust the marks (the corridor then tests its cells one by one). No panic.
 
+use crate::geometry::sqrt;
 use crate::map::grid::{Grid, Point};
 
 /// Words a pending interval takes on [`sweep`]'s stack.
@@ -53,7 +54,9 @@ const MAX_DEPTH: i32 = 1 << 13;
 /// bound of its side; and for no other index. `depth` bounds the depth `|dx|` of the cells with
 /// `|dx| >= |dy|` (`depth[0]` those right of `u`, `depth[1]` left) and `|dy|` of those with
 /// `|dy| >= |dx|` (`depth[2]` below, `depth[3]` above); a cell on a diagonal is marked if either
-/// of its two bounds allows it. `stack` holds the pending intervals
+/// of its two bounds allows it. With `near`, a cell `v` whose `|v - u| + |v - goal|` is at
+/// least `near.reach` may be left out too (a few thousandths of slack for `f32` roundings:
+/// the caller leaves more, see [`Near`]). `stack` holds the pending intervals
 /// ([`FRAME`] words each); `false` when it was too short (then some visible cells may be
 /// missing) or the box is not on the map or does not hold `u`.
 pub fn sweep(
@@ -62,6 +65,7 @@ pub fn sweep(
     lo: Point,
     hi: Point,
     depth: [u16; 4],
+    near: Option<Near>,
     stack: &mut [u32],
     mut mark: impl FnMut(usize),
 ) -> bool {
@@ -86,16 +90,24 @@ pub fn sweep(
         uy.wrapping_sub(y0),
     );
     let mut ok = true;
-    for (rows, cols, dr, dc) in [
-        // Depth along x (columns along y), then depth along y.
-        (right.min(dr_), down, 1, w),
-        (right.min(dr_), up, 1, w.wrapping_neg()),
-        (left.min(dl_), down, -1, w),
-        (left.min(dl_), up, -1, w.wrapping_neg()),
-        (down.min(dd_), right, w, 1),
-        (down.min(dd_), left, w, -1),
-        (up.min(du_), right, w.wrapping_neg(), 1),
-        (up.min(du_), left, w.wrapping_neg(), -1),
+    // The goal from `u` (x, y), and the bound (infinite: none).
+    let (gx, gy, reach) = near.map_or((0.0, 0.0, f32::INFINITY), |n| {
+        (
+            f32::from(n.goal.x) - f32::from(u.x),
+            f32::from(n.goal.y) - f32::from(u.y),
+            n.reach,
+        )
+    });
+    for (rows, cols, dr, dc, goal) in [
+        // Depth along x (columns along y), then depth along y; the goal in (depth, column).
+        (right.min(dr_), down, 1, w, (gx, gy)),
+        (right.min(dr_), up, 1, w.wrapping_neg(), (gx, -gy)),
+        (left.min(dl_), down, -1, w, (-gx, gy)),
+        (left.min(dl_), up, -1, w.wrapping_neg(), (-gx, -gy)),
+        (down.min(dd_), right, w, 1, (gy, gx)),
+        (down.min(dd_), left, w, -1, (gy, -gx)),
+        (up.min(du_), right, w.wrapping_neg(), 1, (-gy, gx)),
+        (up.min(du_), left, w.wrapping_neg(), -1, (-gy, -gx)),
     ] {
         let oct = Octant {
             grid,
@@ -104,10 +116,24 @@ pub fn sweep(
             dc,
             rows,
             cols,
+            goal,
+            reach,
         };
         ok &= oct.sweep(stack, &mut mark);
     }
     ok
+}
+
+/// The cells worth marking: those `v` with `|v - u| + |v - goal| < reach`, an ellipse around
+/// `u` and the goal. An A* relaxation from `u` at `g` improves `v` only if
+/// `g + |v - u| + |v - goal| < limit`: with `reach = limit - g + slack` ([`crate::polish::corridor`]
+/// adds an eighth of a cell), every cell left out fails the A*'s own length test.
+#[derive(Clone, Copy, Debug)]
+pub struct Near {
+    /// The goal.
+    pub goal: Point,
+    /// The bound on `|v - u| + |v - goal|`.
+    pub reach: f32,
 }
 
 /// One octant of [`sweep`]: cell `(r, c)` (depth, column) is map index `base + r dr + c dc`;
@@ -119,6 +145,10 @@ struct Octant<'g, 'b> {
     dc: i32,
     rows: i32,
     cols: i32,
+    /// The goal in (depth, column) coordinates from `u`.
+    goal: (f32, f32),
+    /// [`Near::reach`] (infinite: none).
+    reach: f32,
 }
 
 impl Octant<'_, '_> {
@@ -130,6 +160,35 @@ impl Octant<'_, '_> {
             || self
                 .grid
                 .blocked_at(row.wrapping_add(c.wrapping_mul(self.dc)) as usize)
+    }
+
+    /// Whether no cell at depth `r` or beyond with slope in `[lo, hi]` is nearer than the
+    /// reach: `f(w) = |w| + |w - goal|` grows along every ray from `u` (its derivative along
+    /// the ray is `1 + cos >= 0`), so over that sector it is least on the row-`r` slice
+    /// `(r, r s)`, `s` in `[lo, hi]`; convex along the slice, least at its minimiser over the
+    /// whole line `x = r` clamped to the slice. That minimiser is where the segment from `u` to
+    /// the goal (or to its mirror image across the line, when both lie on the same side)
+    /// crosses the line.
+    #[inline(always)]
+    fn far(&self, r: i32, lo: Frac, hi: Frac) -> bool {
+        if self.reach == f32::INFINITY {
+            return false;
+        }
+        let (ga, gc) = self.goal;
+        let rf = r as f32;
+        let tx = if ga > rf { ga } else { rf + rf - ga };
+        let (slo, shi) = (lo.0 as f32 / lo.1 as f32, hi.0 as f32 / hi.1 as f32);
+        let mut s = gc / tx;
+        if s < slo {
+            s = slo;
+        }
+        if s > shi {
+            s = shi;
+        }
+        let y = rf * s;
+        let (ex, ey) = (rf - ga, y - gc);
+        let f = sqrt(rf * rf + y * y) + sqrt(ex * ex + ey * ey);
+        f >= self.reach
     }
 
     fn sweep(&self, stack: &mut [u32], mark: &mut impl FnMut(usize)) -> bool {
@@ -146,6 +205,9 @@ impl Octant<'_, '_> {
             return false;
         }
         while let Some((r, (ln, ld), (hn, hd))) = pop(stack, &mut top) {
+            if self.far(r, (ln, ld), (hn, hd)) {
+                continue;
+            }
             // Columns whose slope lies in the interval: `c ld > ln r` (or any `c >= 0` when
             // closed at 0) and `c hd < hn r` (or `c <= r` when closed at 1).
             let cmin = if ln == 0 {
@@ -296,8 +358,13 @@ mod tests {
             } else {
                 [0; 4].map(|_| pick(&mut rng, 45))
             };
+            // Every third round, a goal and a reach: cells beyond it may be left out.
+            let reach = (round % 3 == 1).then(|| Near {
+                goal: Point::new(pick(&mut rng, w), pick(&mut rng, h)),
+                reach: (rng.next_word() % 60) as f32 + 0.5,
+            });
             let mut got = vec![false; g.cells()];
-            assert!(sweep(&g, u, lo, hi, depth, &mut stack, |i| got[i] = true));
+            assert!(sweep(&g, u, lo, hi, depth, reach, &mut stack, |i| got[i] = true));
             for (i, &got) in got.iter().enumerate() {
                 let v = g.point(i);
                 let inside = v.x >= lo.x && v.x <= hi.x && v.y >= lo.y && v.y <= hi.y;
@@ -305,6 +372,18 @@ mod tests {
                 let near = (dx >= dy && dx <= depth[usize::from(v.x < u.x)])
                     || (dy >= dx && dy <= depth[2 + usize::from(v.y < u.y)]);
                 let want = inside && v != u && near && g.is_free(v) && segment_clear(&g, u, v);
+                // Within the reach (with a thousandth's slack), a visible cell must be marked;
+                // beyond it, it may be.
+                let within = reach.is_none_or(|n| {
+                    let f = |a: Point, b: Point| {
+                        (f64::from(a.x) - f64::from(b.x)).hypot(f64::from(a.y) - f64::from(b.y))
+                    };
+                    f(v, u) + f(v, n.goal) < f64::from(n.reach) - 1e-3
+                });
+                if want && !within {
+                    assert!(!got || want, "{u:?} -> {v:?}: marked, hidden");
+                    continue;
+                }
                 assert_eq!(
                     got, want,
                     "{w}x{h} {u:?} -> {v:?} box {lo:?}..{hi:?} depth {depth:?}"
@@ -330,8 +409,26 @@ mod tests {
         let g = Grid::new(w, h, &b).unwrap();
         let (u, lo, hi) = (Point::new(0, 2), Point::new(0, 0), Point::new(w - 1, h - 1));
         let mut stack = [0u32; FRAME];
-        assert!(!sweep(&g, u, lo, hi, [u16::MAX; 4], &mut stack, |_| ()));
+        assert!(!sweep(
+            &g,
+            u,
+            lo,
+            hi,
+            [u16::MAX; 4],
+            None,
+            &mut stack,
+            |_| ()
+        ));
         let mut stack = [0u32; 2 * FRAME];
-        assert!(sweep(&g, u, lo, hi, [u16::MAX; 4], &mut stack, |_| ()));
+        assert!(sweep(
+            &g,
+            u,
+            lo,
+            hi,
+            [u16::MAX; 4],
+            None,
+            &mut stack,
+            |_| ()
+        ));
     }
 }
