@@ -180,18 +180,9 @@ pub fn try_shortest(
     // of the entries are closed: each cell is moved O(1) times on average.
     let mut live = list.len();
     let mut closed = 0usize;
-    // The live cells in runs of `RUN` (see [`Run`]), in `open`'s tail when it has room (beyond
-    // the `v` entries the open list can ever hold); without room, one run of every live cell
-    // and no bulk skips.
-    let (open, runs) = if open.len() >= v.saturating_add(runs_words(v)) {
-        open.split_at_mut(v)
-    } else {
-        (open, &mut [][..])
-    };
-    // The sweep's pending intervals beyond the runs (none: every expansion tests its cells one
-    // by one, the same marks).
-    let (runs, stack) = runs.split_at_mut(runs_words(v).min(runs.len()));
-    let mut nruns = build_runs(grid, list, live, cell, runs);
+    // The sweep's pending intervals, in `open`'s tail beyond the `v` entries the open list can
+    // ever hold (no room: every expansion tests its cells one by one, the same marks).
+    let (open, stack) = open.split_at_mut(v.min(open.len()));
     // Expansions so far: the cells the current one sees carry it in `Entry::seen`.
     let mut stamp = 0u16;
     let exact = grid.width() <= EXACT_SIDE && grid.height() <= EXACT_SIDE;
@@ -233,7 +224,6 @@ pub fn try_shortest(
                 }
             }
             (live, closed) = (k, 0);
-            nruns = build_runs(grid, list, live, cell, runs);
         }
         let p = grid.point(i);
         let limit = cell.get(t).map_or(bound, |e| e.g.min(bound));
@@ -250,7 +240,7 @@ pub fn try_shortest(
             goal,
             reach: limit - gi + SLACK,
         };
-        let swept = crate::polish::sweep::sweep(grid, p, lo, hi, depth, Some(near), stack, |k| {
+        let swept = crate::polish::sweep::sweep(grid, p, [lo, hi], depth, Some(near), stack, |k| {
             if let Some(e) = cell.get_mut(k) {
                 e.seen = stamp;
             }
@@ -268,53 +258,39 @@ pub fn try_shortest(
                 }
             }
         }
-        for r in 0..nruns {
-            let (from, to) = if runs.is_empty() {
-                (0, live)
-            } else {
-                let from = r.wrapping_mul(RUN);
-                (from, from.saturating_add(RUN).min(live))
-            };
-            let run = runs
-                .get(r.wrapping_mul(RUN_WORDS)..r.wrapping_add(1).wrapping_mul(RUN_WORDS))
-                .and_then(Run::read);
-            if run.is_some_and(|run| run.skips(p, gi, limit)) {
+        for &c in list.get(..live).unwrap_or_default() {
+            let q = unpack(c);
+            let j = grid.index(q);
+            let Some(e) = cell.get(j) else { continue };
+            // Not seen from `p`: hidden, or too far to improve (below).
+            if e.seen != stamp || e.closed() {
                 continue;
             }
-            for &c in list.get(from..to).unwrap_or_default() {
-                let q = unpack(c);
-                let j = grid.index(q);
-                let Some(e) = cell.get(j) else { continue };
-                // Not seen from `p`: hidden, or too far to improve (below).
-                if e.seen != stamp || e.closed() {
+            // On maps of sides up to `EXACT_SIDE` the length comes first: the square-root-free
+            // lower bound is never above it ([`octile_low`]), so its test adds nothing, and
+            // on the Cortex-M4F the square root is one instruction (`vsqrt.f32`), fewer than
+            // the bound's. Beyond, the bound is tested first, as it always was.
+            if !exact {
+                let low = gi + octile_low(p.x.abs_diff(q.x), p.y.abs_diff(q.y));
+                if low >= e.g || low + e.h >= limit {
                     continue;
                 }
-                // On maps of sides up to `EXACT_SIDE` the length comes first: the square-root-free
-                // lower bound is never above it ([`octile_low`]), so its test adds nothing, and
-                // on the Cortex-M4F the square root is one instruction (`vsqrt.f32`), fewer than
-                // the bound's. Beyond, the bound is tested first, as it always was.
-                if !exact {
-                    let low = gi + octile_low(p.x.abs_diff(q.x), p.y.abs_diff(q.y));
-                    if low >= e.g || low + e.h >= limit {
-                        continue;
-                    }
-                }
-                let nd = gi + distance(p, q);
-                if nd >= e.g || nd + e.h >= limit {
-                    continue;
-                }
-                let first = e.g == f32::INFINITY;
-                if let Some(e) = cell.get_mut(j) {
-                    e.g = nd;
-                    e.parent = i as u32;
-                }
-                if first {
-                    // A cell opens once (closed cells are never relaxed), so the open list
-                    // never holds more than the corridor's cells; no room left: stop.
-                    let slot = open.get_mut(open_len).ok_or(Short::List)?;
-                    *slot = j as u32;
-                    open_len = open_len.wrapping_add(1);
-                }
+            }
+            let nd = gi + distance(p, q);
+            if nd >= e.g || nd + e.h >= limit {
+                continue;
+            }
+            let first = e.g == f32::INFINITY;
+            if let Some(e) = cell.get_mut(j) {
+                e.g = nd;
+                e.parent = i as u32;
+            }
+            if first {
+                // A cell opens once (closed cells are never relaxed), so the open list
+                // never holds more than the corridor's cells; no room left: stop.
+                let slot = open.get_mut(open_len).ok_or(Short::List)?;
+                *slot = j as u32;
+                open_len = open_len.wrapping_add(1);
             }
         }
     }
@@ -346,7 +322,7 @@ pub fn try_shortest(
 /// The larger of the two square-root-free lower bounds of the length of a vector `(dx, dy)`:
 /// Chebyshev's `max(dx, dy)` and the octile diagonal's `(dx + dy) / sqrt 2`. Monotone in `dx`
 /// and in `dy` (every step rounds monotonically), so the bound of a box's nearest offset is
-/// at most the bound of any cell in it ([`Run::skips`]).
+/// at most the bound of any cell in it.
 ///
 /// Never above [`distance`] for offsets below [`EXACT_SIDE`]: there `dx^2 + dy^2` is exact in
 /// `f32` and its square root correctly rounded, `max(dx, dy)` is exact and at most the true
@@ -368,18 +344,6 @@ fn octile_low(dx: u16, dy: u16) -> f32 {
 /// Sides up to which `dx^2 + dy^2` is exact in `f32` (below 2^23), so that [`octile_low`] is
 /// never above [`distance`].
 const EXACT_SIDE: u16 = 2048;
-
-/// Live corridor cells a [`Run`] holds: consecutive entries of the live list (measured on
-/// complex-26's device plan, once the length came before the bound: 8, 16, 32, 64 and a single
-/// run give 4.16, 4.06, 4.03, 4.06 and 4.21 M instructions).
-const RUN: usize = 32;
-/// Words a [`Run`] takes in the list's scratch.
-const RUN_WORDS: usize = 3;
-
-/// Words the runs of `v` live cells take.
-fn runs_words(v: usize) -> usize {
-    v.div_ceil(RUN).saturating_mul(RUN_WORDS)
-}
 
 /// The most rows from an expanded cell at `gi` within which a cell may still improve: the
 /// largest `d` with `gi + d < limit` in `f32` (a cell at depth above it is at least that far,
@@ -444,97 +408,6 @@ fn reaches(gi: f32, limit: f32, p: Point, goal: Point) -> [u16; 4] {
         side(dy),
         side(dy.wrapping_neg()),
     ]
-}
-
-/// `RUN` consecutive live cells of the corridor's list (consecutive cells of the corridor, so
-/// near one another), with what lets an expansion skip them all at once ([`Run::skips`]):
-/// their bounding box and their least distance to the goal. A skipped run is one whose every
-/// cell the per-cell test `low + h >= limit` rejects, so the search relaxes the same edges in
-/// the same order whether runs are skipped or not.
-#[derive(Clone, Copy)]
-struct Run {
-    lo: Point,
-    hi: Point,
-    /// The least `h` of its cells.
-    hmin: f32,
-}
-
-impl Run {
-    fn read(w: &[u32]) -> Option<Self> {
-        let [lo, hi, hmin] = *w else {
-            return None;
-        };
-        Some(Self {
-            lo: unpack(lo),
-            hi: unpack(hi),
-            hmin: f32::from_bits(hmin),
-        })
-    }
-
-    fn write(&self, w: &mut [u32]) {
-        if let [lo, hi, hmin] = w {
-            *lo = pack(self.lo);
-            *hi = pack(self.hi);
-            *hmin = self.hmin.to_bits();
-        }
-    }
-
-    /// Whether no edge from `p` (at `gi`) can improve any of its cells: the lower bound from
-    /// `p` to the box ([`octile_low`] of the nearest offset, at most each cell's, and `f32`
-    /// additions round monotonically) plus the least `h` already reaches the best length known,
-    /// so each cell's own `low + h >= limit` holds too.
-    fn skips(&self, p: Point, gi: f32, limit: f32) -> bool {
-        let off = |v: u16, lo: u16, hi: u16| {
-            if v < lo {
-                lo.wrapping_sub(v)
-            } else {
-                v.saturating_sub(hi)
-            }
-        };
-        let low = gi
-            + octile_low(
-                off(p.x, self.lo.x, self.hi.x),
-                off(p.y, self.lo.y, self.hi.y),
-            );
-        low + self.hmin >= limit
-    }
-}
-
-/// Cut `list[..live]` into runs of [`RUN`] cells and write each one's [`Run`] to `runs`; returns
-/// how many runs the scan walks (one run of all `live` cells, with no record, when `runs` is
-/// too short).
-fn build_runs(
-    grid: &Grid<'_>,
-    list: &[u32],
-    live: usize,
-    cell: &[Entry],
-    runs: &mut [u32],
-) -> usize {
-    let n = live.div_ceil(RUN);
-    if runs.len() < n.saturating_mul(RUN_WORDS) {
-        return 1;
-    }
-    let cells = list.get(..live).unwrap_or_default();
-    for (chunk, words) in cells.chunks(RUN).zip(runs.chunks_exact_mut(RUN_WORDS)) {
-        let first = chunk.first().map_or(Point::new(0, 0), |&c| unpack(c));
-        let mut run = Run {
-            lo: first,
-            hi: first,
-            hmin: f32::INFINITY,
-        };
-        for &c in chunk {
-            let q = unpack(c);
-            run.lo = Point::new(run.lo.x.min(q.x), run.lo.y.min(q.y));
-            run.hi = Point::new(run.hi.x.max(q.x), run.hi.y.max(q.y));
-            if let Some(e) = cell.get(grid.index(q)) {
-                if e.h < run.hmin {
-                    run.hmin = e.h;
-                }
-            }
-        }
-        run.write(words);
-    }
-    n
 }
 
 /// A cell as one word in the corridor's list (`x` high, `y` low): no division to get it back.

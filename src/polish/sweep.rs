@@ -49,7 +49,7 @@ type Frac = (i32, i32);
 /// Depths up to which the fractions' products fit in `i32`.
 const MAX_DEPTH: i32 = 1 << 13;
 
-/// Call `mark(i)` for every map index `i` of a free cell `v` in the box `lo..=hi` (inclusive,
+/// Call `mark(i)` for every map index `i` of a free cell `v` in the box `[lo, hi]` (corners, inclusive,
 /// on the map, holding `u`), `v != u`, with `segment_clear(grid, u, v)` and within the depth
 /// bound of its side; and for no other index. `depth` bounds the depth `|dx|` of the cells with
 /// `|dx| >= |dy|` (`depth[0]` those right of `u`, `depth[1]` left) and `|dy|` of those with
@@ -62,8 +62,7 @@ const MAX_DEPTH: i32 = 1 << 13;
 pub fn sweep(
     grid: &Grid<'_>,
     u: Point,
-    lo: Point,
-    hi: Point,
+    [lo, hi]: [Point; 2],
     depth: [u16; 4],
     near: Option<Near>,
     stack: &mut [u32],
@@ -364,7 +363,9 @@ mod tests {
                 reach: (rng.next_word() % 60) as f32 + 0.5,
             });
             let mut got = vec![false; g.cells()];
-            assert!(sweep(&g, u, lo, hi, depth, reach, &mut stack, |i| got[i] = true));
+            assert!(sweep(&g, u, [lo, hi], depth, reach, &mut stack, |i| got
+                [i] =
+                true));
             for (i, &got) in got.iter().enumerate() {
                 let v = g.point(i);
                 let inside = v.x >= lo.x && v.x <= hi.x && v.y >= lo.y && v.y <= hi.y;
@@ -412,8 +413,7 @@ mod tests {
         assert!(!sweep(
             &g,
             u,
-            lo,
-            hi,
+            [lo, hi],
             [u16::MAX; 4],
             None,
             &mut stack,
@@ -423,8 +423,7 @@ mod tests {
         assert!(sweep(
             &g,
             u,
-            lo,
-            hi,
+            [lo, hi],
             [u16::MAX; 4],
             None,
             &mut stack,
