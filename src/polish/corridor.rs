@@ -16,16 +16,19 @@
 //! What it cannot fix is a corridor on the other side of an obstacle: the any-angle optimum may go
 //! around an obstacle the 8-connected optimum passes on the other side.
 //!
-//! Cost: for `V` corridor cells (at most the map's cells) and `E` expanded ones, `O(E V)` cheap
-//! steps (each expansion scans the open list and the live corridor cells, each with its length:
-//! one `vsqrt.f32` on the device) and a segment test per improving edge. The segment tests were the cost
-//! (10,058 walks on complex-26, 2.7 M of 4.4 M host instructions): `Shadows` remembers blocked
-//! cells, per corridor cell ([`Entry::shade`]) and the last few found, and an edge whose segment
-//! touches one is blocked without a walk (756 walks left; `docs/ALGORITHM.md`, "Its cost, and the
-//! shadows"). The live cells are scanned in runs of `RUN` (`Run`): a run whose bounding box
-//! cannot beat the best length known (its lower bound plus its least `h`) is skipped whole, in
-//! the list's tail when it has room ("Runs, and what is left"). It runs on maps of at most [`crate::colony::pheromone::BLOCKS`] cells, whose per-cell
-//! pheromone increments lend the per-cell scratch (`g`, parent, flags, shade).
+//! Cost: for `V` corridor cells (at most the map's cells) and `E` expanded ones, each
+//! expansion scans the open list and the live corridor cells. Which of those its cell sees is
+//! not tested one candidate at a time (on complex-26, 10,058 candidates past the length
+//! bounds, 9,706 of them hidden): one sweep from the expanded cell
+//! ([`crate::polish::sweep`], shadowcasting over the corridor's bounding box, exactly
+//! [`segment_clear`]'s rule) stamps the cells it sees with the expansion's number
+//! ([`Entry::seen`]), leaving out the rows and sectors where no cell can improve (the A*'s own
+//! length test, with an eighth of a cell of slack: `reaches`, [`crate::polish::sweep::Near`]).
+//! The scan reads the stamp first, then the length (one `vsqrt.f32` on the device) of the few
+//! stamped cells. The sweep's pending intervals live in the list's tail; without room, each
+//! expansion stamps its improving candidates by one [`segment_clear`] each (the same stamps).
+//! It runs on maps of at most [`crate::colony::pheromone::BLOCKS`] cells, whose per-cell
+//! pheromone increments lend the per-cell scratch (`g`, parent, flags, stamp).
 //!
 //! Guarantees: the result is never longer than the input (the input's vertices lie in the
 //! corridor, and the input is replaced only by a strictly shorter path), every segment obeys the
@@ -118,7 +121,7 @@ impl fmt::Display for Short {
 /// point count. `pts` beyond `n` is room for a new path of more points than the input (the
 /// planner's path buffer has the raw path's length); `cell` is scratch of one entry per map cell,
 /// `list` scratch for the corridor's cells and its open ones (at most twice the corridor's cells;
-/// with 3 words per 16 cells more the scan skips runs of cells, the same path faster).
+/// beyond that, room for the sweep's pending intervals, 3 words each: the same path faster).
 /// Any of them too short leaves the path unchanged ([`try_shortest`] says which).
 pub fn shortest(
     grid: &Grid<'_>,
