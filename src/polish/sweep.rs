@@ -2,10 +2,11 @@
 //! exactly [`crate::geometry::segment_clear`]'s rule, for the corridor search
 //! ([`crate::polish::corridor`]).
 //!
-//! [`sweep`] reports (by map index, through a callback) every free cell `v` of a box, at depth
-//! (Chebyshev distance) at most a bound from a cell `u` of the box, whose segment from `u`'s
-//! centre touches no blocked or off-map cell's closed square; and only those. Each cell may be
-//! reported more than once (the octants share their borders).
+//! [`sweep`] reports (by map index, through a callback) every free cell `v` of a box, within
+//! depth bounds (and, with [`Near`], within an ellipse around `u` and a goal) from a free cell
+//! `u` of the box, whose segment from `u`'s centre touches no blocked or off-map cell's closed
+//! square; and never a cell whose segment does. Each cell may be reported more than once (the
+//! octants share their borders).
 //!
 //! **Why it is exact.** Put `u` at the origin and take one octant: depth `r = |dx| >= |dy| = c`
 //! (the other seven by reflection), slope `s = c / r` in `[0, 1]`, cell centres at integer points
@@ -22,7 +23,11 @@
 //! target `(r, c)` is visible iff `c / r` lies in no closed interval of a blocked square of rows
 //! `1..r`, and, when `c = r`, `(0, 1)` and `(r, r - 1)` are free. The sweep keeps that set, a
 //! union of intervals, row after row: the interval `[0, 1]`, cut by each blocked square's
-//! closed interval (so every end it leaves is open, except 0 and 1 uncut). All of it in
+//! closed interval (so every end it leaves is open, except 0 and 1 uncut). In row `r` a pending
+//! interval covers the columns `cmin..=cmax` whose slopes lie in it; a blocked square meets it
+//! only in columns `cmin - 1 ..= cmax + 1`: the square of column `cmin - 2` or less ends at
+//! `(2 cmin - 3) / (2r - 1) <= (cmin - 1) / r` (as `cmin <= r + 1`), at or below the interval's
+//! open lower end, and symmetrically above. All of it in
 //! integers: an end is a fraction `n / d` of the forms above, compared by cross-multiplication
 //! (depths below 2^13: every product below 2^27).
 //!
