@@ -68,9 +68,9 @@ pub struct Entry {
     pub h: f32,
     /// `CANDIDATE` (in the corridor) and `CLOSED` (expanded) bits.
     pub flags: u16,
-    /// The expansion (a count from 1) whose cell last saw this one ([`crate::polish::sweep`]);
-    /// 0: none yet.
-    pub seen: u16,
+    /// Its position in the live list (set when listed, and at each compaction): its bit in
+    /// the bitmap of the cells an expansion sees.
+    pub pos: u16,
 }
 
 impl Entry {
@@ -80,7 +80,7 @@ impl Entry {
         parent: 0,
         h: 0.0,
         flags: 0,
-        seen: 0,
+        pos: 0,
     };
 
     fn closed(&self) -> bool {
@@ -183,11 +183,16 @@ pub fn try_shortest(
     // of the entries are closed: each cell is moved O(1) times on average.
     let mut live = list.len();
     let mut closed = 0usize;
-    // The sweep's pending intervals, in `open`'s tail beyond the `v` entries the open list can
-    // ever hold (no room: every expansion tests its cells one by one, the same marks).
-    let (open, stack) = open.split_at_mut(v.min(open.len()));
-    // Expansions so far: the cells the current one sees carry it in `Entry::seen`.
-    let mut stamp = 0u16;
+    // In `open`'s tail beyond the `v` entries the open list can ever hold: a bit a live
+    // position (the cells an expansion sees), then the sweep's pending intervals. No room for
+    // the bits: every expansion tests its improving cells one by one.
+    let (open, rest) = open.split_at_mut(v.min(open.len()));
+    let words = v.div_ceil(32);
+    let (seen, stack) = if rest.len() >= words && v <= 1 << 16 {
+        rest.split_at_mut(words)
+    } else {
+        (&mut [][..], rest)
+    };
     let exact = grid.width() <= EXACT_SIDE && grid.height() <= EXACT_SIDE;
     // A*: expand the open cell of least g + h (the first one on ties) until the goal closes.
     while open_len > 0 {
@@ -218,8 +223,11 @@ pub fn try_shortest(
             let mut k = 0usize;
             for r in 0..live {
                 let Some(&c) = list.get(r) else { break };
-                let shut = cell.get(grid.index(unpack(c))).is_none_or(Entry::closed);
-                if !shut {
+                let Some(e) = cell.get_mut(grid.index(unpack(c))) else {
+                    continue;
+                };
+                if !e.closed() {
+                    e.pos = k as u16; // < v <= 2^16 when the bits are used
                     if let Some(slot) = list.get_mut(k) {
                         *slot = c;
                     }
@@ -230,70 +238,76 @@ pub fn try_shortest(
         }
         let p = grid.point(i);
         let limit = cell.get(t).map_or(bound, |e| e.g.min(bound));
-        if stamp == u16::MAX {
-            // (Never on the corridor's maps: fewer expansions than cells.)
-            cell.iter_mut().for_each(|e| e.seen = 0);
-            stamp = 0;
-        }
-        stamp = stamp.wrapping_add(1);
-        // Mark the cells `p` sees: those a relaxation may reach. Beyond `depth` rows no cell
-        // can improve: its length is at least its depth, and `gi + depth >= limit`.
+        // Mark the cells `p` sees: those a relaxation may reach (below). Beyond `depth` rows
+        // and outside the ellipse no cell can improve.
         let depth = reaches(gi, limit, p, goal);
         let near = crate::polish::sweep::Near {
             goal,
             reach: limit - gi + SLACK,
         };
-        let swept = crate::polish::sweep::sweep(grid, p, [lo, hi], depth, Some(near), stack, |k| {
-            if let Some(e) = cell.get_mut(k) {
-                e.seen = stamp;
-            }
-        });
-        if !swept {
-            // The stack was too short: mark each improving candidate by its own test.
-            for &c in list.get(..live).unwrap_or_default() {
+        let nw = live.div_ceil(32);
+        let marked = !seen.is_empty() && {
+            seen.iter_mut().take(nw).for_each(|w| *w = 0);
+            crate::polish::sweep::sweep(grid, p, [lo, hi], depth, Some(near), stack, |k| {
+                if let Some(e) = cell.get(k) {
+                    if e.flags & (CANDIDATE | CLOSED) == CANDIDATE {
+                        let b = usize::from(e.pos);
+                        if let Some(w) = seen.get_mut(b >> 5) {
+                            *w |= 1 << (b & 31);
+                        }
+                    }
+                }
+            })
+        };
+        // The live cells in the list's order (the ties): the seen ones, or (not `marked`: no
+        // room, or the sweep's stack was too short) all of them, each tested below.
+        for wi in 0..nw {
+            let mut bits = if marked {
+                seen.get(wi).copied().unwrap_or(0)
+            } else if wi.wrapping_add(1).wrapping_mul(32) <= live {
+                u32::MAX
+            } else {
+                u32::MAX >> (32usize.wrapping_sub(live & 31) & 31)
+            };
+            while bits != 0 {
+                let b = (wi << 5) | bits.trailing_zeros() as usize;
+                bits &= bits.wrapping_sub(1);
+                let Some(&c) = list.get(b) else { break };
                 let q = unpack(c);
-                let Some(e) = cell.get_mut(grid.index(q)) else {
+                let j = grid.index(q);
+                let Some(e) = cell.get(j) else { continue };
+                if e.closed() {
                     continue;
-                };
+                }
+                // On maps of sides up to `EXACT_SIDE` the length comes first: the square-root-free
+                // lower bound is never above it ([`octile_low`]), so its test adds nothing, and
+                // on the Cortex-M4F the square root is one instruction (`vsqrt.f32`), fewer than
+                // the bound's. Beyond, the bound is tested first, as it always was.
+                if !exact {
+                    let low = gi + octile_low(p.x.abs_diff(q.x), p.y.abs_diff(q.y));
+                    if low >= e.g || low + e.h >= limit {
+                        continue;
+                    }
+                }
                 let nd = gi + distance(p, q);
-                if !e.closed() && nd < e.g && nd + e.h < limit && segment_clear(grid, p, q) {
-                    e.seen = stamp;
-                }
-            }
-        }
-        for &c in list.get(..live).unwrap_or_default() {
-            let q = unpack(c);
-            let j = grid.index(q);
-            let Some(e) = cell.get(j) else { continue };
-            // Not seen from `p`: hidden, or too far to improve (below).
-            if e.seen != stamp || e.closed() {
-                continue;
-            }
-            // On maps of sides up to `EXACT_SIDE` the length comes first: the square-root-free
-            // lower bound is never above it ([`octile_low`]), so its test adds nothing, and
-            // on the Cortex-M4F the square root is one instruction (`vsqrt.f32`), fewer than
-            // the bound's. Beyond, the bound is tested first, as it always was.
-            if !exact {
-                let low = gi + octile_low(p.x.abs_diff(q.x), p.y.abs_diff(q.y));
-                if low >= e.g || low + e.h >= limit {
+                if nd >= e.g || nd + e.h >= limit {
                     continue;
                 }
-            }
-            let nd = gi + distance(p, q);
-            if nd >= e.g || nd + e.h >= limit {
-                continue;
-            }
-            let first = e.g == f32::INFINITY;
-            if let Some(e) = cell.get_mut(j) {
-                e.g = nd;
-                e.parent = i as u32;
-            }
-            if first {
-                // A cell opens once (closed cells are never relaxed), so the open list
-                // never holds more than the corridor's cells; no room left: stop.
-                let slot = open.get_mut(open_len).ok_or(Short::List)?;
-                *slot = j as u32;
-                open_len = open_len.wrapping_add(1);
+                if !marked && !segment_clear(grid, p, q) {
+                    continue;
+                }
+                let first = e.g == f32::INFINITY;
+                if let Some(e) = cell.get_mut(j) {
+                    e.g = nd;
+                    e.parent = i as u32;
+                }
+                if first {
+                    // A cell opens once (closed cells are never relaxed), so the open list
+                    // never holds more than the corridor's cells; no room left: stop.
+                    let slot = open.get_mut(open_len).ok_or(Short::List)?;
+                    *slot = j as u32;
+                    open_len = open_len.wrapping_add(1);
+                }
             }
         }
     }
@@ -467,6 +481,7 @@ fn mark(
                         continue;
                     }
                     e.flags = CANDIDATE;
+                    e.pos = v as u16; // < v <= 2^16 when the bits are used
                     *list.get_mut(v)? = pack(q);
                     v = v.wrapping_add(1); // < list.len(): the slot existed
                 }
