@@ -21,14 +21,16 @@
 //! not tested one candidate at a time (on complex-26, 10,058 candidates past the length
 //! bounds, 9,706 of them hidden): one sweep from the expanded cell
 //! ([`crate::polish::sweep`], shadowcasting over the corridor's bounding box, exactly
-//! [`segment_clear`]'s rule) stamps the cells it sees with the expansion's number
-//! ([`Entry::seen`]), leaving out the rows and sectors where no cell can improve (the A*'s own
-//! length test, with an eighth of a cell of slack: `reaches`, [`crate::polish::sweep::Near`]).
-//! The scan reads the stamp first, then the length (one `vsqrt.f32` on the device) of the few
-//! stamped cells. The sweep's pending intervals live in the list's tail; without room, each
-//! expansion stamps its improving candidates by one [`segment_clear`] each (the same stamps).
+//! [`segment_clear`]'s rule) sets the bits of the corridor cells it sees in a bitmap of
+//! live-list positions ([`Entry::pos`]), leaving out the rows and sectors where no cell can
+//! improve (the A*'s own length test, with an eighth of a cell of slack: `reaches`,
+//! [`crate::polish::sweep::Near`]). The scan walks the set bits in the list's order (the same
+//! ties as a scan of every live cell) and takes the length (one `vsqrt.f32` on the device) of
+//! those cells only. The bitmap and the sweep's pending intervals live in the list's tail;
+//! without room (or when the sweep's stack runs out), the expansion tests every live cell's
+//! improving edge by one [`segment_clear`] each: the same relaxations.
 //! It runs on maps of at most [`crate::colony::pheromone::BLOCKS`] cells, whose per-cell
-//! pheromone increments lend the per-cell scratch (`g`, parent, flags, stamp).
+//! pheromone increments lend the per-cell scratch (`g`, parent, flags, position).
 //!
 //! Guarantees: the result is never longer than the input (the input's vertices lie in the
 //! corridor, and the input is replaced only by a strictly shorter path), every segment obeys the
@@ -121,7 +123,8 @@ impl fmt::Display for Short {
 /// point count. `pts` beyond `n` is room for a new path of more points than the input (the
 /// planner's path buffer has the raw path's length); `cell` is scratch of one entry per map cell,
 /// `list` scratch for the corridor's cells and its open ones (at most twice the corridor's cells;
-/// beyond that, room for the sweep's pending intervals, 3 words each: the same path faster).
+/// beyond that, one bit a corridor cell and room for the sweep's pending intervals, 3 words
+/// each: the same path faster).
 /// Any of them too short leaves the path unchanged ([`try_shortest`] says which).
 pub fn shortest(
     grid: &Grid<'_>,
