@@ -9,4 +9,5 @@ pub mod corridor;
 pub mod links;
 pub mod refine;
 pub mod smoothing;
+pub mod sweep;
 pub mod taut;

@@ -1,0 +1,438 @@
+//! The cells a cell sees, found by one sweep (shadowcasting) instead of one segment test each:
+//! exactly [`crate::geometry::segment_clear`]'s rule, for the corridor search
+//! ([`crate::polish::corridor`]).
+//!
+//! [`sweep`] reports (by map index, through a callback) every free cell `v` of a box, within
+//! depth bounds (and, with [`Near`], within an ellipse around `u` and a goal) from a free cell
+//! `u` of the box, whose segment from `u`'s centre touches no blocked or off-map cell's closed
+//! square; and never a cell whose segment does. Each cell may be reported more than once (the
+//! octants share their borders).
+//!
+//! **Why it is exact.** Put `u` at the origin and take one octant: depth `r = |dx| >= |dy| = c`
+//! (the other seven by reflection), slope `s = c / r` in `[0, 1]`, cell centres at integer points
+//! and cell squares of side 1 around them. A square at depth `r' >= 1`, column `c' >= 0`, meets
+//! the ray of slope `s` (from the origin, `x > 0`) iff some corner lies on or below the ray and
+//! some on or above it, i.e. iff `s` is in the closed interval of its corner slopes
+//! `[(2c' - 1) / (2r' + 1), (2c' + 1) / (2r' - 1)]` (for `c' = 0` the lower end is below 0;
+//! columns `c' < 0` lie wholly below slope 0 and columns `c' > r' + 1` wholly above 1). For a
+//! target at depth `r >= r' + 1` the segment covers `x` in `[0, r]`, beyond the square's
+//! `[r' - 1/2, r' + 1/2]`, so the segment touches the square iff the ray does. The squares of
+//! the target's own row `r` (other than its own) and of `u`'s row 0 are touched only through a
+//! corner on the exact diagonal `s = 1`: cells `(r, r - 1)` and `(0, 1)` (the segment covers
+//! `y` in `[c - s / 2, c]` within row `r`'s band, and `[0, s / 2]` within row 0's). So a free
+//! target `(r, c)` is visible iff `c / r` lies in no closed interval of a blocked square of rows
+//! `1..r`, and, when `c = r`, `(0, 1)` and `(r, r - 1)` are free. The sweep keeps that set, a
+//! union of intervals, row after row: the interval `[0, 1]`, cut by each blocked square's
+//! closed interval (so every end it leaves is open, except 0 and 1 uncut). In row `r` a pending
+//! interval covers the columns `cmin..=cmax` whose slopes lie in it; a blocked square meets it
+//! only in columns `cmin - 1 ..= cmax + 1`: the square of column `cmin - 2` or less ends at
+//! `(2 cmin - 3) / (2r - 1) <= (cmin - 1) / r` (as `cmin <= r + 1`), at or below the interval's
+//! open lower end, and symmetrically above. All of it in
+//! integers: an end is a fraction `n / d` of the forms above, compared by cross-multiplication
+//! (depths below 2^13: every product below 2^27).
+//!
+//! Cells outside the box count as blocked: with both `u` and `v` in the box, every cell the
+//! segment touches lies in the box they span (the segment runs between their centres), so a
+//! cell outside it never decides a target inside it. So the box bounds the sweep, and the
+//! off-map cells of `segment_clear` are outside every box on the map.
+//!
+//! **Cost.** Each pending interval scans the cells of its row it covers, plus one cell each
+//! side (a blocked square's interval reaches half a column beyond its own slope); a hidden
+//! region costs nothing. The pending intervals live on a caller's stack of
+//! [`FRAME`] words each (no allocation); when it is full, [`sweep`] says so (`false`) and the
+//! caller must not trust the marks (the corridor then tests its cells one by one). No panic.
+
+use crate::geometry::sqrt;
+use crate::map::grid::{Grid, Point};
+
+/// Words a pending interval takes on [`sweep`]'s stack.
+pub const FRAME: usize = 3;
+
+/// A fraction `n / d` (`d > 0`): an end of a pending interval or of a blocked square's.
+type Frac = (i32, i32);
+
+/// Depths up to which the fractions' products fit in `i32`.
+const MAX_DEPTH: i32 = 1 << 13;
+
+/// Call `mark(i)` for every map index `i` of a free cell `v` in the box `[lo, hi]` (corners, inclusive,
+/// on the map, holding `u`), `v != u`, with `segment_clear(grid, u, v)` and within the depth
+/// bound of its side; and for no other index. `depth` bounds the depth `|dx|` of the cells with
+/// `|dx| >= |dy|` (`depth[0]` those right of `u`, `depth[1]` left) and `|dy|` of those with
+/// `|dy| >= |dx|` (`depth[2]` below, `depth[3]` above); a cell on a diagonal is marked if either
+/// of its two bounds allows it. With `near`, a cell `v` whose `|v - u| + |v - goal|` is at
+/// least `near.reach` may be left out too (a few thousandths of slack for `f32` roundings:
+/// the caller leaves more, see [`Near`]). `stack` holds the pending intervals
+/// ([`FRAME`] words each); `false` when it was too short (then some visible cells may be
+/// missing) or the box is not on the map or does not hold `u`.
+pub fn sweep(
+    grid: &Grid<'_>,
+    u: Point,
+    [lo, hi]: [Point; 2],
+    depth: [u16; 4],
+    near: Option<Near>,
+    stack: &mut [u32],
+    mut mark: impl FnMut(usize),
+) -> bool {
+    let (w, h) = (i32::from(grid.width()), i32::from(grid.height()));
+    let (ux, uy) = (i32::from(u.x), i32::from(u.y));
+    let (x0, y0, x1, y1) = (
+        i32::from(lo.x),
+        i32::from(lo.y),
+        i32::from(hi.x),
+        i32::from(hi.y),
+    );
+    if x0 > ux || ux > x1 || y0 > uy || uy > y1 || x1 >= w || y1 >= h {
+        return false;
+    }
+    let [dr_, dl_, dd_, du_] = depth.map(|d| i32::from(d).min(MAX_DEPTH));
+    let base = uy.wrapping_mul(w).wrapping_add(ux);
+    // Room in the box beyond `u` on each side: right, left, down, up.
+    let (right, left, down, up) = (
+        x1.wrapping_sub(ux),
+        ux.wrapping_sub(x0),
+        y1.wrapping_sub(uy),
+        uy.wrapping_sub(y0),
+    );
+    let mut ok = true;
+    // The goal from `u` (x, y), and the bound (infinite: none).
+    let (gx, gy, reach) = near.map_or((0.0, 0.0, f32::INFINITY), |n| {
+        (
+            f32::from(n.goal.x) - f32::from(u.x),
+            f32::from(n.goal.y) - f32::from(u.y),
+            n.reach,
+        )
+    });
+    for (rows, cols, dr, dc, goal) in [
+        // Depth along x (columns along y), then depth along y; the goal in (depth, column).
+        (right.min(dr_), down, 1, w, (gx, gy)),
+        (right.min(dr_), up, 1, w.wrapping_neg(), (gx, -gy)),
+        (left.min(dl_), down, -1, w, (-gx, gy)),
+        (left.min(dl_), up, -1, w.wrapping_neg(), (-gx, -gy)),
+        (down.min(dd_), right, w, 1, (gy, gx)),
+        (down.min(dd_), left, w, -1, (gy, -gx)),
+        (up.min(du_), right, w.wrapping_neg(), 1, (-gy, gx)),
+        (up.min(du_), left, w.wrapping_neg(), -1, (-gy, -gx)),
+    ] {
+        let oct = Octant {
+            grid,
+            base,
+            dr,
+            dc,
+            rows,
+            cols,
+            goal,
+            reach,
+        };
+        ok &= oct.sweep(stack, &mut mark);
+    }
+    ok
+}
+
+/// The cells worth marking: those `v` with `|v - u| + |v - goal| < reach`, an ellipse around
+/// `u` and the goal. An A* relaxation from `u` at `g` improves `v` only if
+/// `g + |v - u| + |v - goal| < limit`: with `reach = limit - g + slack` ([`crate::polish::corridor`]
+/// adds an eighth of a cell), every cell left out fails the A*'s own length test.
+#[derive(Clone, Copy, Debug)]
+pub struct Near {
+    /// The goal.
+    pub goal: Point,
+    /// The bound on `|v - u| + |v - goal|`.
+    pub reach: f32,
+}
+
+/// One octant of [`sweep`]: cell `(r, c)` (depth, column) is map index `base + r dr + c dc`;
+/// rows beyond `rows` are not swept, columns beyond `cols` are outside the box (blocked).
+struct Octant<'g, 'b> {
+    grid: &'g Grid<'b>,
+    base: i32,
+    dr: i32,
+    dc: i32,
+    rows: i32,
+    cols: i32,
+    /// The goal in (depth, column) coordinates from `u`.
+    goal: (f32, f32),
+    /// [`Near::reach`] (infinite: none).
+    reach: f32,
+}
+
+impl Octant<'_, '_> {
+    /// Whether cell `(r, c)` (`0 <= c`) blocks: outside the box, or blocked on the map.
+    #[inline(always)]
+    fn blocked(&self, row: i32, c: i32) -> bool {
+        // In the box: the index is on the map, non-negative.
+        c > self.cols
+            || self
+                .grid
+                .blocked_at(row.wrapping_add(c.wrapping_mul(self.dc)) as usize)
+    }
+
+    /// Whether no cell at depth `r` or beyond with slope in `[lo, hi]` is nearer than the
+    /// reach: `f(w) = |w| + |w - goal|` grows along every ray from `u` (its derivative along
+    /// the ray is `1 + cos >= 0`), so over that sector it is least on the row-`r` slice
+    /// `(r, r s)`, `s` in `[lo, hi]`; convex along the slice, least at its minimiser over the
+    /// whole line `x = r` clamped to the slice. That minimiser is where the segment from `u` to
+    /// the goal (or to its mirror image across the line, when both lie on the same side)
+    /// crosses the line.
+    #[inline(always)]
+    fn far(&self, r: i32, lo: Frac, hi: Frac) -> bool {
+        if self.reach == f32::INFINITY {
+            return false;
+        }
+        let (ga, gc) = self.goal;
+        let rf = r as f32;
+        let tx = if ga > rf { ga } else { rf + rf - ga };
+        let (slo, shi) = (lo.0 as f32 / lo.1 as f32, hi.0 as f32 / hi.1 as f32);
+        let mut s = gc / tx;
+        if s < slo {
+            s = slo;
+        }
+        if s > shi {
+            s = shi;
+        }
+        let y = rf * s;
+        let (ex, ey) = (rf - ga, y - gc);
+        let f = sqrt(rf * rf + y * y) + sqrt(ex * ex + ey * ey);
+        f >= self.reach
+    }
+
+    fn sweep(&self, stack: &mut [u32], mark: &mut impl FnMut(usize)) -> bool {
+        if self.rows < 1 {
+            return true;
+        }
+        // The diagonal also needs `(0, 1)` free (it passes its corner).
+        let diag = !self.blocked(self.base, 1);
+        // A pending interval: its row, its lower end `ln / ld` (closed iff `ln == 0`: the
+        // uncut 0) and its upper end `hn / hd` (closed iff `hd == 1`: the uncut 1); ends are
+        // non-negative and below 2^16.
+        let mut top = 0usize;
+        if !push(stack, &mut top, 1, (0, 1), (1, 1)) {
+            return false;
+        }
+        while let Some((r, (ln, ld), (hn, hd))) = pop(stack, &mut top) {
+            if self.far(r, (ln, ld), (hn, hd)) {
+                continue;
+            }
+            // Columns whose slope lies in the interval: `c ld > ln r` (or any `c >= 0` when
+            // closed at 0) and `c hd < hn r` (or `c <= r` when closed at 1).
+            let cmin = if ln == 0 {
+                0
+            } else {
+                ln.wrapping_mul(r)
+                    .checked_div(ld)
+                    .unwrap_or(0)
+                    .wrapping_add(1)
+            };
+            let cmax = if hd == 1 {
+                r
+            } else {
+                hn.wrapping_mul(r)
+                    .wrapping_sub(1)
+                    .checked_div(hd)
+                    .unwrap_or(0)
+            };
+            let row = self.base.wrapping_add(r.wrapping_mul(self.dr));
+            // Blocked squares of this row whose closed interval meets the pending one lie in
+            // columns `cmin - 1 ..= cmax + 1` (see the module doc: a square's interval reaches
+            // less than a column beyond its own), and at most `r + 1`.
+            let (a, b) = (
+                cmin.wrapping_sub(1).max(0),
+                cmax.wrapping_add(1).min(r.wrapping_add(1)),
+            );
+            let (d_lo, d_hi) = (
+                r.wrapping_mul(2).wrapping_add(1),
+                r.wrapping_mul(2).wrapping_sub(1),
+            );
+            let next = r.wrapping_add(1);
+            let deeper = next <= self.rows;
+            // The part of the interval not cut yet starts at `cur` (open unless 0).
+            let mut cur = (ln, ld);
+            let mut prev_blocked = false;
+            for c in a..=b {
+                if self.blocked(row, c) {
+                    // This square hides `[(2c - 1) / (2r + 1), (2c + 1) / (2r - 1)]`.
+                    let (sn, sd) = (c.wrapping_mul(2).wrapping_sub(1), d_lo);
+                    let (en, ed) = (c.wrapping_mul(2).wrapping_add(1), d_hi);
+                    // The piece before it (its upper end open: the square's lower end), up to
+                    // the interval's own upper end if that comes first.
+                    let upper = if less_eq((sn, sd), (hn, hd)) {
+                        (sn, sd)
+                    } else {
+                        (hn, hd)
+                    };
+                    if deeper && less(cur, upper) && !push(stack, &mut top, next, cur, upper) {
+                        return false;
+                    }
+                    if less(cur, (en, ed)) {
+                        cur = (en, ed);
+                    }
+                    prev_blocked = true;
+                } else {
+                    if c >= cmin && c <= cmax && (c < r || (diag && !prev_blocked)) {
+                        // On the map and in the box (not blocked), so the index is valid.
+                        mark(row.wrapping_add(c.wrapping_mul(self.dc)) as usize);
+                    }
+                    prev_blocked = false;
+                }
+            }
+            if deeper && less(cur, (hn, hd)) && !push(stack, &mut top, next, cur, (hn, hd)) {
+                return false;
+            }
+        }
+        true
+    }
+}
+
+/// `a < b` for fractions with positive denominators.
+#[inline(always)]
+fn less(a: Frac, b: Frac) -> bool {
+    a.0.wrapping_mul(b.1) < b.0.wrapping_mul(a.1)
+}
+
+/// `a <= b` for fractions with positive denominators.
+#[inline(always)]
+fn less_eq(a: Frac, b: Frac) -> bool {
+    a.0.wrapping_mul(b.1) <= b.0.wrapping_mul(a.1)
+}
+
+/// Push a pending interval (ends non-negative and below 2^16); `false` when `stack` is full.
+#[inline(always)]
+fn push(stack: &mut [u32], top: &mut usize, r: i32, lo: Frac, hi: Frac) -> bool {
+    let Some(slot) = stack.get_mut(*top..top.wrapping_add(FRAME)) else {
+        return false;
+    };
+    if let [a, b, c] = slot {
+        *a = r as u32;
+        *b = ((lo.0 as u32) << 16) | (lo.1 as u32 & 0xFFFF);
+        *c = ((hi.0 as u32) << 16) | (hi.1 as u32 & 0xFFFF);
+    }
+    *top = top.wrapping_add(FRAME);
+    true
+}
+
+/// The last pending interval pushed, taken off `stack`.
+#[inline(always)]
+fn pop(stack: &[u32], top: &mut usize) -> Option<(i32, Frac, Frac)> {
+    let from = top.checked_sub(FRAME)?;
+    let [a, b, c] = *stack.get(from..*top)? else {
+        return None;
+    };
+    *top = from;
+    Some((
+        a as i32,
+        ((b >> 16) as i32, (b & 0xFFFF) as i32),
+        ((c >> 16) as i32, (c & 0xFFFF) as i32),
+    ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::segment_clear;
+
+    /// The swept set against `segment_clear` on every target of random maps, boxes, depth
+    /// bounds and origins (diagonals, borders, grazed corners included).
+    #[test]
+    fn the_swept_set_is_exactly_the_segment_rule() {
+        let mut rng = crate::rng::Xoshiro128pp::from_u64(36);
+        let mut stack = vec![0u32; 3 * 256];
+        let (mut seen, mut hidden) = (0usize, 0usize);
+        for round in 0..600 {
+            let w = 1 + (rng.next_word() % 40) as u16;
+            let h = 1 + (rng.next_word() % 40) as u16;
+            let density = (round % 7) as f32 * 0.1;
+            let b = crate::testutil::random_bits(&mut rng, w, h, density);
+            let g = Grid::new(w, h, &b).unwrap();
+            let pick = |rng: &mut crate::rng::Xoshiro128pp, n: u16| {
+                (rng.next_word() % u32::from(n)) as u16
+            };
+            let u = Point::new(pick(&mut rng, w), pick(&mut rng, h));
+            if !g.is_free(u) {
+                continue; // (the corridor sweeps from free cells only)
+            }
+            let (lo, hi) = if round % 3 == 0 {
+                (Point::new(0, 0), Point::new(w - 1, h - 1))
+            } else {
+                (
+                    Point::new(pick(&mut rng, u.x + 1), pick(&mut rng, u.y + 1)),
+                    Point::new(u.x + pick(&mut rng, w - u.x), u.y + pick(&mut rng, h - u.y)),
+                )
+            };
+            let depth = if round % 2 == 0 {
+                [u16::MAX; 4]
+            } else {
+                [0; 4].map(|_| pick(&mut rng, 45))
+            };
+            // Every third round, a goal and a reach: cells beyond it may be left out.
+            let reach = (round % 3 == 1).then(|| Near {
+                goal: Point::new(pick(&mut rng, w), pick(&mut rng, h)),
+                reach: (rng.next_word() % 60) as f32 + 0.5,
+            });
+            let mut got = vec![false; g.cells()];
+            assert!(sweep(&g, u, [lo, hi], depth, reach, &mut stack, |i| got
+                [i] =
+                true));
+            for (i, &got) in got.iter().enumerate() {
+                let v = g.point(i);
+                let inside = v.x >= lo.x && v.x <= hi.x && v.y >= lo.y && v.y <= hi.y;
+                let (dx, dy) = (v.x.abs_diff(u.x), v.y.abs_diff(u.y));
+                let near = (dx >= dy && dx <= depth[usize::from(v.x < u.x)])
+                    || (dy >= dx && dy <= depth[2 + usize::from(v.y < u.y)]);
+                let want = inside && v != u && near && g.is_free(v) && segment_clear(&g, u, v);
+                // Within the reach (with a thousandth's slack), a visible cell must be marked;
+                // beyond it, it may be.
+                let within = reach.is_none_or(|n| {
+                    let f = |a: Point, b: Point| {
+                        (f64::from(a.x) - f64::from(b.x)).hypot(f64::from(a.y) - f64::from(b.y))
+                    };
+                    f(v, u) + f(v, n.goal) < f64::from(n.reach) - 1e-3
+                });
+                if want && !within {
+                    assert!(!got || want, "{u:?} -> {v:?}: marked, hidden");
+                    continue;
+                }
+                assert_eq!(
+                    got, want,
+                    "{w}x{h} {u:?} -> {v:?} box {lo:?}..{hi:?} depth {depth:?}"
+                );
+                if inside && v != u && near && g.is_free(v) {
+                    if want {
+                        seen += 1;
+                    } else {
+                        hidden += 1;
+                    }
+                }
+            }
+        }
+        assert!(seen > 10_000 && hidden > 10_000, "{seen} {hidden}");
+    }
+
+    /// A stack too short says so: one blocked cell splits an octant's interval in two (the
+    /// square at depth 3, column 1 hides `[1/7, 3/5]`), so the second piece has no room.
+    #[test]
+    fn a_short_stack_says_so() {
+        let rows = [".......", ".......", ".......", "...#...", "......."];
+        let (b, w, h) = crate::testutil::bits(&rows);
+        let g = Grid::new(w, h, &b).unwrap();
+        let (u, lo, hi) = (Point::new(0, 2), Point::new(0, 0), Point::new(w - 1, h - 1));
+        let mut stack = [0u32; FRAME];
+        assert!(!sweep(
+            &g,
+            u,
+            [lo, hi],
+            [u16::MAX; 4],
+            None,
+            &mut stack,
+            |_| ()
+        ));
+        let mut stack = [0u32; 2 * FRAME];
+        assert!(sweep(
+            &g,
+            u,
+            [lo, hi],
+            [u16::MAX; 4],
+            None,
+            &mut stack,
+            |_| ()
+        ));
+    }
+}
