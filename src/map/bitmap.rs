@@ -89,7 +89,7 @@ pub fn copy(dst: &mut [u32], src: &[u32], cells: usize) {
     }
 }
 
-/// The bits of cells `i`, `i + 1`, `i + 2` (bits 0-2; beyond the buffer: set).
+/// The bits of cells `i`, `i + 1`, `i + 2`, wrapping (bits 0-2; beyond the buffer: set).
 #[inline]
 pub fn three(bits: &[u32], i: usize) -> u32 {
     let (k, s) = (i >> 5, (i & 31) as u32);
@@ -97,17 +97,23 @@ pub fn three(bits: &[u32], i: usize) -> u32 {
     if s <= 29 {
         return lo & 7;
     }
-    // The three bits straddle two words (s is 30 or 31, so 32 - s is 1 or 2).
-    let hi = bits.get(k.wrapping_add(1)).copied().unwrap_or(u32::MAX);
+    // The three bits straddle two words (s is 30 or 31, so 32 - s is 1 or 2): the next word is
+    // cell `i + 2`'s, which wraps to word 0 for `i` at `usize::MAX - 1` or `usize::MAX` (what
+    // [`around`] reads on the map's first row and column).
+    let hi = bits
+        .get(i.wrapping_add(2) >> 5)
+        .copied()
+        .unwrap_or(u32::MAX);
     (lo | hi << (32u32.wrapping_sub(s) & 31)) & 7
 }
 
 /// The set's members among the eight neighbours of cell `i` of a map `width` cells wide, as a
-/// direction mask (bit `d`: the neighbour in direction `d` of [`crate::map::dir`]). `i` must not lie
-/// on the map's border (its neighbours' indices are taken as `i +- 1`, `i +- width`).
+/// direction mask (bit `d`: the neighbour in direction `d` of [`crate::map::dir`]). The
+/// neighbours' indices are taken as `i +- 1`, `i +- width`, ... (wrapping): on the map's border a
+/// direction off the map reads another row's cell, or a cell beyond the words (set), so a caller
+/// on the border masks those directions out.
 #[inline]
 pub fn around(bits: &[u32], i: usize, width: usize) -> u8 {
-    // Border cells are excluded by the caller, so `i - width - 1` does not wrap.
     around_top(bits, i.wrapping_sub(width).wrapping_sub(1), width)
 }
 
@@ -209,6 +215,40 @@ mod tests {
                     }
                 }
                 assert_eq!(around(&b, i, w), want, "cell {i}");
+            }
+        }
+    }
+
+    #[test]
+    fn around_reads_the_neighbours_on_the_map_from_the_border_too() {
+        // On the border a direction off the map reads anything (the caller masks it out); a
+        // neighbour on the map reads its own bit, the first row's and column's too, whose reads
+        // wrap below index 0 (`three` takes the next word from cell `i + 2`, wrapping).
+        use crate::map::dir::{DX, DY};
+        for (w, h) in [(37usize, 5usize), (32, 3), (3, 3), (30, 4)] {
+            let mut x = 987u32;
+            let mut b = vec![0u32; words(w * h)];
+            for i in 0..w * h {
+                x ^= x << 13;
+                x ^= x >> 17;
+                x ^= x << 5;
+                if x & 1 == 1 {
+                    set(&mut b, i);
+                }
+            }
+            for y in 0..h as i32 {
+                for cx in 0..w as i32 {
+                    let i = (y * w as i32 + cx) as usize;
+                    let got = around(&b, i, w);
+                    for d in 0..8 {
+                        let (nx, ny) = (cx + DX[d], y + DY[d]);
+                        if nx < 0 || ny < 0 || nx >= w as i32 || ny >= h as i32 {
+                            continue;
+                        }
+                        let j = (ny * w as i32 + nx) as usize;
+                        assert_eq!(got >> d & 1 == 1, get(&b, j), "{w}x{h} cell {i} dir {d}");
+                    }
+                }
             }
         }
     }

@@ -101,12 +101,11 @@ impl Ant<'_, '_, '_> {
         // step.
         let mut weight = [0.0f32; 8];
         let width = usize::from(grid.width());
-        let last_row = usize::from(grid.height()).wrapping_sub(1);
         let first = moves;
         let stop = self.budget.min(moves.saturating_add(*limit));
         while ci != goal {
             let allowed = self.moves.at(ci, cur);
-            let tabu_moves = visited_moves(tabu, (ci, cur), allowed, (width, last_row), step);
+            let tabu_moves = visited_moves(tabu, ci, allowed, width);
             // As in the general loop.
             if !may_tighten && tabu_moves & tabu_moves.wrapping_sub(1) != 0 {
                 may_tighten = self.shortcut_seen(ci, tabu_moves, step);

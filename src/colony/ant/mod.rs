@@ -297,7 +297,6 @@ impl Ant<'_, '_, '_> {
         let mut cand_dir = [0u8; 8];
         let mut cand_w = [0.0f32; 8];
         let width = usize::from(grid.width());
-        let last_row = usize::from(grid.height()).wrapping_sub(1);
         // The walk stops at its budget or after `limit` more moves, whichever comes first.
         let first = moves;
         let stop = self.budget.min(moves.saturating_add(*limit));
@@ -306,7 +305,7 @@ impl Ant<'_, '_, '_> {
             // The allowed moves into visited (or pruned) cells: from a 3 x 3 read of the tabu
             // set away from the border, one test a move on it.
             let step = |d: usize| offsets.get(d).copied().unwrap_or(0);
-            let tabu_moves = visited_moves(tabu, (ci, cur), allowed, (width, last_row), step);
+            let tabu_moves = visited_moves(tabu, ci, allowed, width);
             // A visited neighbour (not a pruned one) may offer a shortcut: one of them is the
             // cell we came from, a second one may be a shortcut. Once one walk cell had two, the
             // answer is known and the test is skipped.
@@ -503,31 +502,15 @@ impl Ant<'_, '_, '_> {
     }
 }
 
-/// The `allowed` moves of cell `ci` at `cur` into cells of the tabu set (visited or pruned), as a
-/// direction mask: a 3 x 3 read of the set away from the map's border (`width`, `last_row`), one
-/// test a move on it (`step` gives a direction's index offset).
+/// The `allowed` moves of cell `ci` into cells of the tabu set (visited or pruned), as a
+/// direction mask: one 3 x 3 read of the set around `ci` on a map `width` cells wide, for every
+/// cell, the border's too. A neighbour on the map has the index the read takes for it
+/// (`ci +- 1`, `ci +- width`, ...); a direction off the map is never allowed (the move masks
+/// keep an ant on its map), so what the read finds there (another row's cell, or a cell beyond
+/// the words: set) is masked out. So the same mask as a test per allowed move, at one read.
 #[inline(always)]
-fn visited_moves(
-    tabu: &TabuSet<'_>,
-    (ci, cur): (usize, Point),
-    allowed: u8,
-    (width, last_row): (usize, usize),
-    step: impl Fn(usize) -> isize,
-) -> u8 {
-    let (x, y) = (usize::from(cur.x), usize::from(cur.y));
-    if x > 0 && y > 0 && x.wrapping_add(1) < width && y < last_row {
-        return tabu.around(ci, width) & allowed;
-    }
-    let mut t = 0u8;
-    let mut m = allowed;
-    while m != 0 {
-        let di = m.trailing_zeros() as usize & 7;
-        m &= m.wrapping_sub(1);
-        if tabu.contains(ci.wrapping_add_signed(step(di))) {
-            t |= 1 << di;
-        }
-    }
-    t
+fn visited_moves(tabu: &TabuSet<'_>, ci: usize, allowed: u8, width: usize) -> u8 {
+    tabu.around(ci, width) & allowed
 }
 
 /// Roulette-wheel choice: index `i` with probability `w[i] / total` (one uniform draw). If every
