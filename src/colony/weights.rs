@@ -66,8 +66,10 @@ impl<'a> WeightTable<'a> {
 
     /// Forget every row (the pheromone changed): each is filled again at its next use.
     pub fn clear(&self) {
-        for first in self.rows.iter().step_by(STRIDE) {
-            first.set(UNFILLED);
+        for row in self.rows.chunks_exact(STRIDE) {
+            if let Some(first) = row.first() {
+                first.set(UNFILLED);
+            }
         }
     }
 
@@ -76,11 +78,8 @@ impl<'a> WeightTable<'a> {
     #[inline(always)]
     pub fn row(&self, ci: usize, fill: impl FnOnce() -> [f32; ROW]) -> Option<&Row> {
         let start = ci.checked_mul(STRIDE)?;
-        let row: &Row = self
-            .rows
-            .get(start..start.checked_add(STRIDE)?)?
-            .try_into()
-            .ok()?;
+        // The words from the row's first on, then its first STRIDE: two tests, no sum to check.
+        let row: &Row = self.rows.get(start..)?.first_chunk()?;
         let [first, ..] = row;
         if first.get() == UNFILLED {
             for (slot, w) in row.iter().zip(fill()) {
