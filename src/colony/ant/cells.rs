@@ -244,7 +244,9 @@ fn roulette_open(
     total: f32,
 ) -> Dir {
     if !(total > 0.0 && total <= f32::MAX) {
-        return uniform_open(rng, open);
+        // The draw here, the choice out of line: the generator's state never has its address
+        // taken, so the walk keeps it in registers.
+        return uniform_open(rng.next_word(), open);
     }
     let r = rng.next_unit() * total;
     let mut acc = 0.0f32;
@@ -264,12 +266,13 @@ fn roulette_open(
 }
 
 /// [`roulette`]'s uniform choice among the open moves (every weight underflowed, or the sum
-/// overflowed: rare, so out of the loop): the k-th of the set bits of `open`.
+/// overflowed: rare, so out of the loop): the k-th of the set bits of `open`, from the draw
+/// `word`.
 #[cold]
 #[inline(never)]
-fn uniform_open(rng: &mut Xoshiro128pp, open: u8) -> Dir {
+fn uniform_open(word: u32, open: u8) -> Dir {
     let n = u64::from(open.count_ones());
-    let k = (u64::from(rng.next_word()).wrapping_mul(n) >> 32) as u32;
+    let k = (u64::from(word).wrapping_mul(n) >> 32) as u32;
     let mut m = open;
     for _ in 0..k {
         m &= m.wrapping_sub(1);
