@@ -52,30 +52,18 @@ pub fn deposit(table: &mut Table<'_>, grid: &Grid<'_>, start: Point, tour: &[Dir
     let slots = slot_offsets(&offsets);
     let mut c = grid.index(start);
     let flat = table.flat_mut();
-    // Four steps a round (the same additions in the same order), the rest one at a time: the
-    // loop's own count and branch are paid once per four edges.
-    let mut quads = tour.chunks_exact(4);
-    for q in &mut quads {
-        for &d in q {
-            e = add_edge(flat, &moves, e, d, amount);
+    for &d in tour {
+        // A tour holds directions 0..=7 only (the walk writes them); `& 7` keeps any byte in
+        // range of both 8-entry tables without a branch, which the compiler sees.
+        let d = usize::from(d & 7);
+        let slot = slots.get(d).copied().unwrap_or(0);
+        // `c` is a cell index (< cells, and the table's 16 bytes a cell fit in memory), so `4 * c`
+        // does not wrap; a stray index is ignored.
+        if let Some(v) = flat.get_mut(c.wrapping_mul(4).wrapping_add_signed(slot)) {
+            *v += amount;
         }
+        c = c.wrapping_add_signed(offsets.get(d).copied().unwrap_or(0));
     }
-    for &d in quads.remainder() {
-        e = add_edge(flat, &moves, e, d, amount);
-    }
-}
-
-/// One step of [`deposit`]'s flat walk: add `amount` to the entry of the edge from the cell at
-/// `e / 4` in direction `d`, and return the next cell's `4 * cell`.
-#[inline(always)]
-fn add_edge(flat: &mut [f32], moves: &[(isize, isize); 8], e: usize, d: Dir, amount: f32) -> usize {
-    // A tour holds directions 0..=7 only (the walk writes them); `& 7` keeps any byte in range
-    // of the 8-entry table without a branch, which the compiler sees.
-    let (slot, step) = moves.get(usize::from(d & 7)).copied().unwrap_or((0, 0));
-    if let Some(v) = flat.get_mut(e.wrapping_add_signed(slot)) {
-        *v += amount;
-    }
-    e.wrapping_add_signed(step)
 }
 
 /// Where [`wolves`] finds the iteration's best and worst paths, one at a time: the best first
