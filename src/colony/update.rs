@@ -52,18 +52,40 @@ pub fn deposit(table: &mut Table<'_>, grid: &Grid<'_>, start: Point, tour: &[Dir
     let slots = slot_offsets(&offsets);
     let mut c = grid.index(start);
     let flat = table.flat_mut();
-    for &d in tour {
-        // A tour holds directions 0..=7 only (the walk writes them); `& 7` keeps any byte in
-        // range of both 8-entry tables without a branch, which the compiler sees.
-        let d = usize::from(d & 7);
-        let slot = slots.get(d).copied().unwrap_or(0);
-        // `c` is a cell index (< cells, and the table's 16 bytes a cell fit in memory), so `4 * c`
-        // does not wrap; a stray index is ignored.
-        if let Some(v) = flat.get_mut(c.wrapping_mul(4).wrapping_add_signed(slot)) {
-            *v += amount;
+    // Four steps a round (the same additions in the same order), the rest one at a time: the
+    // loop's own count and branch are paid once per four edges.
+    let mut quads = tour.chunks_exact(4);
+    for q in &mut quads {
+        for &d in q {
+            c = add_edge(flat, &slots, &offsets, c, d, amount);
         }
-        c = c.wrapping_add_signed(offsets.get(d).copied().unwrap_or(0));
     }
+    for &d in quads.remainder() {
+        c = add_edge(flat, &slots, &offsets, c, d, amount);
+    }
+}
+
+/// One step of [`deposit`]'s flat walk: add `amount` to the entry of the edge from cell `c` in
+/// direction `d`, and return the next cell.
+#[inline(always)]
+fn add_edge(
+    flat: &mut [f32],
+    slots: &[isize; 8],
+    offsets: &[isize; 8],
+    c: usize,
+    d: Dir,
+    amount: f32,
+) -> usize {
+    // A tour holds directions 0..=7 only (the walk writes them); `& 7` keeps any byte in range
+    // of both 8-entry tables without a branch, which the compiler sees.
+    let d = usize::from(d & 7);
+    let slot = slots.get(d).copied().unwrap_or(0);
+    // `c` is a cell index (< cells, and the table's 16 bytes a cell fit in memory), so `4 * c`
+    // does not wrap; a stray index is ignored.
+    if let Some(v) = flat.get_mut(c.wrapping_mul(4).wrapping_add_signed(slot)) {
+        *v += amount;
+    }
+    c.wrapping_add_signed(offsets.get(d).copied().unwrap_or(0))
 }
 
 /// Where [`wolves`] finds the iteration's best and worst paths, one at a time: the best first
@@ -127,6 +149,33 @@ pub fn wolves_amounts(q: f32, best: (f32, u32), worst: (f32, u32)) -> Option<(f3
 mod tests {
     use super::*;
     use crate::colony::pheromone::Blocks;
+
+    /// The flat deposit takes the tour four steps a round and then the rest: every step of a
+    /// tour whose length is not a multiple of four (the rest non-empty) gets the amount, once per
+    /// time the tour takes it, as the edge-by-edge `get` of the table sees it.
+    #[test]
+    fn deposit_every_step_of_quads_and_rest() {
+        let bits = [0u8; 4];
+        let g = Grid::new(5, 5, &bits).unwrap();
+        let mut buf = [[0.0f32; 4]; 25];
+        let mut t = Table::new(Blocks::new(5, 5), &mut buf);
+        assert_eq!(t.blocks().shift(), 0);
+        let start = Point::new(0, 0);
+        // E, E, SE, S, W, NW, E, S, SE: 9 steps (two rounds of four and one more).
+        let tour = [0u8, 0, 1, 2, 4, 5, 0, 2, 1];
+        deposit(&mut t, &g, start, &tour, 0.5);
+        let mut want = [[0.0f32; 4]; 25];
+        let mut w = Table::new(Blocks::new(5, 5), &mut want);
+        let mut p = start;
+        for &d in &tour {
+            let v = w.get(p, d) + 0.5;
+            w.add_flat(w.blocks().index(p, d), 0.5);
+            assert_eq!(w.get(p, d), v);
+            p = neighbour(p, d);
+        }
+        assert_eq!(t.entries(), w.entries());
+        assert!(t.entries().iter().flatten().filter(|v| **v != 0.0).count() >= 8);
+    }
 
     #[test]
     fn reward_best_punish_worst() {
