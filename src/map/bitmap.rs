@@ -190,13 +190,11 @@ mod tests {
         assert_eq!(b, [0; 3]);
     }
 
-    #[test]
-    fn around_reads_the_eight_neighbours() {
-        use crate::map::dir::{DX, DY};
-        let (w, h) = (37usize, 5usize);
-        let mut x = 12345u32;
-        let mut b = vec![0u32; words(w * h)];
-        for i in 0..w * h {
+    /// A set over `cells` cells, each in it with probability 1/2 (an xorshift from `seed`).
+    fn random_bits(cells: usize, seed: u32) -> Vec<u32> {
+        let mut x = seed;
+        let mut b = vec![0u32; words(cells)];
+        for i in 0..cells {
             x ^= x << 13;
             x ^= x >> 17;
             x ^= x << 5;
@@ -204,6 +202,14 @@ mod tests {
                 set(&mut b, i);
             }
         }
+        b
+    }
+
+    #[test]
+    fn around_reads_the_eight_neighbours() {
+        use crate::map::dir::{DX, DY};
+        let (w, h) = (37usize, 5usize);
+        let b = random_bits(w * h, 12345);
         for y in 1..h - 1 {
             for cx in 1..w - 1 {
                 let i = y * w + cx;
@@ -226,16 +232,7 @@ mod tests {
         // wrap below index 0 (`three` takes the next word from cell `i + 2`, wrapping).
         use crate::map::dir::{DX, DY};
         for (w, h) in [(37usize, 5usize), (32, 3), (3, 3), (30, 4)] {
-            let mut x = 987u32;
-            let mut b = vec![0u32; words(w * h)];
-            for i in 0..w * h {
-                x ^= x << 13;
-                x ^= x >> 17;
-                x ^= x << 5;
-                if x & 1 == 1 {
-                    set(&mut b, i);
-                }
-            }
+            let b = random_bits(w * h, 987);
             for y in 0..h as i32 {
                 for cx in 0..w as i32 {
                     let i = (y * w as i32 + cx) as usize;

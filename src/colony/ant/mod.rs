@@ -302,10 +302,10 @@ impl Ant<'_, '_, '_> {
         let stop = self.budget.min(moves.saturating_add(*limit));
         while ci != goal {
             let allowed = self.moves.at(ci, cur);
-            // The allowed moves into visited (or pruned) cells: from a 3 x 3 read of the tabu
-            // set away from the border, one test a move on it.
-            let step = |d: usize| offsets.get(d).copied().unwrap_or(0);
+            // The allowed moves into visited (or pruned) cells: one 3 x 3 read of the tabu set,
+            // the border's cells too ([`visited_moves`]).
             let tabu_moves = visited_moves(tabu, ci, allowed, width);
+            let step = |d: usize| offsets.get(d).copied().unwrap_or(0);
             // A visited neighbour (not a pruned one) may offer a shortcut: one of them is the
             // cell we came from, a second one may be a shortcut. Once one walk cell had two, the
             // answer is known and the test is skipped.
