@@ -226,10 +226,16 @@ impl<'a> Table<'a> {
         for (tv, dv) in tau.iter_mut().zip(delta.iter_mut()) {
             // Comparisons rather than `f32::clamp` (which has a panic path and pulls float
             // formatting into the firmware) or `max`/`min` (library calls on the M4, 6% of a
-            // plan). A NaN would land on `lo`.
+            // plan). A NaN lands on `lo`. Each select is the shape of one SSE instruction
+            // (`maxps`: `a > b ? a : b`, then `minps`: `a < b ? a : b`), so the host does four
+            // entries in about eight instructions. The same value as "`v >= lo`, then `v > hi`"
+            // for `0 < lo <= hi` (what `Params::validate` asks of `tau_min` and `tau_max`):
+            // `v == lo` gives `lo` either way (equal non-zero floats are the same bits), and
+            // `above` is `v` or `lo`, so `above < hi` picks `hi` exactly when `v > hi` does
+            // (test `evaporation_clamps_as_the_two_comparisons`).
             let v = keep * *tv + *dv;
-            let above = if v >= lo { v } else { lo };
-            *tv = if v > hi { hi } else { above };
+            let above = if v > lo { v } else { lo };
+            *tv = if above < hi { above } else { hi };
             *dv = 0.0;
         }
     }
@@ -376,5 +382,52 @@ mod tests {
         ta.evaporate_and_merge(&mut tb, 0.5, 0.01, 0.9);
         assert!(ta.entries().iter().flatten().all(|v| *v == 0.9));
         assert!(tb.entries().iter().flatten().all(|v| *v == 0.0));
+    }
+
+    #[test]
+    fn evaporation_clamps_as_the_two_comparisons() {
+        // With `tau` 0 the merged value is `delta` itself: the edges of the clamp (exactly `lo`
+        // and `hi`, just inside and outside them, zeros, infinities, a NaN) against the
+        // reference "`v >= lo ? v : lo`, then `v > hi ? hi : that`", bit for bit.
+        let (lo, hi) = (0.01f32, 100.0f32);
+        let mut values = vec![
+            lo,
+            hi,
+            0.0,
+            -0.0,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::NAN,
+            -lo,
+            1.0,
+            50.0,
+            f32::MAX,
+            f32::MIN_POSITIVE,
+            -f32::MAX,
+        ];
+        for v in [lo, hi] {
+            values.push(f32::from_bits(v.to_bits() + 1));
+            values.push(f32::from_bits(v.to_bits() - 1));
+        }
+        let mut x = 0x9e37_79b9u32;
+        for _ in 0..1000 {
+            x ^= x << 13;
+            x ^= x >> 17;
+            x ^= x << 5;
+            values.push(f32::from_bits(x));
+        }
+        let mut tau = vec![[0.0f32; 4]; values.len().div_ceil(4)];
+        let mut delta = tau.clone();
+        for (slot, v) in delta.as_flattened_mut().iter_mut().zip(&values) {
+            *slot = *v;
+        }
+        let bl = Blocks::new(tau.len() as u16, 1);
+        Table::new(bl, &mut tau).evaporate_and_merge(&mut Table::new(bl, &mut delta), 0.5, lo, hi);
+        for (got, v) in tau.as_flattened().iter().zip(&values) {
+            let v = 0.0 + *v;
+            let above = if v >= lo { v } else { lo };
+            let want = if v > hi { hi } else { above };
+            assert_eq!(got.to_bits(), want.to_bits(), "{v:e}");
+        }
     }
 }
