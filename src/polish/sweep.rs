@@ -118,7 +118,7 @@ pub fn sweep(
             base,
             dr,
             dc,
-            rows,
+            rows: rows.min(outside(goal, reach)),
             cols,
             goal,
             reach,
@@ -158,6 +158,34 @@ struct Octant<'g, 'b> {
     /// lies inside the ellipse ([`inside`]). Only a saving: an interval kept that `far` would
     /// have dropped marks more cells, never fewer.
     inside: i32,
+}
+
+/// A depth beyond which no cell of the octant lies inside the ellipse `|w| + |w - goal| <
+/// reach` (the goal at `(ga, gc)` in (depth, column) coordinates): on the whole line at depth
+/// `r`, `f(w) = |w| + |w - goal|` is least where the segment from the origin to the goal, or to
+/// its mirror image `(2 r - ga, gc)` once the goal lies before the line (`ga < r`), crosses
+/// it: `|goal|`, or `sqrt((2 r - ga)^2 + gc^2)`. So no row has a cell inside when `|goal| >=
+/// reach`, and none beyond `(ga + sqrt(reach^2 - gc^2)) / 2` otherwise. Computed with a 32nd
+/// of a cell more reach (far above the `f32` roundings): every row it cuts lies wholly outside.
+/// `i32::MAX` without a reach.
+#[inline(always)]
+fn outside((ga, gc): (f32, f32), reach: f32) -> i32 {
+    if reach == f32::INFINITY || reach.is_nan() {
+        return i32::MAX;
+    }
+    let big = reach + 1.0 / 32.0;
+    let room = big * big - gc * gc;
+    if ga * ga + gc * gc >= big * big || room <= 0.0 {
+        return 0;
+    }
+    let t = (ga + sqrt(room)) * 0.5;
+    if t >= MAX_DEPTH as f32 {
+        MAX_DEPTH
+    } else if t > 0.0 {
+        t as i32
+    } else {
+        0
+    }
 }
 
 /// About the last depth `r` whose whole octant row (columns `0..=r`) lies inside the ellipse
@@ -473,6 +501,45 @@ mod tests {
         }
         assert!(some > 1000 && none > 1000, "{some} {none}");
         assert_eq!(inside((3.0, 4.0), f32::INFINITY), 0);
+    }
+
+    /// The rows [`outside`] cuts hold no cell inside the ellipse (every column of the first
+    /// row cut, against `f64`), and the cut is no more than a 16th of a cell of reach early: on
+    /// the line at the last depth kept, the least `f` is below `reach + 1/16`.
+    #[test]
+    fn the_rows_cut_outside_hold_no_cell_inside() {
+        let mut rng = crate::rng::Xoshiro128pp::from_u64(38);
+        let f = |r: f64, c: f64, ga: f64, gc: f64| r.hypot(c) + (r - ga).hypot(c - gc);
+        let (mut cut, mut all) = (0, 0);
+        for _ in 0..20_000 {
+            let pick = |rng: &mut crate::rng::Xoshiro128pp| (rng.next_word() % 121) as f32 - 60.0;
+            let (ga, gc) = (pick(&mut rng), pick(&mut rng));
+            let reach = (rng.next_word() % 2000) as f32 / 16.0;
+            let k = outside((ga, gc), reach);
+            let (ga, gc, reach) = (f64::from(ga), f64::from(gc), f64::from(reach));
+            let next = f64::from(k + 1);
+            for c in 0..=k + 1 {
+                let c = f64::from(c);
+                assert!(
+                    f(next, c, ga, gc) >= reach,
+                    "({ga}, {gc}) {reach}: row {k} + 1 column {c}"
+                );
+            }
+            if k == 0 {
+                all += 1;
+                continue;
+            }
+            cut += 1;
+            let kf = f64::from(k);
+            let least = if ga >= kf {
+                ga.hypot(gc)
+            } else {
+                (2.0 * kf - ga).hypot(gc)
+            };
+            assert!(least < reach + 1.0 / 16.0, "({ga}, {gc}) {reach}: {k}");
+        }
+        assert!(cut > 1000 && all > 1000, "{cut} {all}");
+        assert_eq!(outside((3.0, 4.0), f32::INFINITY), i32::MAX);
     }
 
     /// A stack too short says so: one blocked cell splits an octant's interval in two (the
