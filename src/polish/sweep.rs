@@ -118,7 +118,7 @@ pub fn sweep(
             base,
             dr,
             dc,
-            rows: rows.min(outside(goal, reach)),
+            rows,
             cols,
             goal,
             reach,
@@ -259,7 +259,9 @@ impl Octant<'_, '_> {
     }
 
     fn sweep(&self, stack: &mut [u32], mark: &mut impl FnMut(usize)) -> bool {
-        if self.rows < 1 {
+        // Rows beyond the ellipse hold no cell to mark.
+        let rows = self.rows.min(outside(self.goal, self.reach));
+        if rows < 1 {
             return true;
         }
         // The diagonal also needs `(0, 1)` free (it passes its corner).
@@ -306,7 +308,7 @@ impl Octant<'_, '_> {
                 r.wrapping_mul(2).wrapping_sub(1),
             );
             let next = r.wrapping_add(1);
-            let deeper = next <= self.rows;
+            let deeper = next <= rows;
             // The part of the interval not cut yet starts at `cur` (open unless 0).
             let mut cur = (ln, ld);
             let mut prev_blocked = false;
