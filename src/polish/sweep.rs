@@ -122,6 +122,7 @@ pub fn sweep(
             cols,
             goal,
             reach,
+            inside: inside(goal, reach),
         };
         ok &= oct.sweep(stack, &mut mark);
     }
@@ -153,6 +154,68 @@ struct Octant<'g, 'b> {
     goal: (f32, f32),
     /// [`Near::reach`] (infinite: none).
     reach: f32,
+    /// Rows up to which [`Octant::far`] is not asked: about the last depth whose whole row
+    /// lies inside the ellipse ([`inside`]). Only a saving: an interval kept that `far` would
+    /// have dropped marks more cells, never fewer.
+    inside: i32,
+}
+
+/// A depth beyond which no cell of the octant lies inside the ellipse `|w| + |w - goal| <
+/// reach` (the goal at `(ga, gc)` in (depth, column) coordinates): on the whole line at depth
+/// `r`, `f(w) = |w| + |w - goal|` is least where the segment from the origin to the goal, or to
+/// its mirror image `(2 r - ga, gc)` once the goal lies before the line (`ga < r`), crosses
+/// it: `|goal|`, or `sqrt((2 r - ga)^2 + gc^2)`. So no row has a cell inside when `|goal| >=
+/// reach`, and none beyond `(ga + sqrt(reach^2 - gc^2)) / 2` otherwise. Computed with a 32nd
+/// of a cell more reach (far above the `f32` roundings): every row it cuts lies wholly outside.
+/// `i32::MAX` without a reach.
+#[inline(always)]
+fn outside((ga, gc): (f32, f32), reach: f32) -> i32 {
+    if reach == f32::INFINITY || reach.is_nan() {
+        return i32::MAX;
+    }
+    let big = reach + 1.0 / 32.0;
+    let room = big * big - gc * gc;
+    if ga * ga + gc * gc >= big * big || room <= 0.0 {
+        return 0;
+    }
+    let t = (ga + sqrt(room)) * 0.5;
+    if t >= MAX_DEPTH as f32 {
+        MAX_DEPTH
+    } else if t > 0.0 {
+        t as i32
+    } else {
+        0
+    }
+}
+
+/// About the last depth `r` whose whole octant row (columns `0..=r`) lies inside the ellipse
+/// `|w| + |w - goal| < reach`, the goal at `(ga, gc)` in (depth, column) coordinates: `f(w) =
+/// |w| + |w - goal|` is convex along the row, so largest at its ends `(r, 0)` and `(r, r)`,
+/// and each end's `f < reach` is, squared, linear in `r`: `2 r (reach - ga) < reach^2 -
+/// |goal|^2` and `2 r (sqrt 2 reach - ga - gc) < reach^2 - |goal|^2`. Rounded in `f32`: a row
+/// it takes for inside that is not only costs [`Octant::far`]'s cut there (the caller's
+/// length test rejects the extra cells), so it need not be exact. 0 without a reach.
+#[inline(always)]
+fn inside((ga, gc): (f32, f32), reach: f32) -> i32 {
+    let room = reach * reach - (ga * ga + gc * gc);
+    let (a, b) = (reach - ga, reach * core::f32::consts::SQRT_2 - ga - gc);
+    // (`reach` infinite: the quotients are NaN and the depth 0; `far` is never true then.)
+    if !(room > 0.0 && a > 0.0 && b > 0.0) {
+        return 0;
+    }
+    let (r0, r1) = (room / (a + a), room / (b + b));
+    let r = if r0 < r1 { r0 } else { r1 };
+    // Strictly below the bound (a row exactly on it is not inside), at most `MAX_DEPTH`.
+    if r >= MAX_DEPTH as f32 {
+        MAX_DEPTH
+    } else {
+        let k = r as i32;
+        if k as f32 >= r {
+            k.wrapping_sub(1)
+        } else {
+            k
+        }
+    }
 }
 
 impl Octant<'_, '_> {
@@ -196,7 +259,9 @@ impl Octant<'_, '_> {
     }
 
     fn sweep(&self, stack: &mut [u32], mark: &mut impl FnMut(usize)) -> bool {
-        if self.rows < 1 {
+        // Rows beyond the ellipse hold no cell to mark.
+        let rows = self.rows.min(outside(self.goal, self.reach));
+        if rows < 1 {
             return true;
         }
         // The diagonal also needs `(0, 1)` free (it passes its corner).
@@ -209,7 +274,7 @@ impl Octant<'_, '_> {
             return false;
         }
         while let Some((r, (ln, ld), (hn, hd))) = pop(stack, &mut top) {
-            if self.far(r, (ln, ld), (hn, hd)) {
+            if r > self.inside && self.far(r, (ln, ld), (hn, hd)) {
                 continue;
             }
             // Columns whose slope lies in the interval: `c ld > ln r` (or any `c >= 0` when
@@ -243,7 +308,7 @@ impl Octant<'_, '_> {
                 r.wrapping_mul(2).wrapping_sub(1),
             );
             let next = r.wrapping_add(1);
-            let deeper = next <= self.rows;
+            let deeper = next <= rows;
             // The part of the interval not cut yet starts at `cur` (open unless 0).
             let mut cur = (ln, ld);
             let mut prev_blocked = false;
@@ -404,6 +469,79 @@ mod tests {
             }
         }
         assert!(seen > 10_000 && hidden > 10_000, "{seen} {hidden}");
+    }
+
+    /// The rows [`inside`] lets skip [`Octant::far`] lie inside the ellipse (both ends of each,
+    /// so the whole row), and the next row does not (up to `f32` rounding, and the depth cap):
+    /// a depth too large would only lose `far`'s cut, too small its saving, so the rule pinned is
+    /// the depth itself, against `f64` on random goals and reaches.
+    #[test]
+    fn the_inside_rows_are_inside_the_ellipse() {
+        let mut rng = crate::rng::Xoshiro128pp::from_u64(37);
+        let f = |r: f64, c: f64, ga: f64, gc: f64| r.hypot(c) + (r - ga).hypot(c - gc);
+        let (mut some, mut none) = (0, 0);
+        for _ in 0..20_000 {
+            let pick = |rng: &mut crate::rng::Xoshiro128pp| (rng.next_word() % 121) as f32 - 60.0;
+            let (ga, gc) = (pick(&mut rng), pick(&mut rng));
+            let reach = (rng.next_word() % 2000) as f32 / 16.0;
+            let k = inside((ga, gc), reach);
+            let (ga, gc, reach) = (f64::from(ga), f64::from(gc), f64::from(reach));
+            let end = |r: i32| {
+                let r = f64::from(r);
+                f(r, 0.0, ga, gc).max(f(r, r, ga, gc))
+            };
+            if k > 0 {
+                some += 1;
+                assert!(end(k) < reach + 1e-3, "({ga}, {gc}) {reach}: {k}");
+            } else {
+                none += 1;
+            }
+            assert!(
+                end(k + 1) >= reach - 1e-3 || k == MAX_DEPTH,
+                "({ga}, {gc}) {reach}: {k} + 1"
+            );
+        }
+        assert!(some > 1000 && none > 1000, "{some} {none}");
+        assert_eq!(inside((3.0, 4.0), f32::INFINITY), 0);
+    }
+
+    /// The rows [`outside`] cuts hold no cell inside the ellipse (every column of the first
+    /// row cut, against `f64`), and the cut is no more than a 16th of a cell of reach early: on
+    /// the line at the last depth kept, the least `f` is below `reach + 1/16`.
+    #[test]
+    fn the_rows_cut_outside_hold_no_cell_inside() {
+        let mut rng = crate::rng::Xoshiro128pp::from_u64(38);
+        let f = |r: f64, c: f64, ga: f64, gc: f64| r.hypot(c) + (r - ga).hypot(c - gc);
+        let (mut cut, mut all) = (0, 0);
+        for _ in 0..20_000 {
+            let pick = |rng: &mut crate::rng::Xoshiro128pp| (rng.next_word() % 121) as f32 - 60.0;
+            let (ga, gc) = (pick(&mut rng), pick(&mut rng));
+            let reach = (rng.next_word() % 2000) as f32 / 16.0;
+            let k = outside((ga, gc), reach);
+            let (ga, gc, reach) = (f64::from(ga), f64::from(gc), f64::from(reach));
+            let next = f64::from(k + 1);
+            for c in 0..=k + 1 {
+                let c = f64::from(c);
+                assert!(
+                    f(next, c, ga, gc) >= reach,
+                    "({ga}, {gc}) {reach}: row {k} + 1 column {c}"
+                );
+            }
+            if k == 0 {
+                all += 1;
+                continue;
+            }
+            cut += 1;
+            let kf = f64::from(k);
+            let least = if ga >= kf {
+                ga.hypot(gc)
+            } else {
+                (2.0 * kf - ga).hypot(gc)
+            };
+            assert!(least < reach + 1.0 / 16.0, "({ga}, {gc}) {reach}: {k}");
+        }
+        assert!(cut > 1000 && all > 1000, "{cut} {all}");
+        assert_eq!(outside((3.0, 4.0), f32::INFINITY), i32::MAX);
     }
 
     /// A stack too short says so: one blocked cell splits an octant's interval in two (the
