@@ -475,15 +475,26 @@ mod tests {
     /// so the whole row), and the next row does not (up to `f32` rounding, and the depth cap):
     /// a depth too large would only lose `far`'s cut, too small its saving, so the rule pinned is
     /// the depth itself, against `f64` on random goals and reaches.
+    /// A random goal (depth and column in `-60..=60`) and reach (`0..125` in 16ths of a cell)
+    /// for the ellipse depth tests below.
+    fn random_ellipse(rng: &mut crate::rng::Xoshiro128pp) -> ((f32, f32), f32) {
+        let mut pick = || (rng.next_word() % 121) as f32 - 60.0;
+        let goal = (pick(), pick());
+        (goal, (rng.next_word() % 2000) as f32 / 16.0)
+    }
+
+    /// `|w| + |w - goal|` for the cell `w` at depth `r`, column `c`, in `f64`.
+    fn ellipse_f(r: f64, c: f64, ga: f64, gc: f64) -> f64 {
+        r.hypot(c) + (r - ga).hypot(c - gc)
+    }
+
     #[test]
     fn the_inside_rows_are_inside_the_ellipse() {
         let mut rng = crate::rng::Xoshiro128pp::from_u64(37);
-        let f = |r: f64, c: f64, ga: f64, gc: f64| r.hypot(c) + (r - ga).hypot(c - gc);
+        let f = ellipse_f;
         let (mut some, mut none) = (0, 0);
         for _ in 0..20_000 {
-            let pick = |rng: &mut crate::rng::Xoshiro128pp| (rng.next_word() % 121) as f32 - 60.0;
-            let (ga, gc) = (pick(&mut rng), pick(&mut rng));
-            let reach = (rng.next_word() % 2000) as f32 / 16.0;
+            let ((ga, gc), reach) = random_ellipse(&mut rng);
             let k = inside((ga, gc), reach);
             let (ga, gc, reach) = (f64::from(ga), f64::from(gc), f64::from(reach));
             let end = |r: i32| {
@@ -511,12 +522,10 @@ mod tests {
     #[test]
     fn the_rows_cut_outside_hold_no_cell_inside() {
         let mut rng = crate::rng::Xoshiro128pp::from_u64(38);
-        let f = |r: f64, c: f64, ga: f64, gc: f64| r.hypot(c) + (r - ga).hypot(c - gc);
+        let f = ellipse_f;
         let (mut cut, mut all) = (0, 0);
         for _ in 0..20_000 {
-            let pick = |rng: &mut crate::rng::Xoshiro128pp| (rng.next_word() % 121) as f32 - 60.0;
-            let (ga, gc) = (pick(&mut rng), pick(&mut rng));
-            let reach = (rng.next_word() % 2000) as f32 / 16.0;
+            let ((ga, gc), reach) = random_ellipse(&mut rng);
             let k = outside((ga, gc), reach);
             let (ga, gc, reach) = (f64::from(ga), f64::from(gc), f64::from(reach));
             let next = f64::from(k + 1);
