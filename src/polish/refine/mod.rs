@@ -23,7 +23,11 @@
 //! heuristic, 8 moves, no corner cutting through [`Grid::move_mask`]) runs from `P[s]` to `P[t]`
 //! inside it. A strictly shorter result replaces the piece. Either way the path is committed up
 //! to the middle of the piece (the rest stays pending), so consecutive windows overlap by half.
-//! Passes repeat until one changes nothing or `max_passes` ran. Pieces whose length already
+//! Passes repeat until one changes nothing or `max_passes` ran, or end at once when a window
+//! replaced the whole path by a shortest path on the whole map (its box the whole map, or the
+//! straight line): no later window could shorten it, so the second look that would only
+//! confirm it is skipped (on a small map, whose one window is the whole map, half the local
+//! search). Pieces whose length already
 //! equals the obstacle-free octile distance are skipped without a search, and a longer piece
 //! whose ends' straight line is free takes that line without a search (it is a shortest path in
 //! any box: the proof is in `line`'s docs).
@@ -408,11 +412,19 @@ impl Refiner {
         };
         // Search unless the piece is already as short as it can be.
         let mut replaced = false;
+        // Whether the piece is the whole path (start to goal) and its replacement a shortest
+        // path on the whole map: then no later window can shorten any piece of it (a piece of
+        // a shortest path is a shortest path between its ends, and a window replaces a piece
+        // only by a strictly shorter one), so the refinement ends there with the path every
+        // further window and pass would have left as it is.
+        let whole_path = s == 0 && t.saturating_add(1) >= total;
+        let mut optimal = false;
         if old > octile(ps, pt) && line::free(grid, ps, pt) {
             // The straight line is a shortest path between the ends (`line`'s proof): the
             // window's search would find its cost; write the line instead of searching.
             budget.lines = budget.lines.saturating_add(1);
             replaced = self.replace_line(out, s, t, ps, pt);
+            optimal = whole_path;
         } else if old > octile(ps, pt) {
             let ex = usize::from(x1.wrapping_sub(x0)).saturating_add(1);
             let ey = usize::from(y1.wrapping_sub(y0)).saturating_add(1);
@@ -435,6 +447,13 @@ impl Refiner {
                     }
                     if cost < old {
                         replaced = self.replace(grid, out, scratch, &bbox, s, t, pt);
+                        // The window's box is the whole map: its A* is the exact optimum on
+                        // the map (the module docs).
+                        optimal = whole_path
+                            && bbox.x0 == 0
+                            && bbox.y0 == 0
+                            && bbox.w >= shape.map_w
+                            && bbox.h >= shape.map_h;
                     }
                 }
             } else {
@@ -444,6 +463,8 @@ impl Refiner {
         if replaced {
             budget.improved = budget.improved.saturating_add(1);
             self.improved = true;
+            // (See `whole_path` above: `finish` compacts the path as it stands.)
+            self.done = optimal;
             return;
         }
         // Commit up to the middle of the piece (at least one pending cell, everything at the end).

@@ -406,3 +406,49 @@ fn a_line_is_taken_only_when_free() {
         vec![Point::new(0, 0), Point::new(1, 0), Point::new(2, 1)]
     );
 }
+
+#[test]
+fn a_whole_map_window_that_replaces_the_whole_path_ends_the_refinement() {
+    // The detour map of `detour_becomes_the_optimum_inside_one_window` fits one window: the
+    // first search is the exact optimum on the map, so no second window looks again.
+    let rows = [
+        "..........",
+        "..........",
+        "....#.....",
+        "....#.....",
+        "....#.....",
+        "..........",
+        "..........",
+        "..........",
+    ];
+    let (b, w, h) = grid(&rows);
+    let g = Grid::new(w, h, &b).unwrap();
+    let mut dirs = vec![2u8; 4];
+    dirs.extend([0u8; 7]);
+    dirs.extend([6u8; 4]);
+    let path = walk(Point::new(1, 3), &dirs);
+    let (out, b) = run(&g, &path, 64 * 64);
+    assert_eq!(cost(&g, &out), 4 * DIAGONAL + 3 * STRAIGHT, "{out:?}");
+    assert_eq!((b.windows, b.improved), (1, 1), "{b:?}");
+}
+
+#[test]
+fn a_window_smaller_than_the_map_looks_again_after_replacing_the_whole_path() {
+    // A 40 x 40 map and a 16 x 16 window: the whole path (a detour around one blocked cell)
+    // fits the window, but the window is not the map, so its optimum is not known to be the
+    // map's and the refinement goes on (the window over the new path is searched again).
+    let mut rows = vec!["........................................".to_string(); 40];
+    rows[2].replace_range(6..7, "#");
+    let rows: Vec<&str> = rows.iter().map(String::as_str).collect();
+    let (b, w, h) = grid(&rows);
+    let g = Grid::new(w, h, &b).unwrap();
+    // (2,2) -> down to row 6, east to x 10, up to (10,2).
+    let mut dirs = vec![2u8; 4];
+    dirs.extend([0u8; 8]);
+    dirs.extend([6u8; 4]);
+    let path = walk(Point::new(2, 2), &dirs);
+    let (out, b) = run(&g, &path, 16 * 16);
+    assert_eq!(cost(&g, &out), 6 * STRAIGHT + 2 * DIAGONAL, "{out:?}");
+    assert_eq!(b.lines, 0, "{b:?}");
+    assert!(b.improved == 1 && b.windows >= 2, "{b:?}");
+}
