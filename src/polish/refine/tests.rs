@@ -68,9 +68,10 @@ fn walk(start: Point, dirs: &[u8]) -> Vec<Point> {
     p
 }
 
-#[test]
-fn detour_becomes_the_optimum_inside_one_window() {
-    // Around a wall: down, right along the bottom, up; the optimum hugs the wall's end.
+/// A 10 x 8 map with a wall of three cells, and a detour around it: from (1,3) down to row 7,
+/// right to x 8, up to (8,3). Its optimum (over or under the wall) is 4 diagonals and 3 straight
+/// steps.
+fn detour() -> ((Vec<u8>, u16, u16), Vec<Point>) {
     let rows = [
         "..........",
         "..........",
@@ -81,13 +82,17 @@ fn detour_becomes_the_optimum_inside_one_window() {
         "..........",
         "..........",
     ];
-    let (b, w, h) = grid(&rows);
-    let g = Grid::new(w, h, &b).unwrap();
-    // (1,3) -> down to row 7, right to x 8, up to (8,3).
     let mut dirs = vec![2u8; 4];
     dirs.extend([0u8; 7]);
     dirs.extend([6u8; 4]);
-    let path = walk(Point::new(1, 3), &dirs);
+    (grid(&rows), walk(Point::new(1, 3), &dirs))
+}
+
+#[test]
+fn detour_becomes_the_optimum_inside_one_window() {
+    // Around a wall: down, right along the bottom, up; the optimum hugs the wall's end.
+    let ((b, w, h), path) = detour();
+    let g = Grid::new(w, h, &b).unwrap();
     let (out, b) = run(&g, &path, 64 * 64);
     // Optimum (over or under the wall): 4 diagonals and 3 straight steps.
     assert_eq!(cost(&g, &out), 4 * DIAGONAL + 3 * STRAIGHT, "{out:?}");
@@ -411,22 +416,8 @@ fn a_line_is_taken_only_when_free() {
 fn a_whole_map_window_that_replaces_the_whole_path_ends_the_refinement() {
     // The detour map of `detour_becomes_the_optimum_inside_one_window` fits one window: the
     // first search is the exact optimum on the map, so no second window looks again.
-    let rows = [
-        "..........",
-        "..........",
-        "....#.....",
-        "....#.....",
-        "....#.....",
-        "..........",
-        "..........",
-        "..........",
-    ];
-    let (b, w, h) = grid(&rows);
+    let ((b, w, h), path) = detour();
     let g = Grid::new(w, h, &b).unwrap();
-    let mut dirs = vec![2u8; 4];
-    dirs.extend([0u8; 7]);
-    dirs.extend([6u8; 4]);
-    let path = walk(Point::new(1, 3), &dirs);
     let (out, b) = run(&g, &path, 64 * 64);
     assert_eq!(cost(&g, &out), 4 * DIAGONAL + 3 * STRAIGHT, "{out:?}");
     assert_eq!((b.windows, b.improved), (1, 1), "{b:?}");
