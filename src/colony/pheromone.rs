@@ -409,13 +409,8 @@ mod tests {
             values.push(f32::from_bits(v.to_bits() + 1));
             values.push(f32::from_bits(v.to_bits() - 1));
         }
-        let mut x = 0x9e37_79b9u32;
-        for _ in 0..1000 {
-            x ^= x << 13;
-            x ^= x >> 17;
-            x ^= x << 5;
-            values.push(f32::from_bits(x));
-        }
+        let mut rng = crate::rng::Xoshiro128pp::from_u64(0x9e37_79b9);
+        values.extend((0..1000).map(|_| f32::from_bits(rng.next_word())));
         let mut tau = vec![[0.0f32; 4]; values.len().div_ceil(4)];
         let mut delta = tau.clone();
         for (slot, v) in delta.as_flattened_mut().iter_mut().zip(&values) {

@@ -190,15 +190,13 @@ mod tests {
         assert_eq!(b, [0; 3]);
     }
 
-    /// A set over `cells` cells, each in it with probability 1/2 (an xorshift from `seed`).
-    fn random_bits(cells: usize, seed: u32) -> Vec<u32> {
-        let mut x = seed;
+    /// A set over `cells` cells, each in it with probability 1/2 (the crate's generator from
+    /// `seed`).
+    fn random_bits(cells: usize, seed: u64) -> Vec<u32> {
+        let mut rng = crate::rng::Xoshiro128pp::from_u64(seed);
         let mut b = vec![0u32; words(cells)];
         for i in 0..cells {
-            x ^= x << 13;
-            x ^= x >> 17;
-            x ^= x << 5;
-            if x & 1 == 1 {
+            if rng.next_word() & 1 == 1 {
                 set(&mut b, i);
             }
         }

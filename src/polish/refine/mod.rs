@@ -449,11 +449,7 @@ impl Refiner {
                         replaced = self.replace(grid, out, scratch, &bbox, s, t, pt);
                         // The window's box is the whole map: its A* is the exact optimum on
                         // the map (the module docs).
-                        optimal = whole_path
-                            && bbox.x0 == 0
-                            && bbox.y0 == 0
-                            && bbox.w >= shape.map_w
-                            && bbox.h >= shape.map_h;
+                        optimal = whole_path && bbox.covers(shape.map_w, shape.map_h);
                     }
                 }
             } else {

@@ -121,6 +121,12 @@ impl Box2 {
         self.w.saturating_mul(self.h)
     }
 
+    /// Whether the box is the whole `map_w x map_h` map (its A* is then the map's exact
+    /// optimum).
+    pub(super) fn covers(&self, map_w: usize, map_h: usize) -> bool {
+        self.x0 == 0 && self.y0 == 0 && self.w >= map_w && self.h >= map_h
+    }
+
     pub(super) fn local(&self, p: Point) -> Option<usize> {
         let lx = usize::from(p.x.checked_sub(self.x0)?);
         let ly = usize::from(p.y.checked_sub(self.y0)?);
