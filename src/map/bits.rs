@@ -20,6 +20,21 @@ pub fn get(bits: &[u8], i: usize) -> Option<bool> {
     bits.get(i >> 3).map(|b| (b >> (i & 7)) & 1 == 1)
 }
 
+/// Cells `i..i + n` (`n` at most 32) as the low bits of a word, bit `k` = cell `i + k` (1 =
+/// blocked); cells past the end of `bits` read as blocked.
+#[inline]
+pub fn run(bits: &[u8], i: usize, n: u32) -> u32 {
+    let k = i >> 3;
+    let byte = |j: usize| u64::from(bits.get(k.wrapping_add(j)).copied().unwrap_or(0xFF));
+    let word = byte(0) | byte(1) << 8 | byte(2) << 16 | byte(3) << 24 | byte(4) << 32;
+    let mask = if n >= 32 {
+        u32::MAX
+    } else {
+        (1u32 << n).wrapping_sub(1)
+    };
+    (word >> (i & 7)) as u32 & mask
+}
+
 /// Set cell `i`'s bit to `blocked` (nothing past the end).
 #[inline]
 pub fn set(bits: &mut [u8], i: usize, blocked: bool) {

@@ -196,6 +196,19 @@ pub fn try_shortest(
     } else {
         (&mut [][..], rest)
     };
+    // The box's lines of free bits ([`crate::polish::sweep::Lines`]), from the stack's room
+    // when the box is small enough and the stack keeps room for its intervals: each sweep then
+    // reads an octant's row as one word. Without them, the same marks one cell at a time.
+    let (lines, stack) = match crate::polish::sweep::line_words([lo, hi]) {
+        Some(n) if stack.len() >= n.saturating_add(LINE_STACK) => {
+            let (words, stack) = stack.split_at_mut(n);
+            (
+                crate::polish::sweep::Lines::fill(grid, [lo, hi], words),
+                stack,
+            )
+        }
+        _ => (None, stack),
+    };
     let exact = grid.width() <= EXACT_SIDE && grid.height() <= EXACT_SIDE;
     // A*: expand the open cell of least g + h (the first one on ties) until the goal closes.
     while open_len > 0 {
@@ -251,16 +264,25 @@ pub fn try_shortest(
         let nw = live.div_ceil(32);
         let marked = !seen.is_empty() && {
             seen.iter_mut().take(nw).for_each(|w| *w = 0);
-            crate::polish::sweep::sweep(grid, p, [lo, hi], depth, Some(near), stack, |k| {
-                if let Some(e) = cell.get(k) {
-                    if e.flags & (CANDIDATE | CLOSED) == CANDIDATE {
-                        let b = usize::from(e.pos);
-                        if let Some(w) = seen.get_mut(b >> 5) {
-                            *w |= 1 << (b & 31);
+            crate::polish::sweep::sweep(
+                grid,
+                p,
+                [lo, hi],
+                depth,
+                Some(near),
+                lines.as_ref(),
+                stack,
+                |k| {
+                    if let Some(e) = cell.get(k) {
+                        if e.flags & (CANDIDATE | CLOSED) == CANDIDATE {
+                            let b = usize::from(e.pos);
+                            if let Some(w) = seen.get_mut(b >> 5) {
+                                *w |= 1 << (b & 31);
+                            }
                         }
                     }
-                }
-            })
+                },
+            )
         };
         // The live cells in the list's order (the ties): the seen ones, or (not `marked`: no
         // room, or the sweep's stack was too short) all of them, each tested below.
@@ -385,6 +407,11 @@ fn reach(gi: f32, limit: f32) -> u16 {
     }
     d
 }
+
+/// Words of the sweep's stack left for its pending intervals when the box's lines take their
+/// room ([`crate::polish::sweep::FRAME`] words an interval): the lines are only a saving, a
+/// stack too short for the intervals a fallback to one segment test a cell.
+const LINE_STACK: usize = 96 * crate::polish::sweep::FRAME;
 
 /// Slack, in cells, above the `f32` roundings of a candidate's `gi + distance + h` (each below
 /// half a unit in the last place, a few thousandths for lengths below 2^16).

@@ -70,6 +70,7 @@ pub fn sweep(
     [lo, hi]: [Point; 2],
     depth: [u16; 4],
     near: Option<Near>,
+    lines: Option<&Lines<'_>>,
     stack: &mut [u32],
     mut mark: impl FnMut(usize),
 ) -> bool {
@@ -102,18 +103,66 @@ pub fn sweep(
             n.reach,
         )
     });
-    for (rows, cols, dr, dc, goal) in [
+    // The box's lines of free bits, when the caller filled them for this box: the octant's
+    // rows are its columns (depth along x) or its rows (depth along y), read forward or
+    // reversed ([`Lines`]), from `u`'s line, the column `u`'s bit.
+    let lines = lines.filter(|l| l.corners == [lo, hi]);
+    let (fx, fy) = (ux.wrapping_sub(x0), uy.wrapping_sub(y0));
+    let (bx, by) = (x1.wrapping_sub(ux), y1.wrapping_sub(uy));
+    for (rows, cols, dr, dc, goal, (kind, step, shift)) in [
         // Depth along x (columns along y), then depth along y; the goal in (depth, column).
-        (right.min(dr_), down, 1, w, (gx, gy)),
-        (right.min(dr_), up, 1, w.wrapping_neg(), (gx, -gy)),
-        (left.min(dl_), down, -1, w, (-gx, gy)),
-        (left.min(dl_), up, -1, w.wrapping_neg(), (-gx, -gy)),
-        (down.min(dd_), right, w, 1, (gy, gx)),
-        (down.min(dd_), left, w, -1, (gy, -gx)),
-        (up.min(du_), right, w.wrapping_neg(), 1, (-gy, gx)),
-        (up.min(du_), left, w.wrapping_neg(), -1, (-gy, -gx)),
+        (right.min(dr_), down, 1, w, (gx, gy), (COLS, 1, fy)),
+        (
+            right.min(dr_),
+            up,
+            1,
+            w.wrapping_neg(),
+            (gx, -gy),
+            (COLS_REV, 1, by),
+        ),
+        (left.min(dl_), down, -1, w, (-gx, gy), (COLS, -1, fy)),
+        (
+            left.min(dl_),
+            up,
+            -1,
+            w.wrapping_neg(),
+            (-gx, -gy),
+            (COLS_REV, -1, by),
+        ),
+        (down.min(dd_), right, w, 1, (gy, gx), (ROWS, 1, fx)),
+        (down.min(dd_), left, w, -1, (gy, -gx), (ROWS_REV, 1, bx)),
+        (
+            up.min(du_),
+            right,
+            w.wrapping_neg(),
+            1,
+            (-gy, gx),
+            (ROWS, -1, fx),
+        ),
+        (
+            up.min(du_),
+            left,
+            w.wrapping_neg(),
+            -1,
+            (-gy, -gx),
+            (ROWS_REV, -1, bx),
+        ),
     ] {
+        let line = lines.map(|l| {
+            let first = if kind == COLS || kind == COLS_REV {
+                fx
+            } else {
+                fy
+            };
+            OctantLines {
+                lines: l.sets.get(kind).copied().unwrap_or_default(),
+                first,
+                step,
+                shift: shift as u32,
+            }
+        });
         let oct = Octant {
+            line,
             grid,
             base,
             dr,
@@ -144,6 +193,8 @@ pub struct Near {
 /// One octant of [`sweep`]: cell `(r, c)` (depth, column) is map index `base + r dr + c dc`;
 /// rows beyond `rows` are not swept, columns beyond `cols` are outside the box (blocked).
 struct Octant<'g, 'b> {
+    /// The octant's rows as words of free bits ([`Lines`]), when the caller has them.
+    line: Option<OctantLines<'g>>,
     grid: &'g Grid<'b>,
     base: i32,
     dr: i32,
@@ -158,6 +209,112 @@ struct Octant<'g, 'b> {
     /// lies inside the ellipse ([`inside`]). Only a saving: an interval kept that `far` would
     /// have dropped marks more cells, never fewer.
     inside: i32,
+}
+
+/// The longest side of a box whose lines [`Lines`] holds: a line is one word, and an octant's
+/// row reads its columns `0..=r + 1` (`r` below the side) from it.
+pub const LINE_SIDE: u16 = 31;
+
+/// Which of [`Lines`]'s four sets.
+const ROWS: usize = 0;
+const ROWS_REV: usize = 1;
+const COLS: usize = 2;
+const COLS_REV: usize = 3;
+
+/// A box's free cells as words, one a line (a row or a column of the box), for [`sweep`]: an
+/// octant's row is then one word, so its blocked squares are found by their set bits and its
+/// free cells marked by theirs, instead of one map read a column. Four sets: the rows read from
+/// the left (bit `k` = cell `(x0 + k, y)`), the rows from the right (`(x1 - k, y)`), the columns
+/// from the top (`(x, y0 + k)`) and from the bottom (`(x, y1 - k)`); a bit is set iff the cell
+/// is free, so the columns beyond the box read as blocked, as [`sweep`] counts them. Filled
+/// once for a box ([`Lines::fill`]) and read by every sweep over that box.
+#[derive(Debug)]
+pub struct Lines<'a> {
+    /// The box, `[lo, hi]`: a sweep over another box does not use these lines.
+    corners: [Point; 2],
+    /// The four sets, by [`ROWS`], [`ROWS_REV`], [`COLS`], [`COLS_REV`].
+    sets: [&'a [u32]; 4],
+}
+
+/// One octant's view of [`Lines`]: the set its rows are in, the line of depth 0, which way the
+/// depth goes along the lines, and `u`'s bit in a line (its column 0).
+#[derive(Clone, Copy)]
+struct OctantLines<'a> {
+    lines: &'a [u32],
+    first: i32,
+    step: i32,
+    shift: u32,
+}
+
+impl OctantLines<'_> {
+    /// The free bits of the octant's row `r`: bit `c` = column `c` (0 beyond the box).
+    #[inline(always)]
+    fn free(&self, r: i32) -> u32 {
+        let k = self.first.wrapping_add(r.wrapping_mul(self.step));
+        usize::try_from(k)
+            .ok()
+            .and_then(|k| self.lines.get(k))
+            .map_or(0, |&l| l.wrapping_shr(self.shift))
+    }
+}
+
+/// Columns `lo..=hi` as bits of a word, for `0 <= lo, hi <= 31` (none when `hi < lo`: the
+/// two masks do not meet).
+#[inline(always)]
+fn span(lo: i32, hi: i32) -> u32 {
+    u32::MAX.wrapping_shr(31u32.wrapping_sub(hi as u32)) & u32::MAX.wrapping_shl(lo as u32)
+}
+
+/// Words [`Lines::fill`] needs for the box `[lo, hi]`: twice its height plus twice its width;
+/// `None` when a side is above [`LINE_SIDE`] (or the corners are not ordered).
+pub fn line_words([lo, hi]: [Point; 2]) -> Option<usize> {
+    let (w, h) = (hi.x.checked_sub(lo.x)?, hi.y.checked_sub(lo.y)?);
+    (w < LINE_SIDE && h < LINE_SIDE).then(|| 2 * (usize::from(w) + usize::from(h) + 2))
+}
+
+impl<'a> Lines<'a> {
+    /// The lines of the box `[lo, hi]` (on the map) in `words`; `None` when the box is not on
+    /// the map, a side is above [`LINE_SIDE`] or `words` is shorter than [`line_words`].
+    pub fn fill(grid: &Grid<'_>, [lo, hi]: [Point; 2], words: &'a mut [u32]) -> Option<Self> {
+        let n = line_words([lo, hi])?;
+        if !grid.contains(hi) {
+            return None;
+        }
+        // Both sides at most `LINE_SIDE` (31): every shift below is under 32.
+        let (w, h) = (u32::from(hi.x - lo.x) + 1, u32::from(hi.y - lo.y) + 1);
+        let (wu, hu) = (w as usize, h as usize);
+        let words = words.get_mut(..n)?;
+        words.fill(0);
+        let (rows, rest) = words.split_at_mut(hu);
+        let (rows_rev, rest) = rest.split_at_mut(hu);
+        let (cols, cols_rev) = rest.split_at_mut(wu);
+        let full = u32::MAX.wrapping_shr(32 - w);
+        for (k, (row, rev)) in rows.iter_mut().zip(rows_rev.iter_mut()).enumerate() {
+            let y = usize::from(lo.y).wrapping_add(k);
+            let i = y
+                .wrapping_mul(usize::from(grid.width()))
+                .wrapping_add(usize::from(lo.x));
+            let free = !crate::map::bits::run(grid.bits(), i, w) & full;
+            *row = free;
+            *rev = free.reverse_bits().wrapping_shr(32 - w);
+            // The row's free cells in the columns: bit k from the top, h - 1 - k from the bottom.
+            let mut m = free;
+            while m != 0 {
+                let j = m.trailing_zeros() as usize;
+                m &= m.wrapping_sub(1);
+                if let Some(c) = cols.get_mut(j) {
+                    *c |= 1u32.wrapping_shl(k as u32);
+                }
+                if let Some(c) = cols_rev.get_mut(j) {
+                    *c |= 1u32.wrapping_shl(h.wrapping_sub(1).wrapping_sub(k as u32));
+                }
+            }
+        }
+        Some(Self {
+            corners: [lo, hi],
+            sets: [rows, rows_rev, cols, cols_rev],
+        })
+    }
 }
 
 /// A depth beyond which no cell of the octant lies inside the ellipse `|w| + |w - goal| <
@@ -311,32 +468,67 @@ impl Octant<'_, '_> {
             let deeper = next <= rows;
             // The part of the interval not cut yet starts at `cur` (open unless 0).
             let mut cur = (ln, ld);
-            let mut prev_blocked = false;
-            for c in a..=b {
-                if self.blocked(row, c) {
-                    // This square hides `[(2c - 1) / (2r + 1), (2c + 1) / (2r - 1)]`.
-                    let (sn, sd) = (c.wrapping_mul(2).wrapping_sub(1), d_lo);
-                    let (en, ed) = (c.wrapping_mul(2).wrapping_add(1), d_hi);
-                    // The piece before it (its upper end open: the square's lower end), up to
-                    // the interval's own upper end if that comes first.
-                    let upper = if less_eq((sn, sd), (hn, hd)) {
-                        (sn, sd)
-                    } else {
-                        (hn, hd)
-                    };
-                    if deeper && less(cur, upper) && !push(stack, &mut top, next, cur, upper) {
+            // A blocked square at column `c` hides `[(2c - 1) / (2r + 1), (2c + 1) / (2r - 1)]`:
+            // the piece before it (its upper end open: the square's lower end, or the
+            // interval's own upper end if that comes first) goes deeper, `cur` moves past it.
+            // `false`: the stack is full.
+            let mut cut = |c: i32, cur: &mut Frac, top: &mut usize| {
+                let (sn, sd) = (c.wrapping_mul(2).wrapping_sub(1), d_lo);
+                let (en, ed) = (c.wrapping_mul(2).wrapping_add(1), d_hi);
+                let upper = if less_eq((sn, sd), (hn, hd)) {
+                    (sn, sd)
+                } else {
+                    (hn, hd)
+                };
+                if deeper && less(*cur, upper) && !push(stack, top, next, *cur, upper) {
+                    return false;
+                }
+                if less(*cur, (en, ed)) {
+                    *cur = (en, ed);
+                }
+                true
+            };
+            if let Some(line) = self.line {
+                // The row as a word (the box's sides are at most `LINE_SIDE`: `r + 1 <= 31`):
+                // the blocked squares in order, then the free cells, the same cuts and marks
+                // as the loop below (the marks' order is not the loop's; they only set bits).
+                let free = line.free(r);
+                let mut blocked = !free & span(a, b);
+                // The diagonal cell `(r, r)` also needs the square before it free (it passes
+                // that square's corner), when that square is in the row's columns.
+                let before_diag = r > a && blocked.wrapping_shr(r.wrapping_sub(1) as u32) & 1 == 1;
+                while blocked != 0 {
+                    let c = blocked.trailing_zeros() as i32;
+                    blocked &= blocked.wrapping_sub(1);
+                    if !cut(c, &mut cur, &mut top) {
                         return false;
                     }
-                    if less(cur, (en, ed)) {
-                        cur = (en, ed);
+                }
+                let mut seen = free & span(cmin, cmax);
+                if !diag || before_diag {
+                    seen &= !1u32.wrapping_shl(r as u32);
+                }
+                while seen != 0 {
+                    let c = seen.trailing_zeros() as i32;
+                    seen &= seen.wrapping_sub(1);
+                    // Free, so on the map and in the box: the index is valid.
+                    mark(row.wrapping_add(c.wrapping_mul(self.dc)) as usize);
+                }
+            } else {
+                let mut prev_blocked = false;
+                for c in a..=b {
+                    if self.blocked(row, c) {
+                        if !cut(c, &mut cur, &mut top) {
+                            return false;
+                        }
+                        prev_blocked = true;
+                    } else {
+                        if c >= cmin && c <= cmax && (c < r || (diag && !prev_blocked)) {
+                            // On the map and in the box (not blocked), so the index is valid.
+                            mark(row.wrapping_add(c.wrapping_mul(self.dc)) as usize);
+                        }
+                        prev_blocked = false;
                     }
-                    prev_blocked = true;
-                } else {
-                    if c >= cmin && c <= cmax && (c < r || (diag && !prev_blocked)) {
-                        // On the map and in the box (not blocked), so the index is valid.
-                        mark(row.wrapping_add(c.wrapping_mul(self.dc)) as usize);
-                    }
-                    prev_blocked = false;
                 }
             }
             if deeper && less(cur, (hn, hd)) && !push(stack, &mut top, next, cur, (hn, hd)) {
@@ -400,7 +592,7 @@ mod tests {
     fn the_swept_set_is_exactly_the_segment_rule() {
         let mut rng = crate::rng::Xoshiro128pp::from_u64(36);
         let mut stack = vec![0u32; 3 * 256];
-        let (mut seen, mut hidden) = (0usize, 0usize);
+        let (mut seen, mut hidden, mut with_lines) = (0usize, 0usize, 0usize);
         for round in 0..600 {
             let w = 1 + (rng.next_word() % 40) as u16;
             let h = 1 + (rng.next_word() % 40) as u16;
@@ -433,9 +625,33 @@ mod tests {
                 reach: (rng.next_word() % 60) as f32 + 0.5,
             });
             let mut got = vec![false; g.cells()];
-            assert!(sweep(&g, u, [lo, hi], depth, reach, &mut stack, |i| got
-                [i] =
-                true));
+            assert!(sweep(
+                &g,
+                u,
+                [lo, hi],
+                depth,
+                reach,
+                None,
+                &mut stack,
+                |i| got[i] = true
+            ));
+            // The same marks from the box's lines, where its sides allow them.
+            let mut words = vec![0u32; line_words([lo, hi]).unwrap_or(0)];
+            if let Some(lines) = Lines::fill(&g, [lo, hi], &mut words) {
+                let mut by_lines = vec![false; g.cells()];
+                assert!(sweep(
+                    &g,
+                    u,
+                    [lo, hi],
+                    depth,
+                    reach,
+                    Some(&lines),
+                    &mut stack,
+                    |i| by_lines[i] = true
+                ));
+                assert_eq!(by_lines, got, "{w}x{h} {u:?} box {lo:?}..{hi:?} by lines");
+                with_lines += 1;
+            }
             for (i, &got) in got.iter().enumerate() {
                 let v = g.point(i);
                 let inside = v.x >= lo.x && v.x <= hi.x && v.y >= lo.y && v.y <= hi.y;
@@ -469,6 +685,7 @@ mod tests {
             }
         }
         assert!(seen > 10_000 && hidden > 10_000, "{seen} {hidden}");
+        assert!(with_lines > 300, "{with_lines}");
     }
 
     /// The rows [`inside`] lets skip [`Octant::far`] lie inside the ellipse (both ends of each,
@@ -568,6 +785,7 @@ mod tests {
             [lo, hi],
             [u16::MAX; 4],
             None,
+            None,
             &mut stack,
             |_| ()
         ));
@@ -577,6 +795,7 @@ mod tests {
             u,
             [lo, hi],
             [u16::MAX; 4],
+            None,
             None,
             &mut stack,
             |_| ()
