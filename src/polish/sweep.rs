@@ -426,11 +426,12 @@ impl Octant<'_, '_> {
         // A pending interval: its row, its lower end `ln / ld` (closed iff `ln == 0`: the
         // uncut 0) and its upper end `hn / hd` (closed iff `hd == 1`: the uncut 1); ends are
         // non-negative and below 2^16.
+        // The interval next swept is kept out of the stack: the last piece a row leaves is
+        // the one the stack would give back first (it is pushed last), so it goes on without
+        // a push and a pop; the others wait on the stack, in the same order as ever.
         let mut top = 0usize;
-        if !push(stack, &mut top, 1, (0, 1), (1, 1)) {
-            return false;
-        }
-        while let Some((r, (ln, ld), (hn, hd))) = pop(stack, &mut top) {
+        let mut held = Some((1, (0, 1), (1, 1)));
+        while let Some((r, (ln, ld), (hn, hd))) = held.take().or_else(|| pop(stack, &mut top)) {
             if r > self.inside && self.far(r, (ln, ld), (hn, hd)) {
                 continue;
             }
@@ -531,8 +532,8 @@ impl Octant<'_, '_> {
                     }
                 }
             }
-            if deeper && less(cur, (hn, hd)) && !push(stack, &mut top, next, cur, (hn, hd)) {
-                return false;
+            if deeper && less(cur, (hn, hd)) {
+                held = Some((next, cur, (hn, hd)));
             }
         }
         true
