@@ -477,6 +477,9 @@ fn mark(
     list: &mut [u32],
 ) -> Option<usize> {
     let mut v = 0usize;
+    // The last square visited (columns, then rows, inclusive): consecutive points of the
+    // walk along the segments are at most a cell apart, so their squares mostly overlap.
+    let mut seen: Option<(i64, i64, i64, i64)> = None;
     let r = i64::from(radius);
     let (w, h) = (i64::from(grid.width()), i64::from(grid.height()));
     // Coordinates and offsets are below 2^17 in magnitude, so no i64 operation below wraps.
@@ -498,8 +501,27 @@ fn mark(
         for k in 0..=steps {
             let x = ax.wrapping_add(at(dx, k));
             let y = ay.wrapping_add(at(dy, k));
-            for cy in y.wrapping_sub(r).max(0)..=y.wrapping_add(r).min(h.wrapping_sub(1)) {
-                for cx in x.wrapping_sub(r).max(0)..=x.wrapping_add(r).min(w.wrapping_sub(1)) {
+            let square = (
+                x.wrapping_sub(r).max(0),
+                x.wrapping_add(r).min(w.wrapping_sub(1)),
+                y.wrapping_sub(r).max(0),
+                y.wrapping_add(r).min(h.wrapping_sub(1)),
+            );
+            let (x0, x1, y0, y1) = square;
+            // The previous square's cells are all candidates already (its free ones were
+            // listed): only the rest of this one is visited, in the same order (row by row,
+            // left to right), so the cells are listed in the order of a visit of every cell.
+            let (px0, px1, py0, py1) = seen.unwrap_or((1, 0, 1, 0));
+            seen = Some(square);
+            for cy in y0..=y1 {
+                // The row's columns outside the previous square: left of it, then right of it
+                // (all of them when the row is not the previous square's).
+                let (left, right) = if cy >= py0 && cy <= py1 {
+                    (x1.min(px0.wrapping_sub(1)), x0.max(px1.wrapping_add(1)))
+                } else {
+                    (x1, x1.wrapping_add(1))
+                };
+                for cx in (x0..=left).chain(right..=x1) {
                     // In range: 0 <= cx < w and 0 <= cy < h, both below 2^16.
                     let q = Point::new(cx as u16, cy as u16);
                     if !grid.is_free(q) {
@@ -600,6 +622,64 @@ mod tests {
     /// sweep's stack, only the stack short (the sweep gives up, every cell is tested), or no
     /// bitmap (every cell tested by `segment_clear`). A fallback that skipped a visible cell,
     /// or let a hidden one through, would change the path.
+    /// The corridor's list is every free cell within the radius of the path's points, in the
+    /// order a visit of each point's whole square finds them first (the order the A*'s ties
+    /// follow): `mark`, which visits only the part of each square its predecessor's does not
+    /// cover, lists the same cells in the same order, on random maps and paths.
+    #[test]
+    fn the_corridor_lists_its_cells_in_the_order_of_whole_squares() {
+        let mut rng = crate::rng::Xoshiro128pp::from_u64(41);
+        for round in 0..300 {
+            let (w, h) = (
+                1 + (rng.next_word() % 40) as u16,
+                1 + (rng.next_word() % 40) as u16,
+            );
+            let b = crate::testutil::random_bits(&mut rng, w, h, (round % 5) as f32 * 0.1);
+            let g = Grid::new(w, h, &b).unwrap();
+            let n = 2 + (rng.next_word() % 6) as usize;
+            let path: Vec<Point> = (0..n)
+                .map(|_| {
+                    Point::new(
+                        (rng.next_word() % u32::from(w)) as u16,
+                        (rng.next_word() % u32::from(h)) as u16,
+                    )
+                })
+                .collect();
+            let radius = (round % 4) as u16;
+            // Every square whole, in order.
+            let mut want: Vec<u32> = Vec::new();
+            for pair in path.windows(2) {
+                let (a, b) = (pair[0], pair[1]);
+                let (dx, dy) = (
+                    i64::from(b.x) - i64::from(a.x),
+                    i64::from(b.y) - i64::from(a.y),
+                );
+                let steps = dx.abs().max(dy.abs()).max(1);
+                for k in 0..=steps {
+                    let at = |d: i64| (2 * d * k + steps).div_euclid(2 * steps);
+                    let (x, y) = (i64::from(a.x) + at(dx), i64::from(a.y) + at(dy));
+                    let r = i64::from(radius);
+                    for cy in (y - r).max(0)..=(y + r).min(i64::from(h) - 1) {
+                        for cx in (x - r).max(0)..=(x + r).min(i64::from(w) - 1) {
+                            let q = Point::new(cx as u16, cy as u16);
+                            if g.is_free(q) && !want.contains(&pack(q)) {
+                                want.push(pack(q));
+                            }
+                        }
+                    }
+                }
+            }
+            let mut cell = vec![Entry::EMPTY; g.cells()];
+            let mut list = vec![0u32; g.cells()];
+            let v = mark(&g, &path, radius, &mut cell, &mut list).unwrap();
+            assert_eq!(&list[..v], &want[..], "round {round}");
+            for (k, &c) in want.iter().enumerate() {
+                let e = cell[g.index(unpack(c))];
+                assert_eq!((e.flags, e.pos), (CANDIDATE, k as u16));
+            }
+        }
+    }
+
     #[test]
     fn the_path_does_not_depend_on_the_room_for_the_sweep() {
         let rows = [
