@@ -212,14 +212,19 @@ pub fn try_shortest(
     let exact = grid.width() <= EXACT_SIDE && grid.height() <= EXACT_SIDE;
     // A*: expand the open cell of least g + h (the first one on ties) until the goal closes.
     while open_len > 0 {
-        let mut best: Option<(usize, f32)> = None;
-        for (k, &c) in open.iter().enumerate().take(open_len) {
-            let f = cell.get(c as usize).map_or(f32::INFINITY, |e| e.g + e.h);
-            if best.is_none_or(|(_, bf)| f < bf) {
-                best = Some((k, f));
+        let shown = open.get(..open_len.min(open.len())).unwrap_or_default();
+        let f_of = |c: u32| cell.get(c as usize).map_or(f32::INFINITY, |e| e.g + e.h);
+        let Some((&first, others)) = shown.split_first() else {
+            break;
+        };
+        // The first, then each later one strictly below the least so far.
+        let (mut k, mut least) = (0usize, f_of(first));
+        for (j, &c) in others.iter().enumerate() {
+            let f = f_of(c);
+            if f < least {
+                (k, least) = (j.wrapping_add(1), f);
             }
         }
-        let Some((k, _)) = best else { break };
         // Take it out of the open list: the last open cell fills its place.
         open_len = open_len.wrapping_sub(1); // > 0: the loop's condition
         let i = open.get(k).copied().unwrap_or(0) as usize;
