@@ -199,16 +199,14 @@ pub fn try_shortest(
     // The box's lines of free bits ([`crate::polish::sweep::Lines`]), from the stack's room
     // when the box is small enough and the stack keeps room for its intervals: each sweep then
     // reads an octant's row as one word. Without them, the same marks one cell at a time.
-    let (lines, stack) = match crate::polish::sweep::line_words([lo, hi]) {
-        Some(n) if stack.len() >= n.saturating_add(LINE_STACK) => {
-            let (words, stack) = stack.split_at_mut(n);
-            (
-                crate::polish::sweep::Lines::fill(grid, [lo, hi], words),
-                stack,
-            )
-        }
-        _ => (None, stack),
+    let room = match crate::polish::sweep::line_words([lo, hi]) {
+        Some(n) if stack.len() >= n.saturating_add(LINE_STACK) => n,
+        _ => 0,
     };
+    let (words, stack) = stack.split_at_mut(room.min(stack.len()));
+    let lines = (room > 0)
+        .then(|| crate::polish::sweep::Lines::fill(grid, [lo, hi], words))
+        .flatten();
     let exact = grid.width() <= EXACT_SIDE && grid.height() <= EXACT_SIDE;
     // A*: expand the open cell of least g + h (the first one on ties) until the goal closes.
     while open_len > 0 {
