@@ -26,7 +26,9 @@
 //! improve (the A*'s own length test, with an eighth of a cell of slack: `reaches`,
 //! [`crate::polish::sweep::Near`]). The scan walks the set bits in the list's order (the same
 //! ties as a scan of every live cell) and takes the length (one `vsqrt.f32` on the device) of
-//! those cells only. The bitmap and the sweep's pending intervals live in the list's tail;
+//! those cells only. The bitmap, the box's free cells as words a line (for boxes of sides up
+//! to [`crate::polish::sweep::LINE_SIDE`]: each sweep reads an octant's row as one word,
+//! [`crate::polish::sweep::Lines`]) and the sweep's pending intervals live in the list's tail;
 //! without room (or when the sweep's stack runs out), the expansion tests every live cell's
 //! improving edge by one [`segment_clear`] each: the same relaxations.
 //! It runs on maps of at most [`crate::colony::pheromone::BLOCKS`] cells, whose per-cell

@@ -38,7 +38,8 @@
 //!
 //! **Cost.** Each pending interval scans the cells of its row it covers, plus one cell each
 //! side (a blocked square's interval reaches half a column beyond its own slope); a hidden
-//! region costs nothing. The pending intervals live on a caller's stack of
+//! region costs nothing. Given the box's [`Lines`] (sides up to [`LINE_SIDE`]), a row is one
+//! word: its blocked squares are taken by their bits, its visible cells by theirs. The pending intervals live on a caller's stack of
 //! [`FRAME`] words each (no allocation); when it is full, [`sweep`] says so (`false`) and the
 //! caller must not trust the marks (the corridor then tests its cells one by one). No panic.
 
