@@ -93,6 +93,21 @@ mod tests {
     }
 
     #[test]
+    fn a_run_reads_its_cells_and_blocked_past_the_end() {
+        // Every start and length over seven bytes of a pattern, against one read a cell.
+        let b = [0b1011_0010u8, 0xFF, 0x00, 0b0101_0101, 0x3C, 0x81, 0x7E];
+        for i in 0..64 {
+            for n in 0..=32u32 {
+                let got = run(&b, i, n);
+                for k in 0..32 {
+                    let want = k < n as usize && get(&b, i + k).unwrap_or(true);
+                    assert_eq!(got >> k & 1 == 1, want, "run({i}, {n}) bit {k}");
+                }
+            }
+        }
+    }
+
+    #[test]
     fn fill_sets_exactly_its_cells() {
         // Every (from, len) over three bytes against setting the cells one by one.
         for from in 0..24 {

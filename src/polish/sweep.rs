@@ -65,6 +65,7 @@ const MAX_DEPTH: i32 = 1 << 13;
 /// the caller leaves more, see [`Near`]). `stack` holds the pending intervals
 /// ([`FRAME`] words each); `false` when it was too short (then some visible cells may be
 /// missing) or the box is not on the map or does not hold `u`.
+#[allow(clippy::too_many_arguments)]
 pub fn sweep(
     grid: &Grid<'_>,
     u: Point,
@@ -270,7 +271,13 @@ fn span(lo: i32, hi: i32) -> u32 {
 /// `None` when a side is above [`LINE_SIDE`] (or the corners are not ordered).
 pub fn line_words([lo, hi]: [Point; 2]) -> Option<usize> {
     let (w, h) = (hi.x.checked_sub(lo.x)?, hi.y.checked_sub(lo.y)?);
-    (w < LINE_SIDE && h < LINE_SIDE).then(|| 2 * (usize::from(w) + usize::from(h) + 2))
+    // Sides at most 31: no overflow.
+    (w < LINE_SIDE && h < LINE_SIDE).then(|| {
+        usize::from(w)
+            .wrapping_add(usize::from(h))
+            .wrapping_add(2)
+            .wrapping_mul(2)
+    })
 }
 
 impl<'a> Lines<'a> {
@@ -282,14 +289,17 @@ impl<'a> Lines<'a> {
             return None;
         }
         // Both sides at most `LINE_SIDE` (31): every shift below is under 32.
-        let (w, h) = (u32::from(hi.x - lo.x) + 1, u32::from(hi.y - lo.y) + 1);
+        let (w, h) = (
+            u32::from(hi.x.wrapping_sub(lo.x)).wrapping_add(1),
+            u32::from(hi.y.wrapping_sub(lo.y)).wrapping_add(1),
+        );
         let (wu, hu) = (w as usize, h as usize);
         let words = words.get_mut(..n)?;
         words.fill(0);
         let (rows, rest) = words.split_at_mut(hu);
         let (rows_rev, rest) = rest.split_at_mut(hu);
         let (cols, cols_rev) = rest.split_at_mut(wu);
-        let full = u32::MAX.wrapping_shr(32 - w);
+        let full = u32::MAX.wrapping_shr(32u32.wrapping_sub(w));
         for (k, (row, rev)) in rows.iter_mut().zip(rows_rev.iter_mut()).enumerate() {
             let y = usize::from(lo.y).wrapping_add(k);
             let i = y
@@ -297,7 +307,7 @@ impl<'a> Lines<'a> {
                 .wrapping_add(usize::from(lo.x));
             let free = !crate::map::bits::run(grid.bits(), i, w) & full;
             *row = free;
-            *rev = free.reverse_bits().wrapping_shr(32 - w);
+            *rev = free.reverse_bits().wrapping_shr(32u32.wrapping_sub(w));
             // The row's free cells in the columns: bit k from the top, h - 1 - k from the bottom.
             let mut m = free;
             while m != 0 {
