@@ -219,6 +219,10 @@ impl Ant<'_, '_, '_> {
         if let (true, Some(table)) = (cells, self.weights) {
             return self.resume_table(table, trail, rng, tabu, tour, left);
         }
+        // The loop for an entry a cell without a table reads the linear layout only: a set in
+        // the rows layout walks by the general loop, which reads either (the same walk).
+        #[cfg(any(feature = "alloc", test))]
+        let cells = cells && !tabu.is_rows();
         self.resume_by(cells, trail, rng, tabu, tour, left)
     }
 
