@@ -292,7 +292,99 @@ impl<'a> TabuSet<'a> {
 
 #[cfg(test)]
 mod tests {
-    use super::TabuSet;
+    use super::{rows_words, TabuSet, ROWS_WIDTH};
+    use crate::map::bitmap;
+    use crate::map::dir::{DX, DY};
+    use crate::map::grid::Point;
+    use crate::rng::Xoshiro128pp;
+
+    #[test]
+    fn the_rows_layout_reads_as_the_linear_one() {
+        // Random maps up to the widest the rows hold, random pruning marks (or none) and random
+        // cells entered, by index and by point: every cell's membership, and every cell's
+        // neighbourhood on the map by index and (unchecked) by point, read the same in both
+        // layouts; and starting a walk again gives back the marks alone.
+        let mut r = Xoshiro128pp::from_u64(3636);
+        for case in 0..300 {
+            let w = 1 + r.next_word() as usize % ROWS_WIDTH;
+            let h = 1 + r.next_word() as usize % 40;
+            let cells = w * h;
+            let mut dead = vec![0u32; bitmap::words(cells)];
+            if case % 3 != 0 {
+                for i in 0..cells {
+                    if r.next_word() % 5 == 0 {
+                        bitmap::set(&mut dead, i);
+                    }
+                }
+            }
+            let dead: &[u32] = if case % 3 == 0 { &[] } else { &dead };
+            let mut lin_words = vec![u32::MAX; bitmap::words(cells)];
+            let mut row_words = vec![0x5555_5555u32; bitmap::words(cells)];
+            // Junk in the spare words: the set must write every word it reads.
+            let mut spare: Vec<u32> = (0..rows_words(cells) as u32)
+                .map(|i| i.wrapping_mul(0x9E37_79B9) | 1)
+                .collect();
+            let mut lin = TabuSet::new(&mut lin_words);
+            let mut rows = TabuSet::new(&mut row_words).with_rows(&mut spare, w, h, dead);
+            assert!(rows.is_rows() && !lin.is_rows());
+            for round in 0..2 {
+                lin.reset(cells, dead);
+                rows.reset(cells, dead);
+                for _ in 0..r.next_word() as usize % (cells + 1) {
+                    let i = r.next_word() as usize % cells;
+                    lin.insert(i);
+                    if r.next_word() % 2 == 0 {
+                        rows.insert(i);
+                    } else {
+                        let at = Point::new((i % w) as u16, (i / w) as u16);
+                        rows.insert_at(at);
+                    }
+                }
+                for i in 0..cells {
+                    assert_eq!(rows.contains(i), lin.contains(i), "{w}x{h} cell {i}");
+                    let (x, y) = ((i % w) as i32, (i / w) as i32);
+                    let on_map = (0..8)
+                        .filter(|&d| {
+                            let (nx, ny) = (x + DX[d], y + DY[d]);
+                            nx >= 0 && ny >= 0 && nx < w as i32 && ny < h as i32
+                        })
+                        .fold(0u8, |m, d| m | 1 << d);
+                    let want = lin.around(i, w) & on_map;
+                    assert_eq!(
+                        rows.around(i, w) & on_map,
+                        want,
+                        "{w}x{h} cell {i}, {round}"
+                    );
+                    let at = Point::new(x as u16, y as u16);
+                    assert_eq!(rows.around_at(at) & on_map, want, "{w}x{h} at {at:?}");
+                }
+                // Beyond the map: in the set, and never entered.
+                assert!(rows.contains(cells) && rows.contains(usize::MAX));
+                rows.insert(cells);
+                assert!((0..cells).all(|i| rows.contains(i) == lin.contains(i)));
+            }
+        }
+    }
+
+    #[test]
+    fn a_map_the_rows_do_not_hold_stays_linear() {
+        // Too wide, or spare words too short: linear, and read as such.
+        let (w, h) = (ROWS_WIDTH + 1, 4);
+        let mut words = vec![0u32; bitmap::words(w * h)];
+        let mut spare = vec![0u32; rows_words(w * h)];
+        let mut t = TabuSet::new(&mut words).with_rows(&mut spare, w, h, &[]);
+        assert!(!t.is_rows());
+        t.insert(40);
+        assert!(t.contains(40) && !t.contains(39));
+        let mut short = vec![0u32; 2 * (h + 2) - 1];
+        let mut words = vec![0u32; 1];
+        assert!(!TabuSet::new(&mut words)
+            .with_rows(&mut short, 3, h, &[])
+            .is_rows());
+        assert!(!TabuSet::new(&mut words)
+            .with_rows(&mut short, 0, h, &[])
+            .is_rows());
+    }
 
     #[test]
     fn a_set_holds_its_cells_and_refuses_the_rest() {
