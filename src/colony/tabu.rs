@@ -181,13 +181,24 @@ impl<'a> TabuSet<'a> {
         }
     }
 
+    /// In the rows layout: cell `i`'s column and row (the width is not 0 there; were it, a row
+    /// beyond every map).
+    #[cfg(any(feature = "alloc", test))]
+    #[inline]
+    fn xy(&self, i: usize) -> (usize, usize) {
+        let w = self.rows.width;
+        (
+            i.checked_rem(w).unwrap_or(0),
+            i.checked_div(w).unwrap_or(usize::MAX),
+        )
+    }
+
     /// In the rows layout: cell `i`'s word and bit, `None` beyond the map.
     #[cfg(any(feature = "alloc", test))]
     #[inline]
     fn row_bit(&self, i: usize) -> Option<(usize, u32)> {
-        let w = self.rows.width;
-        let (x, y) = (i % w, i / w); // w > 0 in the rows layout
-                                     // y < height, x < width <= 30: neither sum overflows.
+        let (x, y) = self.xy(i);
+        // y < height, x < width <= 30: neither the sum nor the shift overflows.
         (y < self.rows.height).then_some((y.wrapping_add(1), 2u32 << x))
     }
 
@@ -233,8 +244,8 @@ impl<'a> TabuSet<'a> {
     pub fn around(&self, i: usize, width: usize) -> u8 {
         #[cfg(any(feature = "alloc", test))]
         if self.is_rows() {
-            let w = self.rows.width;
-            return self.around_xy(i % w, i / w); // w > 0 in the rows layout
+            let (x, y) = self.xy(i);
+            return self.around_xy(x, y);
         }
         self.around_linear(i, width)
     }
