@@ -122,7 +122,13 @@ pub fn around(bits: &[u32], i: usize, width: usize) -> u8 {
 pub fn around_top(bits: &[u32], top: usize, width: usize) -> u8 {
     let mid = top.wrapping_add(width);
     let bottom = mid.wrapping_add(width);
-    let nb = three(bits, top) | three(bits, mid) << 3 | three(bits, bottom) << 6;
+    ring(three(bits, top) | three(bits, mid) << 3 | three(bits, bottom) << 6)
+}
+
+/// A 3 x 3 neighbourhood's cells (bit `3 r + c` = cell `(x - 1 + c, y - 1 + r)`; bits above 8
+/// ignored) as a direction mask (bit `d` = the neighbour in direction `d`; the centre left out).
+#[inline(always)]
+pub fn ring(nb: u32) -> u8 {
     RING9.get(nb as usize & 511).copied().unwrap_or(0)
 }
 

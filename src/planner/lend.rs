@@ -22,6 +22,7 @@
 //! | setup: the coarse route, packed ([`route::pack`], the compact arena) | the route's words and its heap, a word a block each | the tabu bit set halved, else the tabu set and the links, else the links halved |
 //! | colony: tightening ([`crate::colony::tighten`]) | a cell -> position index | the links (a per-cell array or a hash table), else the links and the path cells' words together (packed keys) |
 //! | colony: the weight table (`crate::colony::weights`), where the walks read one (an entry a cell, no route) | 10 words a cell | its own buffer, whole, when it holds them (`needs::lend_weights`); else none: the walks compute their weights at each move |
+//! | colony: the tabu set's rows layout ([`TabuSet::with_rows`]: a map at most 30 cells wide, read by the loop with a table) | `2 (height + 2)` words | the weight buffer's words beyond the table's, when they hold them; else the tabu set stays linear in its own words |
 //! | polish: the local search ([`crate::polish::refine`]) | two slices of [`super::run::REFINE_WORDS`] | the links and the route's words, the links and the tabu set, the tabu set and the route's words, the tabu set halved, the links halved |
 //! | polish: the local search's memo ([`crate::polish::refine::Memo`]) | [`MEMO_RECORDS`] records | the front of the pheromone increments (the smoothing's ring later, the route's stash at the far end) |
 //! | polish: the smoothing ([`crate::polish::smoothing`]) | `n` links for its shortest-path rule (fewer: the greedy rule) | the links, else the tabu set (free after the last ant and the local search) |
@@ -241,10 +242,23 @@ impl Spent<'_> {
 /// The colony's weight table over `words` for a map of `cells` cells, lent by
 /// [`Need::Weights`]'s rule ([`lend_weights`]). Not inlined: the colony's frame, on the device's
 /// deepest path, keeps its size (the device has no table).
+/// The words beyond the table's ([`weights::words`]`(cells)`) come back beside it: the tabu
+/// set's rows layout takes them ([`TabuSet::with_rows`]; empty when there is no table).
 #[cfg(any(feature = "alloc", test))]
 #[inline(never)]
-fn weight_table(words: &mut [u32], ask: Ask, cells: usize) -> Option<WeightTable<'_>> {
-    WeightTable::of(lend_weights(words, ask)?, cells)
+fn weight_table(
+    words: &mut [u32],
+    ask: Ask,
+    cells: usize,
+) -> (Option<WeightTable<'_>>, &mut [u32]) {
+    let Some(lent) = lend_weights(words, ask) else {
+        return (None, &mut []);
+    };
+    let (table, spare) = lent.split_at_mut(weights::words(cells).min(lent.len()));
+    match WeightTable::of(table, cells) {
+        Some(t) => (Some(t), spare),
+        None => (None, &mut []),
+    }
 }
 
 impl<'a> Workspace<'a> {
@@ -262,23 +276,35 @@ impl<'a> Workspace<'a> {
         }
     }
 
-    /// The colony's view; `table`: the map's cells when its walks read a weight table (the loop
-    /// for an entry a cell, [`crate::colony::ant`]), lent when the workspace holds one for them.
-    pub(super) fn colony(&mut self, table: Option<usize>) -> Colony<'_> {
+    /// The colony's view; `table`: the map's width and height when its walks read a weight
+    /// table (the loop for an entry a cell, [`crate::colony::ant`]), lent when the workspace
+    /// holds one for them, with the tabu set in the rows layout in the weight buffer's words
+    /// beyond the table where they hold it ([`TabuSet::with_rows`]: a map at most
+    /// [`crate::colony::tabu::ROWS_WIDTH`] wide). The same choice at every piece: it depends
+    /// only on the map and the buffers' lengths.
+    pub(super) fn colony(&mut self, table: Option<(usize, usize)>) -> Colony<'_> {
         #[cfg(any(feature = "alloc", test))]
-        let weights = {
-            let cells = table.unwrap_or(0);
+        let (weights, tabu) = {
+            let (width, height) = table.unwrap_or((0, 0));
+            let cells = width.saturating_mul(height);
             let words = table.map_or(0, |_| weights::words(cells));
-            weight_table(self.weights, Ask::weights(words), cells)
+            let (weights, spare) = weight_table(self.weights, Ask::weights(words), cells);
+            let tabu = TabuSet::new(self.tabu);
+            let tabu = if weights.is_some() {
+                tabu.with_rows(spare, width, height, self.dead)
+            } else {
+                tabu
+            };
+            (weights, tabu)
         };
         #[cfg(not(any(feature = "alloc", test)))]
-        let _ = table;
+        let (tabu, _) = (TabuSet::new(self.tabu), table);
         Colony {
             #[cfg(any(feature = "alloc", test))]
             weights,
             tau: self.tau,
             delta: self.delta,
-            tabu: TabuSet::new(self.tabu),
+            tabu,
             dead: self.dead,
             moves: self.moves,
             tours: [self.tour, self.iter_best, self.iter_worst, self.best],

@@ -14,7 +14,7 @@
 //! | `links` | `cells`, or at least tightening's table ([`crate::colony::tighten::hash_words`]`(steps + 1)`: `2 (steps + 1)` half-word slots at a load of 1/2, down to `3 (steps + 1) / 2` at 2/3; fewer leave walks untightened), `steps + 1` (the smoothing's shortest-path rule; fewer: its greedy rule) and [`GUIDE_BLOCKS`] | 4 | path positions (tightening), flood-fill ring, pruning stack, route heap, smoothing links |
 //! | `curve` | iterations recorded | 16 | the convergence curve |
 //! | `guide` | [`GUIDE_BLOCKS`] on maps of more than [`BLOCKS`] cells, else none; an eighth of that packed ([`Workspace::with_packed_route`]) | 4 | the coarse route ([`crate::colony::route`]) |
-//! | `weights`, or none | 10 a cell on maps of at most [`BLOCKS`] cells ([`Workspace::weight_words`]; feature `alloc`: the heap storage gives it, a device's storages none) | 4 | the iteration's weights by cell and direction ([`crate::colony::weights`]; without it the walks compute them at each move, the same walks) |
+//! | `weights`, or none | 12 a cell and 4 on maps of at most [`BLOCKS`] cells ([`Workspace::weight_words`]; feature `alloc`: the heap storage gives it, a device's storages none) | 4 | the iteration's weights by cell and direction ([`crate::colony::weights`]; without it the walks compute them at each move, the same walks), and the tabu set's rows layout beside them ([`crate::colony::tabu`]) |
 //!
 //! A buffer idle in a phase lends itself to another role there (the links above, the tabu set to
 //! the route's heap and the local search, the path cells to tightening's keyed table); each phase
@@ -151,9 +151,13 @@ impl<'a> Workspace<'a> {
 
     /// Words of the colony's weight table ([`Workspace::with_weights`]) for maps of up to `cells`
     /// cells: [`crate::colony::weights::words`] (10 a cell) for the maps whose walks read one (at most
-    /// [`BLOCKS`] cells: the pheromone has an entry a cell), none for larger ones (saturating).
+    /// [`BLOCKS`] cells: the pheromone has an entry a cell), none for larger ones, and beside
+    /// the table the tabu set's rows layout on maps at most
+    /// [`crate::colony::tabu::ROWS_WIDTH`] wide ([`crate::colony::tabu::rows_words`]: 2 a cell
+    /// and 4; saturating).
     pub const fn weight_words(cells: usize) -> usize {
-        crate::colony::weights::words(if cells < BLOCKS { cells } else { BLOCKS })
+        let c = if cells < BLOCKS { cells } else { BLOCKS };
+        crate::colony::weights::words(c).saturating_add(crate::colony::tabu::rows_words(c))
     }
 
     /// The same workspace with a weight table in `weights` ([`crate::colony::weights`]: the

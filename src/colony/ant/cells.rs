@@ -31,7 +31,7 @@ impl Ant<'_, '_, '_> {
         // The generator as a local: the loop keeps its state in registers (through `rng` it
         // would store it at every draw, since the tour and tabu writes might alias it).
         let mut gen = rng.clone();
-        let r = self.cells_loop(None, trail, &mut gen, tabu, tour, limit, pow);
+        let r = self.cells_loop::<false>(None, trail, &mut gen, tabu, tour, limit, pow);
         *rng = gen;
         r
     }
@@ -55,15 +55,23 @@ impl Ant<'_, '_, '_> {
         pow: impl Fn(f32) -> f32,
     ) -> Result<Option<Walk>, Lost> {
         let mut gen = rng.clone();
-        let r = self.cells_loop(Some(table), trail, &mut gen, tabu, tour, limit, pow);
+        // The tabu set's layout, chosen when the set was made: the rows layout's reads where it
+        // has it (a narrow map), else the linear layout's.
+        let r = if tabu.is_rows() {
+            self.cells_loop::<true>(Some(table), trail, &mut gen, tabu, tour, limit, pow)
+        } else {
+            self.cells_loop::<false>(Some(table), trail, &mut gen, tabu, tour, limit, pow)
+        };
         *rng = gen;
         r
     }
 
-    /// The loop of [`Ant::walk_cells`] (`table` `None`) and [`Ant::walk_table`].
+    /// The loop of [`Ant::walk_cells`] (`table` `None`) and [`Ant::walk_table`], reading the
+    /// tabu set in its rows layout (`ROWS`: by the ant's column and row, [`TabuSet::around_at`])
+    /// or in its linear one (by the cell's index): the caller knows which the set has.
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
-    fn cells_loop(
+    fn cells_loop<const ROWS: bool>(
         &self,
         table: Option<&WeightTable<'_>>,
         trail: &mut Trail,
@@ -105,7 +113,7 @@ impl Ant<'_, '_, '_> {
         let stop = self.budget.min(moves.saturating_add(*limit));
         while ci != goal {
             let allowed = self.moves.at(ci, cur);
-            let tabu_moves = visited_moves(tabu, ci, allowed, width);
+            let tabu_moves = visited::<ROWS>(tabu, ci, cur, width) & allowed;
             // As in the general loop.
             if !may_tighten && tabu_moves & tabu_moves.wrapping_sub(1) != 0 {
                 may_tighten = self.shortcut_seen(ci, tabu_moves, step);
@@ -215,7 +223,7 @@ impl Ant<'_, '_, '_> {
                     }
                     DeadEnd::Backtrack => {
                         let ni = ci.wrapping_add_signed(step(usize::from(d)));
-                        tabu.insert(ni);
+                        enter::<ROWS>(tabu, ni, neighbour(cur, d));
                         moves = moves.wrapping_sub(1); // counted above: at least 1
                         continue;
                     }
@@ -225,11 +233,35 @@ impl Ant<'_, '_, '_> {
             steps = steps.wrapping_add(1); // < tour.len() + 1: the slot existed
             ci = ci.wrapping_add_signed(step(usize::from(d)));
             cur = neighbour(cur, d);
-            tabu.insert(ci);
+            enter::<ROWS>(tabu, ci, cur);
         }
         *limit = limit.saturating_sub(moves.wrapping_sub(first));
         self.arrived(tabu, tour, steps, moves, may_tighten)
     }
+}
+
+/// The tabu set's cells around cell `ci` at `at` on a map `width` wide, as a direction mask
+/// ([`TabuSet::around`]), read in the rows layout (`ROWS`) or the linear one, unchecked.
+#[inline(always)]
+fn visited<const ROWS: bool>(tabu: &TabuSet<'_>, ci: usize, at: Point, width: usize) -> u8 {
+    #[cfg(any(feature = "alloc", test))]
+    if ROWS {
+        return tabu.around_at(at);
+    }
+    let _ = at;
+    tabu.around_linear(ci, width)
+}
+
+/// Put cell `ci` at `at` in the tabu set ([`TabuSet::insert`]), in the rows layout (`ROWS`) or
+/// the linear one, unchecked.
+#[inline(always)]
+fn enter<const ROWS: bool>(tabu: &mut TabuSet<'_>, ci: usize, at: Point) {
+    #[cfg(any(feature = "alloc", test))]
+    if ROWS {
+        return tabu.insert_at(at);
+    }
+    let _ = at;
+    tabu.insert_linear(ci);
 }
 
 /// [`roulette`] over the open moves (the set bits of `open`, at least two, lowest first) with

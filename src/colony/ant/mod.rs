@@ -254,6 +254,10 @@ impl Ant<'_, '_, '_> {
         tour: &mut [Dir],
         left: &mut u32,
     ) -> Result<Option<Walk>, Lost> {
+        // The loop for an entry a cell without a table reads the linear layout only: a set in
+        // the rows layout walks by the general loop, which reads either (the same walk).
+        #[cfg(any(feature = "alloc", test))]
+        let cells = cells && !tabu.is_rows();
         // The common exponent gets its own copy of each loop, without a test per candidate;
         // `pow_alpha(t, 1.0)` is `t`, so both give the same weights. Each loop is a function of
         // its own, so this one's stack frame is small and the deeper of them is the stack's need.
@@ -607,12 +611,15 @@ mod tests {
     }
 
     /// Walk the ant in pieces of `piece` moves by one loop (`cells`: [`Ant::walk_cells`], or
-    /// [`Ant::walk_table`] for an ant with a weight table; else the general one): every
-    /// piece's result, the tour, the tabu set and the generator's state at the end.
+    /// [`Ant::walk_table`] for an ant with a weight table; else the general one), with the tabu
+    /// set in the rows layout where `rows` and the map is narrow enough (over junk words, a set
+    /// made again at each piece as the planner's colony does): every piece's result, the tour,
+    /// the tabu set (its cells, in the linear layout) and the generator's state at the end.
     #[allow(clippy::type_complexity)]
     fn pieces(
         ant: &Ant<'_, '_, '_>,
         cells: bool,
+        rows: bool,
         seed: u64,
         piece: u32,
         tour_len: usize,
@@ -622,27 +629,41 @@ mod tests {
         Vec<u32>,
         Xoshiro128pp,
     ) {
-        let cells_n = ant.moves.grid().cells();
+        let grid = ant.moves.grid();
+        let cells_n = grid.cells();
+        let (w, h) = (usize::from(grid.width()), usize::from(grid.height()));
         let mut tabu = vec![0u32; bitmap::words(cells_n)];
+        let mut spare: Vec<u32> = (0..crate::colony::tabu::rows_words(cells_n) as u32)
+            .map(|i| i.wrapping_mul(0x9E37_79B9))
+            .collect();
         let mut tour = vec![0u8; tour_len];
         let mut rng = Xoshiro128pp::from_u64(seed);
-        let mut set = TabuSet::new(&mut tabu);
-        let mut trail = ant.begin(&mut set, &mut tour);
+        let mut trail = None;
         let mut out = Vec::new();
-        loop {
+        let linear = loop {
+            let mut set = TabuSet::new(&mut tabu);
+            if rows {
+                set = set.with_rows(&mut spare, w, h, ant.dead);
+                assert_eq!(set.is_rows(), w <= crate::colony::tabu::ROWS_WIDTH);
+            }
+            let trail = trail.get_or_insert_with(|| ant.begin(&mut set, &mut tour));
             let mut left = piece;
             let r = if cells && ant.weights.is_some() {
                 // The loop reading the table (an entry a cell, no route: `resume` takes it).
-                ant.resume(&mut trail, &mut rng, &mut set, &mut tour, &mut left)
+                ant.resume(trail, &mut rng, &mut set, &mut tour, &mut left)
             } else {
-                ant.resume_by(cells, &mut trail, &mut rng, &mut set, &mut tour, &mut left)
+                ant.resume_by(cells, trail, &mut rng, &mut set, &mut tour, &mut left)
             };
             out.push(r);
             if !matches!(r, Ok(None)) {
-                break;
+                let mut linear = vec![0u32; bitmap::words(cells_n)];
+                for i in (0..cells_n).filter(|&i| set.contains(i)) {
+                    bitmap::set(&mut linear, i);
+                }
+                break linear;
             }
-        }
-        (out, tour, tabu, rng)
+        };
+        (out, tour, linear, rng)
     }
 
     #[test]
@@ -727,15 +748,19 @@ mod tests {
             };
             let piece = [u32::MAX, 1, 3, 17][r.next_word() as usize % 4];
             let seed = u64::from(r.next_word());
-            let cells = pieces(&ant, true, seed, piece, tour_len);
-            let general = pieces(&ant, false, seed, piece, tour_len);
+            let cells = pieces(&ant, true, false, seed, piece, tour_len);
+            let general = pieces(&ant, false, false, seed, piece, tour_len);
             assert_eq!(cells.0, general.0, "case {case}");
             assert_eq!(cells.1, general.1, "case {case}: tour");
             assert_eq!(cells.2, general.2, "case {case}: tabu");
             assert_eq!(cells.3, general.3, "case {case}: generator");
+            // A set in the rows layout and no table: the general loop walks it, the same walk.
+            let by_rows = pieces(&ant, true, true, seed, piece, tour_len);
+            assert_eq!(by_rows, general, "case {case}: rows without a table");
             // The same loop reading a weight table (its words junk until cleared, small numbers
             // that an open-move mask may equal): three ants of one iteration, so that rows and
-            // sums another ant filled are read, walk as the general loop.
+            // sums another ant filled are read, walk as the general loop; the first two with
+            // the tabu set in the rows layout, the third in the linear one.
             let n = crate::colony::weights::words(g.cells());
             let mut words: Vec<u32> = (0..n as u32).map(|i| i.wrapping_mul(37) % 256).collect();
             let t = WeightTable::of(&mut words, g.cells()).unwrap();
@@ -748,8 +773,8 @@ mod tests {
                 .into_iter()
                 .enumerate()
             {
-                let table = pieces(&tabled, true, seed, piece, tour_len);
-                let general = pieces(&ant, false, seed, piece, tour_len);
+                let table = pieces(&tabled, true, k < 2, seed, piece, tour_len);
+                let general = pieces(&ant, false, false, seed, piece, tour_len);
                 assert_eq!(table.0, general.0, "case {case}, ant {k}: table");
                 assert_eq!(table.1, general.1, "case {case}, ant {k}: table's tour");
                 assert_eq!(table.2, general.2, "case {case}, ant {k}: table's tabu");

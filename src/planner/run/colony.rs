@@ -184,7 +184,10 @@ impl Run<'_, '_> {
         let p = self.params;
         // The walks read a weight table where they walk by the loop for an entry a cell (the
         // pheromone's block shift 0, no route: `Ant::resume`).
-        let table = (self.blocks.shift() == 0 && !self.routed).then_some(self.grid.cells());
+        let table = (self.blocks.shift() == 0 && !self.routed).then_some((
+            usize::from(self.grid.width()),
+            usize::from(self.grid.height()),
+        ));
         // Every buffer an ant reads or writes (`lend::Colony`).
         let Colony {
             tau,
