@@ -111,55 +111,40 @@ pub fn sweep(
     let lines = lines.filter(|l| l.corners == [lo, hi]);
     let (fx, fy) = (ux.wrapping_sub(x0), uy.wrapping_sub(y0));
     let (bx, by) = (x1.wrapping_sub(ux), y1.wrapping_sub(uy));
-    for (rows, cols, dr, dc, goal, (kind, step, shift)) in [
+    for (k, (rows, cols, dr, dc, goal)) in [
         // Depth along x (columns along y), then depth along y; the goal in (depth, column).
-        (right.min(dr_), down, 1, w, (gx, gy), (COLS, 1, fy)),
-        (
-            right.min(dr_),
-            up,
-            1,
-            w.wrapping_neg(),
-            (gx, -gy),
-            (COLS_REV, 1, by),
-        ),
-        (left.min(dl_), down, -1, w, (-gx, gy), (COLS, -1, fy)),
-        (
-            left.min(dl_),
-            up,
-            -1,
-            w.wrapping_neg(),
-            (-gx, -gy),
-            (COLS_REV, -1, by),
-        ),
-        (down.min(dd_), right, w, 1, (gy, gx), (ROWS, 1, fx)),
-        (down.min(dd_), left, w, -1, (gy, -gx), (ROWS_REV, 1, bx)),
-        (
-            up.min(du_),
-            right,
-            w.wrapping_neg(),
-            1,
-            (-gy, gx),
-            (ROWS, -1, fx),
-        ),
-        (
-            up.min(du_),
-            left,
-            w.wrapping_neg(),
-            -1,
-            (-gy, -gx),
-            (ROWS_REV, -1, bx),
-        ),
-    ] {
+        (right.min(dr_), down, 1, w, (gx, gy)),
+        (right.min(dr_), up, 1, w.wrapping_neg(), (gx, -gy)),
+        (left.min(dl_), down, -1, w, (-gx, gy)),
+        (left.min(dl_), up, -1, w.wrapping_neg(), (-gx, -gy)),
+        (down.min(dd_), right, w, 1, (gy, gx)),
+        (down.min(dd_), left, w, -1, (gy, -gx)),
+        (up.min(du_), right, w.wrapping_neg(), 1, (-gy, gx)),
+        (up.min(du_), left, w.wrapping_neg(), -1, (-gy, -gx)),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        // The octant's lines, from its place in the list (not a column of it: the list's
+        // entries are on the stack, whose depth the device's RAM budget counts): the first
+        // four go along x, the last four along y ([`OCTANT_LINES`]); odd ones have their
+        // columns backwards (up, or left), and the third and fourth of each four their depth.
         let line = lines.map(|l| {
-            let first = if kind == COLS || kind == COLS_REV {
-                fx
+            let back = k & 1 == 1;
+            let (first, shift) = if k < 4 {
+                (fx, if back { by } else { fy })
             } else {
-                fy
+                (fy, if back { bx } else { fx })
             };
             OctantLines {
-                lines: l.sets.get(kind).copied().unwrap_or_default(),
+                lines: OCTANT_LINES
+                    .get(k)
+                    .and_then(|&kind| l.sets.get(kind))
+                    .copied()
+                    .unwrap_or_default(),
                 first,
-                step,
+                // k < 8: 1 for the first two of each four, -1 for the others.
+                step: 1i32.wrapping_sub(k as i32 & 2),
                 shift: shift as u32,
             }
         });
@@ -216,6 +201,11 @@ struct Octant<'g, 'b> {
 /// The longest side of a box whose lines [`Lines`] holds: a line is one word, and an octant's
 /// row reads its columns `0..=r + 1` (`r` below the side) from it.
 pub const LINE_SIDE: u16 = 31;
+
+/// The set of [`Lines`] each of [`sweep`]'s eight octants reads its rows from, in its order.
+const OCTANT_LINES: [usize; 8] = [
+    COLS, COLS_REV, COLS, COLS_REV, ROWS, ROWS_REV, ROWS, ROWS_REV,
+];
 
 /// Which of [`Lines`]'s four sets.
 const ROWS: usize = 0;
