@@ -20,21 +20,6 @@ pub fn get(bits: &[u8], i: usize) -> Option<bool> {
     bits.get(i >> 3).map(|b| (b >> (i & 7)) & 1 == 1)
 }
 
-/// Cells `i..i + n` (`n` at most 32) as the low bits of a word, bit `k` = cell `i + k` (1 =
-/// blocked); cells past the end of `bits` read as blocked.
-#[inline]
-pub fn run(bits: &[u8], i: usize, n: u32) -> u32 {
-    let k = i >> 3;
-    let byte = |j: usize| u64::from(bits.get(k.wrapping_add(j)).copied().unwrap_or(0xFF));
-    let word = byte(0) | byte(1) << 8 | byte(2) << 16 | byte(3) << 24 | byte(4) << 32;
-    let mask = if n >= 32 {
-        u32::MAX
-    } else {
-        (1u32 << n).wrapping_sub(1)
-    };
-    (word >> (i & 7)) as u32 & mask
-}
-
 /// Set cell `i`'s bit to `blocked` (nothing past the end).
 #[inline]
 pub fn set(bits: &mut [u8], i: usize, blocked: bool) {
@@ -90,21 +75,6 @@ mod tests {
         set(&mut b, 99, true);
         assert_eq!(b, [0b1, 0, 0]);
         assert_eq!(bytes(17), 3);
-    }
-
-    #[test]
-    fn a_run_reads_its_cells_and_blocked_past_the_end() {
-        // Every start and length over seven bytes of a pattern, against one read a cell.
-        let b = [0b1011_0010u8, 0xFF, 0x00, 0b0101_0101, 0x3C, 0x81, 0x7E];
-        for i in 0..64 {
-            for n in 0..=32u32 {
-                let got = run(&b, i, n);
-                for k in 0..32 {
-                    let want = k < n as usize && get(&b, i + k).unwrap_or(true);
-                    assert_eq!(got >> k & 1 == 1, want, "run({i}, {n}) bit {k}");
-                }
-            }
-        }
     }
 
     #[test]

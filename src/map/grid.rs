@@ -688,6 +688,21 @@ mod tests {
     }
 
     #[test]
+    fn the_blocked_window_reads_its_cells_and_blocked_past_the_end() {
+        // Every start over seven bytes of a pattern (a 56 x 1 map) and its low 32 bits, against
+        // one read a cell (beyond the buffer: blocked).
+        let b = [0b1011_0010u8, 0xFF, 0x00, 0b0101_0101, 0x3C, 0x81, 0x7E];
+        let g = Grid::new(56, 1, &b).unwrap();
+        for i in 0..64 {
+            let got = g.blocked_window(i) as u32;
+            for k in 0..32 {
+                let want = crate::map::bits::get(&b, i + k).unwrap_or(true);
+                assert_eq!(got >> k & 1 == 1, want, "blocked_window({i}) bit {k}");
+            }
+        }
+    }
+
+    #[test]
     fn rejects_empty_and_short_maps() {
         assert_eq!(Grid::new(0, 3, &[0; 4]).unwrap_err(), Error::BadMap);
         assert_eq!(Grid::new(5, 5, &[0; 3]).unwrap_err(), Error::BadMap);

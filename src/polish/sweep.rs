@@ -295,7 +295,7 @@ impl<'a> Lines<'a> {
             let i = y
                 .wrapping_mul(usize::from(grid.width()))
                 .wrapping_add(usize::from(lo.x));
-            let free = !crate::map::bits::run(grid.bits(), i, w) & full;
+            let free = !(grid.blocked_window(i) as u32) & full;
             *row = free;
             *rev = free.reverse_bits().wrapping_shr(32u32.wrapping_sub(w));
             // The row's free cells in the columns: bit k from the top, h - 1 - k from the bottom.
