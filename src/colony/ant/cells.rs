@@ -31,6 +31,14 @@ impl Ant<'_, '_, '_> {
         // The generator as a local: the loop keeps its state in registers (through `rng` it
         // would store it at every draw, since the tour and tabu writes might alias it).
         let mut gen = rng.clone();
+        // The tabu set's layout, as in `walk_table` (only a host build has the rows layout: the
+        // device's loop is the linear one alone).
+        #[cfg(any(feature = "alloc", test))]
+        if tabu.is_rows() {
+            let r = self.cells_loop::<true>(None, trail, &mut gen, tabu, tour, limit, pow);
+            *rng = gen;
+            return r;
+        }
         let r = self.cells_loop::<false>(None, trail, &mut gen, tabu, tour, limit, pow);
         *rng = gen;
         r

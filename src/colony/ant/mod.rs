@@ -254,10 +254,6 @@ impl Ant<'_, '_, '_> {
         tour: &mut [Dir],
         left: &mut u32,
     ) -> Result<Option<Walk>, Lost> {
-        // The loop for an entry a cell without a table reads the linear layout only: a set in
-        // the rows layout walks by the general loop, which reads either (the same walk).
-        #[cfg(any(feature = "alloc", test))]
-        let cells = cells && !tabu.is_rows();
         // The common exponent gets its own copy of each loop, without a test per candidate;
         // `pow_alpha(t, 1.0)` is `t`, so both give the same weights. Each loop is a function of
         // its own, so this one's stack frame is small and the deeper of them is the stack's need.
@@ -754,7 +750,8 @@ mod tests {
             assert_eq!(cells.1, general.1, "case {case}: tour");
             assert_eq!(cells.2, general.2, "case {case}: tabu");
             assert_eq!(cells.3, general.3, "case {case}: generator");
-            // A set in the rows layout and no table: the general loop walks it, the same walk.
+            // A set in the rows layout and no table: the loop for an entry a cell walks it in
+            // that layout, the same walk.
             let by_rows = pieces(&ant, true, true, seed, piece, tour_len);
             assert_eq!(by_rows, general, "case {case}: rows without a table");
             // The same loop reading a weight table (its words junk until cleared, small numbers
